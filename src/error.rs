@@ -1,0 +1,57 @@
+//! The library's error type: every failure a user can cause ends as one of these, printed as one line.
+
+use std::path::PathBuf;
+
+/// Everything that can stop a lodbench command. The binary prints `error: {self}` and exits non-zero.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error("unknown {kind} '{name}'; valid {kind}s: {valid}")]
+    UnknownName {
+        kind: &'static str,
+        name: String,
+        valid: String,
+    },
+    #[error("mesh {path}: {problem}")]
+    Mesh { path: String, problem: String },
+    #[error("invalid configuration: {0}")]
+    Config(String),
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("output folder {}: {problem}", path.display())]
+    Output { path: PathBuf, problem: String },
+    #[error("{0}")]
+    NoAdapter(String),
+    #[error("GPU error: {0}")]
+    Gpu(String),
+    #[error("CSV: {0}")]
+    Csv(#[from] csv::Error),
+    #[error("JSON: {0}")]
+    Json(#[from] serde_json::Error),
+    #[error("PNG {}: {problem}", path.display())]
+    Image { path: PathBuf, problem: String },
+    #[error("interrupted by signal")]
+    Interrupted,
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+
+    pub fn unknown(kind: &'static str, name: &str, valid: &[&str]) -> Self {
+        Error::UnknownName {
+            kind,
+            name: name.to_string(),
+            valid: valid.join(", "),
+        }
+    }
+}

@@ -1,0 +1,251 @@
+//! frames.csv and summary.csv. frames.csv is written as `frames.csv.partial`, flushed after each block, and
+//! renamed to `frames.csv` only when the run completes, so an interrupted run keeps what it measured without
+//! leaving a file that looks complete.
+
+use crate::error::{Error, Result};
+use serde::Serialize;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+/// One row of frames.csv: one frame of one method on one scene block.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct FrameRecord {
+    pub scene: String,
+    pub method: String,
+    /// Instance count of the block (bunny-grid's n; 1 for bunny-sweep).
+    pub count: u32,
+    pub frame: u32,
+    /// GPU time between timestamps around all of the frame's passes (empty without timestamp queries).
+    pub gpu_ms: Option<f64>,
+    /// CPU wall time from the start of encoding to the GPU's completion of the frame.
+    pub cpu_ms: f64,
+    pub triangles: u64,
+    pub draw_calls: u32,
+    /// Instances in transition (lod_from != lod_to) this frame.
+    pub t_instances: u32,
+    /// Mean over instances of lod_from + k (lod_to - lod_from), the same for every method.
+    pub lod_mean: f64,
+    pub rmse: f64,
+    pub pop: f64,
+}
+
+/// One row of summary.csv: one method on one scene block.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SummaryRecord {
+    pub scene: String,
+    pub method: String,
+    pub count: u32,
+    pub frames: u32,
+    pub gpu_ms_median: Option<f64>,
+    pub gpu_ms_p5: Option<f64>,
+    pub gpu_ms_p95: Option<f64>,
+    pub cpu_ms_median: f64,
+    pub triangles_mean: f64,
+    pub draw_calls_mean: f64,
+    pub t_instances_mean: f64,
+    pub rmse_mean: f64,
+    pub rmse_max: f64,
+    pub pop_max: f64,
+    pub pop_p95: f64,
+    pub extra_target_bytes: u64,
+}
+
+/// Percentile with linear interpolation between closest ranks (numpy's default); None for no values.
+pub fn percentile(values: &[f64], p: f64) -> Option<f64> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| !x.is_nan()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(|a, b| a.total_cmp(b));
+    let pos = (p / 100.0).clamp(0.0, 1.0) * (v.len() - 1) as f64;
+    let lo = pos.floor() as usize;
+    let hi = pos.ceil() as usize;
+    Some(v[lo] + (v[hi] - v[lo]) * (pos - lo as f64))
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (s, n) = values.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+    if n == 0 {
+        0.0
+    } else {
+        s / n as f64
+    }
+}
+
+impl SummaryRecord {
+    /// Summarises one block's rows (all of the same scene, method and count).
+    pub fn from_frames(rows: &[FrameRecord], extra_target_bytes: u64) -> Option<SummaryRecord> {
+        let first = rows.first()?;
+        let gpu: Vec<f64> = rows.iter().filter_map(|r| r.gpu_ms).collect();
+        let cpu: Vec<f64> = rows.iter().map(|r| r.cpu_ms).collect();
+        let pop: Vec<f64> = rows.iter().map(|r| r.pop).collect();
+        Some(SummaryRecord {
+            scene: first.scene.clone(),
+            method: first.method.clone(),
+            count: first.count,
+            frames: rows.len() as u32,
+            gpu_ms_median: percentile(&gpu, 50.0),
+            gpu_ms_p5: percentile(&gpu, 5.0),
+            gpu_ms_p95: percentile(&gpu, 95.0),
+            cpu_ms_median: percentile(&cpu, 50.0).unwrap_or(f64::NAN),
+            triangles_mean: mean(rows.iter().map(|r| r.triangles as f64)),
+            draw_calls_mean: mean(rows.iter().map(|r| r.draw_calls as f64)),
+            t_instances_mean: mean(rows.iter().map(|r| r.t_instances as f64)),
+            rmse_mean: mean(rows.iter().map(|r| r.rmse)),
+            rmse_max: rows.iter().map(|r| r.rmse).fold(0.0, f64::max),
+            pop_max: pop.iter().copied().fold(0.0, f64::max),
+            pop_p95: percentile(&pop, 95.0).unwrap_or(0.0),
+            extra_target_bytes,
+        })
+    }
+}
+
+pub const FRAMES_CSV: &str = "frames.csv";
+pub const SUMMARY_CSV: &str = "summary.csv";
+pub const PARTIAL_SUFFIX: &str = ".partial";
+
+/// Appends frame rows to `frames.csv.partial`; `finish` renames it to `frames.csv`.
+pub struct FramesWriter {
+    writer: ::csv::Writer<File>,
+    partial: PathBuf,
+    done: PathBuf,
+}
+
+impl FramesWriter {
+    pub fn create(dir: &Path) -> Result<FramesWriter> {
+        let done = dir.join(FRAMES_CSV);
+        let partial = dir.join(format!("{FRAMES_CSV}{PARTIAL_SUFFIX}"));
+        let file = File::create(&partial).map_err(|e| Error::io(&partial, e))?;
+        Ok(FramesWriter {
+            writer: ::csv::Writer::from_writer(file),
+            partial,
+            done,
+        })
+    }
+
+    pub fn write_block(&mut self, rows: &[FrameRecord]) -> Result<()> {
+        for r in rows {
+            self.writer.serialize(r)?;
+        }
+        self.writer.flush().map_err(|e| Error::io(&self.partial, e))
+    }
+
+    pub fn finish(mut self) -> Result<PathBuf> {
+        self.writer
+            .flush()
+            .map_err(|e| Error::io(&self.partial, e))?;
+        drop(self.writer);
+        std::fs::rename(&self.partial, &self.done).map_err(|e| Error::io(&self.done, e))?;
+        Ok(self.done)
+    }
+}
+
+/// Writes summary.csv (through a temporary file, so it appears whole or not at all).
+pub fn write_summary(dir: &Path, rows: &[SummaryRecord]) -> Result<PathBuf> {
+    let path = dir.join(SUMMARY_CSV);
+    let tmp = dir.join(format!("{SUMMARY_CSV}{PARTIAL_SUFFIX}"));
+    {
+        let file = File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
+        let mut w = ::csv::Writer::from_writer(file);
+        for r in rows {
+            w.serialize(r)?;
+        }
+        w.flush().map_err(|e| Error::io(&tmp, e))?;
+    }
+    std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, e))?;
+    Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(frame: u32, gpu: Option<f64>, rmse: f64, pop: f64) -> FrameRecord {
+        FrameRecord {
+            scene: "s".into(),
+            method: "m".into(),
+            count: 1,
+            frame,
+            gpu_ms: gpu,
+            cpu_ms: 2.0,
+            triangles: 100 + frame as u64,
+            draw_calls: 1,
+            t_instances: 0,
+            lod_mean: 0.0,
+            rmse,
+            pop,
+        }
+    }
+
+    #[test]
+    fn percentile_interpolates_like_numpy() {
+        let v = [1.0, 2.0, 3.0, 4.0];
+        assert_eq!(percentile(&v, 50.0), Some(2.5));
+        assert_eq!(percentile(&v, 0.0), Some(1.0));
+        assert_eq!(percentile(&v, 100.0), Some(4.0));
+        assert!((percentile(&v, 95.0).unwrap() - 3.85).abs() < 1e-12);
+        assert_eq!(percentile(&[], 50.0), None);
+    }
+
+    #[test]
+    fn summary_of_rows() {
+        let rows = vec![
+            row(0, Some(1.0), 0.0, 0.0),
+            row(1, Some(3.0), 0.2, 0.5),
+            row(2, Some(2.0), 0.1, 0.1),
+        ];
+        let s = SummaryRecord::from_frames(&rows, 0).unwrap();
+        assert_eq!(s.frames, 3);
+        assert_eq!(s.gpu_ms_median, Some(2.0));
+        assert!((s.rmse_mean - 0.1).abs() < 1e-12);
+        assert_eq!(s.rmse_max, 0.2);
+        assert_eq!(s.pop_max, 0.5);
+        assert_eq!(s.triangles_mean, 101.0);
+        let no_gpu: Vec<_> = rows
+            .iter()
+            .map(|r| FrameRecord {
+                gpu_ms: None,
+                ..r.clone()
+            })
+            .collect();
+        assert_eq!(
+            SummaryRecord::from_frames(&no_gpu, 0)
+                .unwrap()
+                .gpu_ms_median,
+            None
+        );
+    }
+
+    #[test]
+    fn frames_csv_appears_only_when_finished() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut w = FramesWriter::create(dir.path()).unwrap();
+        w.write_block(&[row(0, None, 0.5, 0.0)]).unwrap();
+        assert!(!dir.path().join(FRAMES_CSV).exists());
+        let partial = std::fs::read_to_string(dir.path().join("frames.csv.partial")).unwrap();
+        assert!(partial.starts_with(
+            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,t_instances,lod_mean,rmse,pop\n"
+        ));
+        assert!(
+            partial.contains("s,m,1,0,,2.0,100,1,0,0.0,0.5,0.0"),
+            "{partial}"
+        );
+        w.finish().unwrap();
+        assert!(dir.path().join(FRAMES_CSV).exists());
+        assert!(!dir.path().join("frames.csv.partial").exists());
+    }
+
+    #[test]
+    fn csv_round_trips_exactly() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut w = FramesWriter::create(dir.path()).unwrap();
+        let r = row(3, Some(0.1 + 0.2), 1.0 / 3.0, 2f64.sqrt());
+        w.write_block(std::slice::from_ref(&r)).unwrap();
+        let path = w.finish().unwrap();
+        let mut rd = ::csv::Reader::from_path(path).unwrap();
+        let rec = rd.records().next().unwrap().unwrap();
+        assert_eq!(rec[4].parse::<f64>().unwrap(), 0.1 + 0.2);
+        assert_eq!(rec[10].parse::<f64>().unwrap(), 1.0 / 3.0);
+        assert_eq!(rec[11].parse::<f64>().unwrap(), 2f64.sqrt());
+    }
+}

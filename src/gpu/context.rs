@@ -1,0 +1,202 @@
+//! The headless device: adapter choice, device creation, and GPU errors turned into `Error`s.
+
+use crate::error::{Error, Result};
+use serde::Serialize;
+use std::sync::{Arc, Mutex};
+
+/// The adapter facts recorded in run.json and printed by `lodbench list`.
+#[derive(Debug, Clone, Serialize)]
+pub struct AdapterSummary {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    pub driver_info: String,
+}
+
+impl From<&wgpu::AdapterInfo> for AdapterSummary {
+    fn from(i: &wgpu::AdapterInfo) -> Self {
+        AdapterSummary {
+            name: i.name.clone(),
+            backend: format!("{:?}", i.backend).to_lowercase(),
+            device_type: format!("{:?}", i.device_type),
+            driver: i.driver.clone(),
+            driver_info: i.driver_info.clone(),
+        }
+    }
+}
+
+/// How frame times are taken.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TimingSource {
+    /// GPU timestamp queries around all of a frame's passes.
+    GpuTimestamps,
+    /// No timestamps on this adapter: only the CPU clock from encoding to completion.
+    CpuClock,
+}
+
+pub const NO_ADAPTER_HELP: &str = "no GPU adapter found (lodbench needs Vulkan, Metal or DX12). \
+On a machine without a GPU install a software Vulkan driver, e.g. on Debian/Ubuntu: \
+`sudo apt-get install mesa-vulkan-drivers libvulkan1` (Mesa lavapipe)";
+
+pub struct GpuContext {
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: AdapterSummary,
+    pub timing: TimingSource,
+    /// Nanoseconds per timestamp tick.
+    pub timestamp_period_ns: f32,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+fn instance() -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12;
+    wgpu::Instance::new(desc)
+}
+
+fn type_rank(t: wgpu::DeviceType) -> u8 {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Cpu => 3,
+        wgpu::DeviceType::Other => 4,
+    }
+}
+
+/// Every adapter wgpu finds, best first (discrete, integrated, virtual, CPU).
+pub fn enumerate_adapters() -> Vec<wgpu::Adapter> {
+    let inst = instance();
+    let mut adapters = pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all()));
+    adapters.sort_by_key(|a| type_rank(a.get_info().device_type));
+    adapters
+}
+
+impl GpuContext {
+    /// Opens the best adapter, or the first whose name contains `filter` (case-insensitive).
+    pub fn new(filter: Option<&str>) -> Result<GpuContext> {
+        let adapters = enumerate_adapters();
+        if adapters.is_empty() {
+            return Err(Error::NoAdapter(NO_ADAPTER_HELP.into()));
+        }
+        let adapter = match filter {
+            Some(f) => {
+                let needle = f.to_lowercase();
+                adapters
+                    .iter()
+                    .find(|a| a.get_info().name.to_lowercase().contains(&needle))
+                    .cloned()
+                    .ok_or_else(|| {
+                        let names: Vec<String> =
+                            adapters.iter().map(|a| a.get_info().name).collect();
+                        Error::NoAdapter(format!(
+                            "no adapter name contains '{f}'; found: {}",
+                            names.join(", ")
+                        ))
+                    })?
+            }
+            None => adapters[0].clone(),
+        };
+        let info = adapter.get_info();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let required_features = if timestamps {
+            wgpu::Features::TIMESTAMP_QUERY
+        } else {
+            wgpu::Features::empty()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("lodbench device"),
+            required_features,
+            required_limits: adapter.limits(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|e| Error::Gpu(format!("cannot open a device on {}: {e}", info.name)))?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut v) = sink.lock() {
+                // wgpu's messages span lines; keep them to one.
+                let text = e.to_string();
+                v.push(text.split_whitespace().collect::<Vec<_>>().join(" "));
+            }
+        }));
+        let timestamp_period_ns = queue.get_timestamp_period();
+        Ok(GpuContext {
+            info: AdapterSummary::from(&info),
+            adapter,
+            device,
+            queue,
+            timing: if timestamps {
+                TimingSource::GpuTimestamps
+            } else {
+                TimingSource::CpuClock
+            },
+            timestamp_period_ns,
+            errors,
+        })
+    }
+
+    /// Turns any GPU validation or out-of-memory error reported so far into an `Error`.
+    pub fn check_errors(&self) -> Result<()> {
+        let mut v = self
+            .errors
+            .lock()
+            .map_err(|_| Error::Gpu("error log poisoned".into()))?;
+        if v.is_empty() {
+            Ok(())
+        } else {
+            let first = v.remove(0);
+            let more = v.len();
+            v.clear();
+            Err(Error::Gpu(if more > 0 {
+                format!("{first} (and {more} more)")
+            } else {
+                first
+            }))
+        }
+    }
+
+    /// Blocks until all submitted work is done.
+    pub fn wait_idle(&self) -> Result<()> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))?;
+        self.check_errors()
+    }
+
+    /// Checks that a viewport fits this device.
+    pub fn check_viewport(&self, width: u32, height: u32) -> Result<()> {
+        let max = self.device.limits().max_texture_dimension_2d;
+        if width > max || height > max {
+            return Err(Error::Config(format!(
+                "viewport {width}x{height} exceeds this adapter's largest texture side {max}"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Maps `buffer` for reading, waits, and hands its bytes to `f`.
+    pub fn read_buffer<T>(&self, buffer: &wgpu::Buffer, f: impl FnOnce(&[u8]) -> T) -> Result<T> {
+        let (tx, rx) = std::sync::mpsc::channel();
+        buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait_idle()?;
+        rx.recv()
+            .map_err(|_| Error::Gpu("buffer map callback never ran".into()))?
+            .map_err(|e| Error::Gpu(format!("mapping a read-back buffer: {e}")))?;
+        let out = {
+            let view = buffer
+                .get_mapped_range(..)
+                .map_err(|e| Error::Gpu(format!("reading a mapped buffer: {e:?}")))?;
+            f(&view)
+        };
+        buffer.unmap();
+        Ok(out)
+    }
+}

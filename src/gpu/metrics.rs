@@ -1,0 +1,151 @@
+//! The metric kernels of `shaders/metrics.wgsl`: rmse and pop per frame, computed on the GPU and read back as
+//! scalars. Results of every frame of a block go to their own slot of one buffer, read once at the end.
+
+use crate::error::Result;
+use crate::gpu::context::GpuContext;
+use crate::gpu::renderer::RenderTarget;
+use crate::metrics::FrameMetrics;
+
+pub const METRICS_WGSL: &str = include_str!("../../shaders/metrics.wgsl");
+
+pub struct MetricKernel {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    sums: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    width: u32,
+    height: u32,
+    frames: u32,
+}
+
+impl MetricKernel {
+    /// Compares `method` against `reference` (both the same size) over up to `frames` frames.
+    pub fn new(
+        ctx: &GpuContext,
+        method: &RenderTarget,
+        reference: &RenderTarget,
+        frames: u32,
+    ) -> Result<MetricKernel> {
+        let device = &ctx.device;
+        let (width, height) = (method.width, method.height);
+        let frames = frames.max(1);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("metrics.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(METRICS_WGSL.into()),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("metric kernel"),
+            layout: None,
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let prev_error = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("previous error image"),
+            size: width as u64 * height as u64 * 4,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let sums_size = frames as u64 * 16;
+        let sums = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("metric sums"),
+            size: sums_size,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("metric read-back"),
+            size: sums_size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("metric params"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("metric bind group"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&method.color_bytes_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&reference.color_bytes_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: prev_error.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: sums.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: params.as_entire_binding(),
+                },
+            ],
+        });
+        ctx.check_errors()?;
+        Ok(MetricKernel {
+            pipeline,
+            bind_group,
+            params,
+            sums,
+            readback,
+            width,
+            height,
+            frames,
+        })
+    }
+
+    /// Records the metric pass for `frame` (0-based within the block; frame 0 has pop 0). The sums of the
+    /// block are zeroed when frame 0 is recorded.
+    pub fn encode(&self, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder, frame: u32) {
+        let slot = frame.min(self.frames - 1);
+        if frame == 0 {
+            encoder.clear_buffer(&self.sums, 0, None);
+        }
+        let params = [self.width, self.height, slot, (frame > 0) as u32];
+        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("metric pass"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.dispatch_workgroups(1, self.height, 1);
+    }
+
+    /// rmse and pop of frames `0..frames`, after their submissions.
+    pub fn read(&self, ctx: &GpuContext, frames: u32) -> Result<Vec<FrameMetrics>> {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.sums, 0, &self.readback, 0, None);
+        ctx.queue.submit([encoder.finish()]);
+        let pixels = self.width as f64 * self.height as f64;
+        let n = frames.min(self.frames) as usize;
+        ctx.read_buffer(&self.readback, |bytes| {
+            let words: &[u32] = bytemuck::cast_slice(bytes);
+            (0..n)
+                .map(|f| {
+                    let w = &words[f * 4..f * 4 + 4];
+                    let rmse_sum = w[0] as u64 | (w[1] as u64) << 32;
+                    let pop_sum = w[2] as u64 | (w[3] as u64) << 32;
+                    FrameMetrics {
+                        rmse: (rmse_sum as f64 / (9.0 * 255.0 * 255.0 * pixels)).sqrt(),
+                        pop: (pop_sum as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt(),
+                    }
+                })
+                .collect()
+        })
+    }
+}

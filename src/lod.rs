@@ -1,0 +1,223 @@
+//! LOD chains built with meshoptimizer's `simplify`, and switch distances derived from their errors.
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use serde::Serialize;
+
+/// Default triangle targets, as fractions of LOD0 (issue 2: 100 / 50 / 25 / 10 %).
+pub const DEFAULT_TARGETS: [f32; 4] = [1.0, 0.5, 0.25, 0.1];
+
+/// One level of detail: its own compact mesh and the simplifier's error in the mesh's own (absolute) units.
+#[derive(Debug, Clone)]
+pub struct Lod {
+    pub mesh: Mesh,
+    /// Fraction of LOD0's triangles that was asked for.
+    pub target_fraction: f32,
+    /// meshopt's result error, absolute (object-space units): the largest deviation from the original surface.
+    pub error_abs: f32,
+}
+
+/// LOD0 (the input mesh) followed by coarser simplifications.
+#[derive(Debug, Clone)]
+pub struct LodChain {
+    pub lods: Vec<Lod>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct LodInfo {
+    pub lod: usize,
+    pub triangles: usize,
+    pub vertices: usize,
+    pub target_fraction: f32,
+    pub error_abs: f32,
+}
+
+impl LodChain {
+    /// Simplifies `mesh` to each target fraction (the first must be 1.0: LOD0 is the input itself).
+    /// Each LOD is simplified from LOD0, not from the previous LOD, so errors are measured against the original.
+    pub fn build(name: &str, mesh: &Mesh, targets: &[f32]) -> Result<LodChain> {
+        if targets.first() != Some(&1.0) {
+            return Err(Error::Config(format!(
+                "LOD targets for {name} must start at 1.0 (LOD0 is the input mesh)"
+            )));
+        }
+        if targets.windows(2).any(|w| w[1] >= w[0] || w[1] <= 0.0) {
+            return Err(Error::Config(format!(
+                "LOD targets for {name} must decrease strictly and stay above 0: {targets:?}"
+            )));
+        }
+        let bytes: &[u8] = bytemuck::cast_slice(&mesh.positions);
+        let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| Error::Mesh {
+            path: name.to_string(),
+            problem: format!("meshopt rejected the vertices: {e}"),
+        })?;
+        let mut lods = vec![Lod {
+            mesh: mesh.clone(),
+            target_fraction: 1.0,
+            error_abs: 0.0,
+        }];
+        for &fraction in &targets[1..] {
+            let target_indices =
+                ((mesh.indices.len() as f64 * fraction as f64 / 3.0).round() as usize).max(1) * 3;
+            let mut error = 0.0f32;
+            let indices = meshopt::simplify(
+                &mesh.indices,
+                &adapter,
+                target_indices,
+                f32::MAX,
+                meshopt::SimplifyOptions::ErrorAbsolute,
+                Some(&mut error),
+            );
+            if indices.is_empty() {
+                return Err(Error::Mesh {
+                    path: name.to_string(),
+                    problem: format!(
+                        "simplification to {:.0} % left no triangles",
+                        fraction * 100.0
+                    ),
+                });
+            }
+            lods.push(Lod {
+                mesh: compact(name, mesh, &indices)?,
+                target_fraction: fraction,
+                error_abs: error,
+            });
+        }
+        Ok(LodChain { lods })
+    }
+
+    pub fn info(&self) -> Vec<LodInfo> {
+        self.lods
+            .iter()
+            .enumerate()
+            .map(|(i, l)| LodInfo {
+                lod: i,
+                triangles: l.mesh.triangle_count(),
+                vertices: l.mesh.vertex_count(),
+                target_fraction: l.target_fraction,
+                error_abs: l.error_abs,
+            })
+            .collect()
+    }
+}
+
+/// Keeps only the vertices `indices` reference (in first-use order), with LOD0's normals.
+fn compact(name: &str, src: &Mesh, indices: &[u32]) -> Result<Mesh> {
+    let mut remap = vec![u32::MAX; src.positions.len()];
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    let mut out = Vec::with_capacity(indices.len());
+    for &i in indices {
+        let slot = &mut remap[i as usize];
+        if *slot == u32::MAX {
+            *slot = positions.len() as u32;
+            positions.push(src.positions[i as usize]);
+            normals.push(src.normals[i as usize]);
+        }
+        out.push(*slot);
+    }
+    Mesh::new(name, positions, Some(normals), out)
+}
+
+/// Distance at which an object-space error `error_abs` (at instance scale `scale`) projects to `pixel_error`
+/// pixels on a viewport `height_px` pixels high with vertical field of view `fov_y` (radians):
+/// `pixels = error * height / (2 d tan(fov/2))`, solved for d.
+pub fn switch_distance(
+    error_abs: f32,
+    scale: f32,
+    pixel_error: f32,
+    height_px: u32,
+    fov_y: f32,
+) -> f32 {
+    error_abs * scale * height_px as f32 / (2.0 * pixel_error * (fov_y * 0.5).tan())
+}
+
+/// Switch distances for LOD1.. of a chain: where LOD i's error reaches `pixel_error` pixels. Made strictly
+/// increasing (a LOD whose error is not larger than the previous one's switches just after it), so that the
+/// schedule always moves one LOD at a time.
+pub fn switch_distances(
+    chain: &LodChain,
+    scale: f32,
+    pixel_error: f32,
+    height_px: u32,
+    fov_y: f32,
+) -> Vec<f32> {
+    let mut out: Vec<f32> = Vec::new();
+    for lod in &chain.lods[1..] {
+        let d = switch_distance(lod.error_abs, scale, pixel_error, height_px, fov_y);
+        let d = match out.last() {
+            Some(&prev) if d <= prev * 1.0001 => prev * 1.0001,
+            _ => d,
+        };
+        out.push(d);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn bunny() -> Mesh {
+        Mesh::load_obj(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bunny.obj")).unwrap()
+    }
+
+    #[test]
+    fn bunny_chain_hits_targets_with_growing_error() {
+        let chain = LodChain::build("bunny", &bunny(), &DEFAULT_TARGETS).unwrap();
+        assert_eq!(chain.lods.len(), 4);
+        let t0 = chain.lods[0].mesh.triangle_count() as f32;
+        assert_eq!(t0, 3674.0);
+        for (lod, &frac) in chain.lods.iter().zip(DEFAULT_TARGETS.iter()).skip(1) {
+            let got = lod.mesh.triangle_count() as f32 / t0;
+            // meshopt stops at or below the target unless the topology forbids it: allow 2 % above.
+            assert!(got <= frac + 0.02, "asked {frac}, got {got}");
+            assert!(got >= frac * 0.8, "asked {frac}, got {got}");
+        }
+        assert_eq!(chain.lods[0].error_abs, 0.0);
+        for w in chain.lods.windows(2) {
+            assert!(
+                w[1].error_abs > w[0].error_abs,
+                "{} <= {}",
+                w[1].error_abs,
+                w[0].error_abs
+            );
+        }
+    }
+
+    #[test]
+    fn simplification_is_deterministic() {
+        let a = LodChain::build("bunny", &bunny(), &DEFAULT_TARGETS).unwrap();
+        let b = LodChain::build("bunny", &bunny(), &DEFAULT_TARGETS).unwrap();
+        for (x, y) in a.lods.iter().zip(&b.lods) {
+            assert_eq!(x.mesh, y.mesh);
+            assert_eq!(x.error_abs, y.error_abs);
+        }
+    }
+
+    #[test]
+    fn bad_targets_are_errors() {
+        let m = bunny();
+        assert!(LodChain::build("b", &m, &[0.5, 0.25]).is_err());
+        assert!(LodChain::build("b", &m, &[1.0, 0.5, 0.5]).is_err());
+        assert!(LodChain::build("b", &m, &[1.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn switch_distance_projects_error_to_pixels() {
+        // 0.01 units at 1 px on 600 px with 90 degrees: d = 0.01 * 600 / (2 * 1 * 1) = 3.
+        let d = switch_distance(0.01, 1.0, 1.0, 600, std::f32::consts::FRAC_PI_2);
+        assert!((d - 3.0).abs() < 1e-5);
+        // Projecting back at that distance gives the pixel error.
+        let px = 0.01 * 600.0 / (2.0 * d * (std::f32::consts::FRAC_PI_4).tan());
+        assert!((px - 1.0).abs() < 1e-5);
+        // Twice the pixel tolerance halves the distance; twice the scale doubles it.
+        assert!(
+            (switch_distance(0.01, 1.0, 2.0, 600, std::f32::consts::FRAC_PI_2) - 1.5).abs() < 1e-5
+        );
+        assert!(
+            (switch_distance(0.01, 2.0, 1.0, 600, std::f32::consts::FRAC_PI_2) - 6.0).abs() < 1e-5
+        );
+    }
+}

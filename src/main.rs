@@ -1,0 +1,107 @@
+//! The `lodbench` binary: parse flags, dispatch, print one line on error.
+
+use clap::Parser;
+use lodbench::cli::{Cli, Command, DescribeArgs};
+use lodbench::config::{RunConfig, SceneConfig};
+use lodbench::scene::{SceneDef, SCENES};
+use lodbench::{gpu, methods, runner, Error};
+use std::process::ExitCode;
+use std::sync::atomic::Ordering;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(args) => run(&args),
+        Command::List => list(),
+        Command::Describe(args) => describe(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Error::Interrupted) => {
+            eprintln!("error: interrupted; run.json says so and frames.csv.partial keeps the finished blocks");
+            ExitCode::from(130)
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(args: &lodbench::cli::RunArgs) -> lodbench::Result<()> {
+    let cfg = RunConfig::from_args(args)?;
+    // A second signal while the first is being handled ends the process at once.
+    let _ = ctrlc::set_handler(|| {
+        if runner::INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    let summary = runner::run(&cfg)?;
+    print!("{}", runner::summary_table(&summary));
+    println!("results in {}", summary.out_dir.display());
+    Ok(())
+}
+
+fn list() -> lodbench::Result<()> {
+    println!("scenes:  {}", SCENES.join(", "));
+    println!("methods: {}", methods::METHODS.join(", "));
+    let adapters = gpu::context::enumerate_adapters();
+    if adapters.is_empty() {
+        println!("adapters: none found");
+        println!("  {}", gpu::context::NO_ADAPTER_HELP);
+    } else {
+        println!("adapters (best first; `--adapter SUBSTRING` picks one):");
+        for a in adapters {
+            let i = a.get_info();
+            let ts = a.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+            println!(
+                "  {}  [{:?}, {:?}, driver {} {}{}]",
+                i.name,
+                i.backend,
+                i.device_type,
+                i.driver,
+                i.driver_info,
+                if ts { ", timestamps" } else { "" }
+            );
+        }
+    }
+    Ok(())
+}
+
+fn describe(args: &DescribeArgs) -> lodbench::Result<()> {
+    let cfg = SceneConfig::from_args(&args.scene_args)?;
+    let def = SceneDef::new(&args.scene, &cfg)?;
+    let d = def.describe(&cfg);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&d)?);
+        return Ok(());
+    }
+    println!(
+        "{}: profile {}, {}x{}, fov {} deg, {} frames, instance counts {:?}",
+        d.scene, d.profile, d.width, d.height, d.fov_y_deg, d.frames, d.instance_counts
+    );
+    println!("mesh: {}", d.mesh);
+    for m in &d.models {
+        println!(
+            "model {} (radius {:.3}, switch distances from {}):",
+            m.name, m.radius, m.switch_source
+        );
+        println!(
+            "  {:>4} {:>10} {:>9} {:>14} {:>16}",
+            "lod", "triangles", "vertices", "error_abs", "switch_distance"
+        );
+        for l in &m.lods {
+            println!(
+                "  {:>4} {:>10} {:>9} {:>14.6} {:>16}",
+                l.info.lod,
+                l.info.triangles,
+                l.info.vertices,
+                l.info.error_abs,
+                l.switch_distance
+                    .map_or("-".to_string(), |s| format!("{s:.3}"))
+            );
+        }
+    }
+    println!("motion: {}", serde_json::to_string(&d.motion)?);
+    Ok(())
+}

@@ -1,0 +1,38 @@
+//! `discrete`: plain discrete LOD switching, the popping baseline of seed 003 section 6 and seed 000 Fig. 8.
+//! Each instance shows one LOD; the switch is hard, at the centre of the schedule's band (k = 0.5, i.e. at the
+//! switch distance itself).
+
+use super::{FrameInput, Method, OpaqueInstances};
+use crate::gpu::renderer::{DrawStats, RenderTarget, SceneGpu};
+use crate::scene::Scene;
+
+pub struct Discrete {
+    draw: OpaqueInstances,
+}
+
+impl Discrete {
+    pub fn new(gpu: &SceneGpu, scene: &Scene) -> Self {
+        Discrete {
+            draw: OpaqueInstances::new(gpu, scene, "discrete instances"),
+        }
+    }
+}
+
+impl Method for Discrete {
+    fn name(&self) -> &'static str {
+        "discrete"
+    }
+
+    fn encode(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) -> DrawStats {
+        self.draw
+            .encode(gpu, input, encoder, target, "discrete pass", |s| {
+                s.discrete_lod()
+            })
+    }
+}

@@ -1,0 +1,35 @@
+//! `reference`: the high-poly baseline of seed 003 section 6: every instance at LOD0, always. The quality pass
+//! compares every method against this.
+
+use super::{FrameInput, Method, OpaqueInstances};
+use crate::gpu::renderer::{DrawStats, RenderTarget, SceneGpu};
+use crate::scene::Scene;
+
+pub struct Reference {
+    draw: OpaqueInstances,
+}
+
+impl Reference {
+    pub fn new(gpu: &SceneGpu, scene: &Scene) -> Self {
+        Reference {
+            draw: OpaqueInstances::new(gpu, scene, "reference instances"),
+        }
+    }
+}
+
+impl Method for Reference {
+    fn name(&self) -> &'static str {
+        "reference"
+    }
+
+    fn encode(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) -> DrawStats {
+        self.draw
+            .encode(gpu, input, encoder, target, "reference pass", |_| 0)
+    }
+}

@@ -1,0 +1,474 @@
+//! Scenes: models with LOD chains, instances, the camera and how things move. Pure CPU, no device.
+//!
+//! - `bunny-sweep`: the popping experiment of seed 003 section 6 (steps 1-4): one bunny starts at the nearest
+//!   distance that shows all of it at LOD0 and moves at constant speed along the line of sight until past the
+//!   last switch band, then back the same way. The camera is fixed.
+//! - `bunny-grid`: the performance experiment of seed 003 section 6, eq. 1: n bunnies on the +x axis, evenly
+//!   spaced by dx = (w - camera_x) / n, the camera looking along +x; nothing is culled, so bunnies behind
+//!   others are still drawn (the paper turns occlusion culling off).
+
+use crate::config::SceneConfig;
+use crate::error::{Error, Result};
+use crate::lod::{self, LodChain, LodInfo, DEFAULT_TARGETS};
+use crate::mesh::Mesh;
+use crate::schedule::ScheduleParams;
+use glam::{Mat4, Vec3};
+use serde::Serialize;
+use std::sync::Arc;
+
+/// Every scene name `--scene` accepts.
+pub const SCENES: &[&str] = &["bunny-sweep", "bunny-grid"];
+
+/// The Stanford bunny, npm `bunny@1.0.1` (see scenes/README.md), compiled in so the binary needs no files.
+pub const BUNNY_OBJ: &[u8] = include_bytes!("../scenes/bunny.obj");
+
+/// Background colour (linear RGB) behind every scene.
+pub const BACKGROUND: [f32; 3] = [0.045, 0.05, 0.06];
+
+/// A model: its LOD chain, colour and switch distances.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub name: String,
+    /// Base colour, linear RGB.
+    pub color: [f32; 3],
+    pub chain: LodChain,
+    /// Switch distance of LOD1, LOD2, ... in world units.
+    pub switches: Vec<f32>,
+    /// Where the switch distances came from: "pixel-error" or "override".
+    pub switch_source: &'static str,
+    /// Bounding-sphere centre (object space) and radius (world units, after scale).
+    pub center: Vec3,
+    pub radius: f32,
+    pub scale: f32,
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct Instance {
+    pub model: u32,
+    /// Position of the model's bounding-sphere centre at frame 0 (world).
+    pub position: Vec3,
+    /// Rotation about +y, radians.
+    pub yaw: f32,
+}
+
+/// How instances move over the frames.
+#[derive(Debug, Clone, Copy, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Motion {
+    Static,
+    /// Every instance moves along +x from `near` to `far` (distance from the camera) in the first half of the
+    /// frames and back in the second, at constant speed.
+    SweepX {
+        near: f32,
+        far: f32,
+    },
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub view: Mat4,
+    pub proj: Mat4,
+}
+
+impl Camera {
+    pub fn view_proj(&self) -> Mat4 {
+        self.proj * self.view
+    }
+}
+
+/// A scene ready to render: everything a frame needs is a function of the frame number.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub name: String,
+    /// The `count` column of the CSVs: the instance count this block was built for.
+    pub count: u32,
+    pub models: Arc<[Model]>,
+    pub instances: Vec<Instance>,
+    pub motion: Motion,
+    pub frames: u32,
+    pub width: u32,
+    pub height: u32,
+    pub fov_y: f32,
+    pub near: f32,
+    pub far: f32,
+    pub eye: Vec3,
+    pub forward: Vec3,
+    pub schedule: ScheduleParams,
+}
+
+/// Scene-level facts that do not depend on the instance count: built once per scene name.
+#[derive(Debug, Clone)]
+pub struct SceneDef {
+    pub name: String,
+    pub models: Arc<[Model]>,
+    pub frames: u32,
+    pub width: u32,
+    pub height: u32,
+    pub fov_y: f32,
+    pub schedule: ScheduleParams,
+    /// Instance counts to build (one block each).
+    pub counts: Vec<u32>,
+    pub mesh_source: String,
+}
+
+impl SceneDef {
+    pub fn new(name: &str, cfg: &SceneConfig) -> Result<SceneDef> {
+        if !SCENES.contains(&name) {
+            return Err(Error::unknown("scene", name, SCENES));
+        }
+        let pv = cfg.resolved(name);
+        let fov_y = cfg.fov_deg.to_radians();
+        let (mesh, mesh_source) = match &cfg.mesh {
+            Some(p) => (Mesh::load_obj(p)?, p.display().to_string()),
+            None => (
+                Mesh::parse_obj("scenes/bunny.obj (built in)", BUNNY_OBJ)?,
+                "scenes/bunny.obj (npm bunny@1.0.1, built in)".to_string(),
+            ),
+        };
+        let model = bunny_model(&mesh, cfg, pv.height, fov_y)?;
+        let counts = match name {
+            "bunny-grid" => cfg.counts(),
+            _ => vec![1],
+        };
+        Ok(SceneDef {
+            name: name.to_string(),
+            models: Arc::from(vec![model]),
+            frames: pv.frames,
+            width: pv.width,
+            height: pv.height,
+            fov_y,
+            schedule: cfg.schedule,
+            counts,
+            mesh_source,
+        })
+    }
+
+    pub fn instantiate(&self, count: u32) -> Scene {
+        let m = &self.models[0];
+        let b = self.schedule.band;
+        let h = self.schedule.hysteresis;
+        let last = *m.switches.last().unwrap_or(&m.radius);
+        // Nearest distance at which the whole bounding sphere is in view (the narrower of the two fovs).
+        let aspect = self.width as f32 / self.height as f32;
+        let half_fov = (self.fov_y * 0.5).min(((self.fov_y * 0.5).tan() * aspect).atan());
+        let fit = m.radius / half_fov.sin();
+        let first_band = m.switches.first().map(|s| s * (1.0 - h) * (1.0 - b));
+        let near_d = match first_band {
+            Some(fb) if fit >= fb * 0.95 => fb * 0.9,
+            _ => fit,
+        };
+        // Past the last band, with a margin so the coarsest LOD is seen for a while.
+        let far_d = last * (1.0 + h) * (1.0 + b) * 1.15;
+        let yaw = BUNNY_YAW;
+        let (instances, motion, far_plane) = match self.name.as_str() {
+            "bunny-grid" => {
+                // eq. 1: dx = (w - camera_x) / n, objects from the nearest fully visible distance on.
+                let camera_x = 0.0;
+                let w = camera_x + far_d;
+                let dx = (w - camera_x) / count as f32;
+                let inst = (0..count)
+                    .map(|i| Instance {
+                        model: 0,
+                        position: Vec3::new(camera_x + near_d + i as f32 * dx, 0.0, 0.0),
+                        yaw,
+                    })
+                    .collect();
+                (inst, Motion::Static, near_d + w + 2.0 * m.radius)
+            }
+            _ => (
+                vec![Instance {
+                    model: 0,
+                    position: Vec3::new(near_d, 0.0, 0.0),
+                    yaw,
+                }],
+                Motion::SweepX {
+                    near: near_d,
+                    far: far_d,
+                },
+                far_d + 2.0 * m.radius,
+            ),
+        };
+        Scene {
+            name: self.name.clone(),
+            count,
+            models: self.models.clone(),
+            instances,
+            motion,
+            frames: self.frames,
+            width: self.width,
+            height: self.height,
+            fov_y: self.fov_y,
+            near: m.radius * 0.02,
+            far: far_plane,
+            eye: Vec3::ZERO,
+            forward: Vec3::X,
+            schedule: self.schedule,
+        }
+    }
+}
+
+/// Yaw of the bunny instances: a three-quarter view from the camera on -x.
+pub const BUNNY_YAW: f32 = 2.2;
+
+fn bunny_model(mesh: &Mesh, cfg: &SceneConfig, height: u32, fov_y: f32) -> Result<Model> {
+    let chain = LodChain::build("bunny", mesh, &DEFAULT_TARGETS)?;
+    let (center, radius) = chain.lods[0].mesh.bounding_sphere();
+    if !(radius.is_finite() && radius > 0.0) {
+        return Err(Error::Mesh {
+            path: "bunny".into(),
+            problem: "has zero extent".into(),
+        });
+    }
+    let scale = 1.0;
+    let (switches, switch_source) = match &cfg.switch_distances {
+        Some(s) => {
+            if s.len() != chain.lods.len() - 1 {
+                return Err(Error::Config(format!(
+                    "--switch-distances has {} values but the bunny has {} LODs after LOD0",
+                    s.len(),
+                    chain.lods.len() - 1
+                )));
+            }
+            (s.clone(), "override")
+        }
+        None => (
+            lod::switch_distances(&chain, scale, cfg.pixel_error, height, fov_y),
+            "pixel-error",
+        ),
+    };
+    cfg.schedule.check_switches("bunny", &switches)?;
+    Ok(Model {
+        name: "bunny".into(),
+        color: [0.72, 0.45, 0.28],
+        chain,
+        switches,
+        switch_source,
+        center,
+        radius: radius * scale,
+        scale,
+    })
+}
+
+impl Scene {
+    /// Where instance `i`'s centre is on `frame`.
+    pub fn instance_position(&self, i: usize, frame: u32) -> Vec3 {
+        let inst = &self.instances[i];
+        match self.motion {
+            Motion::Static => inst.position,
+            Motion::SweepX { near, far } => {
+                let d = sweep_distance(near, far, self.frames, frame);
+                Vec3::new(self.eye.x + d, inst.position.y, inst.position.z)
+            }
+        }
+    }
+
+    /// Object-to-world matrix of instance `i` on `frame`: the model's bounding-sphere centre goes to the
+    /// instance position.
+    pub fn instance_matrix(&self, i: usize, frame: u32) -> Mat4 {
+        let inst = &self.instances[i];
+        let m = &self.models[inst.model as usize];
+        Mat4::from_translation(self.instance_position(i, frame))
+            * Mat4::from_rotation_y(inst.yaw)
+            * Mat4::from_scale(Vec3::splat(m.scale))
+            * Mat4::from_translation(-m.center)
+    }
+
+    /// Distance from the camera to instance `i`'s centre on `frame` (what LOD selection uses).
+    pub fn instance_distance(&self, i: usize, frame: u32) -> f32 {
+        self.instance_position(i, frame)
+            .distance(self.camera(frame).eye)
+    }
+
+    pub fn camera(&self, _frame: u32) -> Camera {
+        let view = Mat4::look_at_rh(self.eye, self.eye + self.forward, Vec3::Y);
+        let proj = Mat4::perspective_rh(
+            self.fov_y,
+            self.width as f32 / self.height as f32,
+            self.near,
+            self.far,
+        );
+        Camera {
+            eye: self.eye,
+            view,
+            proj,
+        }
+    }
+
+    pub fn triangles_lod0(&self) -> u64 {
+        self.instances
+            .iter()
+            .map(|i| {
+                self.models[i.model as usize].chain.lods[0]
+                    .mesh
+                    .triangle_count() as u64
+            })
+            .sum()
+    }
+}
+
+/// Constant-speed distance along the sweep: out from `near` to `far` over the first half of the frames, back
+/// over the second; frame f and frame N-1-f are at the same distance.
+pub fn sweep_distance(near: f32, far: f32, frames: u32, frame: u32) -> f32 {
+    if frames < 2 {
+        return near;
+    }
+    let half = (frames - 1) as f32 / 2.0;
+    let u = frame as f32 / half;
+    let u = if u <= 1.0 { u } else { 2.0 - u };
+    near + (far - near) * u
+}
+
+/// What `lodbench describe` prints.
+#[derive(Debug, Clone, Serialize)]
+pub struct SceneDescription {
+    pub scene: String,
+    pub profile: String,
+    pub width: u32,
+    pub height: u32,
+    pub fov_y_deg: f32,
+    pub frames: u32,
+    pub instance_counts: Vec<u32>,
+    pub mesh: String,
+    pub pixel_error: f32,
+    pub schedule: ScheduleParams,
+    pub models: Vec<ModelDescription>,
+    pub motion: Motion,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct ModelDescription {
+    pub name: String,
+    pub radius: f32,
+    pub switch_source: &'static str,
+    pub lods: Vec<LodDescription>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct LodDescription {
+    #[serde(flatten)]
+    pub info: LodInfo,
+    /// Distance beyond which this LOD is selected (None for LOD0).
+    pub switch_distance: Option<f32>,
+}
+
+impl SceneDef {
+    pub fn describe(&self, cfg: &SceneConfig) -> SceneDescription {
+        let first = self.instantiate(self.counts[0]);
+        SceneDescription {
+            scene: self.name.clone(),
+            profile: format!("{:?}", cfg.profile).to_lowercase(),
+            width: self.width,
+            height: self.height,
+            fov_y_deg: cfg.fov_deg,
+            frames: self.frames,
+            instance_counts: self.counts.clone(),
+            mesh: self.mesh_source.clone(),
+            pixel_error: cfg.pixel_error,
+            schedule: self.schedule,
+            models: self
+                .models
+                .iter()
+                .map(|m| ModelDescription {
+                    name: m.name.clone(),
+                    radius: m.radius,
+                    switch_source: m.switch_source,
+                    lods: m
+                        .chain
+                        .info()
+                        .into_iter()
+                        .map(|info| LodDescription {
+                            switch_distance: info.lod.checked_sub(1).map(|j| m.switches[j]),
+                            info,
+                        })
+                        .collect(),
+                })
+                .collect(),
+            motion: first.motion,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::{Cli, Command};
+    use clap::Parser;
+
+    fn cfg(extra: &[&str]) -> SceneConfig {
+        let mut argv = vec!["lodbench", "describe", "--scene", "bunny-sweep"];
+        argv.extend_from_slice(extra);
+        match Cli::try_parse_from(argv).unwrap().command {
+            Command::Describe(d) => SceneConfig::from_args(&d.scene_args).unwrap(),
+            _ => unreachable!(),
+        }
+    }
+
+    #[test]
+    fn sweep_goes_out_and_back_at_constant_speed() {
+        let n = 11;
+        let d: Vec<f32> = (0..n).map(|f| sweep_distance(1.0, 6.0, n, f)).collect();
+        assert_eq!(d[0], 1.0);
+        assert_eq!(d[5], 6.0);
+        assert_eq!(d[10], 1.0);
+        for f in 0..n as usize {
+            assert!((d[f] - d[n as usize - 1 - f]).abs() < 1e-6);
+        }
+        for w in d[..6].windows(2) {
+            assert!((w[1] - w[0] - 1.0).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn sweep_passes_every_switch_starting_at_lod0() {
+        let def = SceneDef::new("bunny-sweep", &cfg(&[])).unwrap();
+        let s = def.instantiate(1);
+        let m = &s.models[0];
+        let d0 = s.instance_distance(0, 0);
+        let dmax = (0..s.frames)
+            .map(|f| s.instance_distance(0, f))
+            .fold(0.0, f32::max);
+        assert!(d0 < m.switches[0] * 0.95);
+        assert!(dmax > m.switches.last().unwrap() * 1.05);
+    }
+
+    #[test]
+    fn grid_follows_equation_1() {
+        let c = cfg(&["--count", "50,7"]);
+        let def = SceneDef::new("bunny-grid", &c).unwrap();
+        assert_eq!(def.counts, vec![50, 7]);
+        let s = def.instantiate(7);
+        assert_eq!(s.instances.len(), 7);
+        let xs: Vec<f32> = s.instances.iter().map(|i| i.position.x).collect();
+        let dx = xs[1] - xs[0];
+        for w in xs.windows(2) {
+            assert!((w[1] - w[0] - dx).abs() < 1e-3);
+        }
+        let last = *s.models[0].switches.last().unwrap();
+        // w - camera_x = n dx reaches past the last switch band.
+        assert!(7.0 * dx > last * 1.05);
+        assert!(s
+            .instances
+            .iter()
+            .all(|i| i.position.y == 0.0 && i.position.z == 0.0));
+        assert_eq!(s.forward, Vec3::X);
+    }
+
+    #[test]
+    fn switch_override_must_match_lod_count() {
+        let c = cfg(&["--switch-distances", "10,20"]);
+        assert!(SceneDef::new("bunny-sweep", &c).is_err());
+        let c = cfg(&["--switch-distances", "10,20,40"]);
+        let def = SceneDef::new("bunny-sweep", &c).unwrap();
+        assert_eq!(def.models[0].switches, vec![10.0, 20.0, 40.0]);
+    }
+
+    #[test]
+    fn switch_distance_halves_with_double_pixel_error() {
+        let a = SceneDef::new("bunny-sweep", &cfg(&[])).unwrap();
+        let b = SceneDef::new("bunny-sweep", &cfg(&["--pixel-error", "2"])).unwrap();
+        for (x, y) in a.models[0].switches.iter().zip(&b.models[0].switches) {
+            assert!((x / y - 2.0).abs() < 1e-3);
+        }
+    }
+}
