@@ -10,6 +10,7 @@ use std::sync::atomic::Ordering;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    quiet_wayland_probe();
     let result = match cli.command {
         Command::Run(args) => run(&args),
         Command::List => list(),
@@ -25,6 +26,15 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Mesa's Vulkan loader probes for a Wayland display and prints `error: XDG_RUNTIME_DIR is invalid...` when
+/// the variable is unset (headless machines, CI), which reads like one of our errors. Point it at the temp
+/// folder for this process only; nothing is created there.
+fn quiet_wayland_probe() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
     }
 }
 

@@ -208,8 +208,8 @@ impl SceneDef {
     }
 }
 
-/// Yaw of the bunny instances: a three-quarter view from the camera on -x.
-pub const BUNNY_YAW: f32 = 2.2;
+/// Yaw of the bunny instances: the classic three-quarter view, face to the right.
+pub const BUNNY_YAW: f32 = 1.0;
 
 fn bunny_model(mesh: &Mesh, cfg: &SceneConfig, height: u32, fov_y: f32) -> Result<Model> {
     let chain = LodChain::build("bunny", mesh, &DEFAULT_TARGETS)?;

@@ -1,0 +1,182 @@
+//! Bad input ends in one clear `error:` line and a non-zero exit, never a panic.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn lodbench(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_lodbench"));
+    c.args(args);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("lodbench runs")
+}
+
+/// Asserts failure with exactly one `error:` line mentioning every needle.
+fn fails_with(out: &Output, needles: &[&str]) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "expected failure, stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one line, got: {stderr}");
+    assert!(lines[0].starts_with("error:"), "{stderr}");
+    for n in needles {
+        assert!(lines[0].contains(n), "'{n}' not in: {stderr}");
+    }
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+#[test]
+fn unknown_scene_and_method_list_valid_names() {
+    let out = lodbench(&["run", "--scene", "bunny-swep"], &[]);
+    fails_with(
+        &out,
+        &["unknown scene 'bunny-swep'", "bunny-sweep, bunny-grid"],
+    );
+    let out = lodbench(&["run", "--method", "reference,fsii"], &[]);
+    fails_with(&out, &["unknown method 'fsii'", "reference", "discrete"]);
+    let out = lodbench(&["describe", "--scene", "nope"], &[]);
+    fails_with(&out, &["unknown scene 'nope'"]);
+}
+
+#[test]
+fn bad_meshes_name_the_file_and_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.obj");
+    let out = lodbench(
+        &[
+            "run",
+            "--scene",
+            "bunny-sweep",
+            "--mesh",
+            missing.to_str().unwrap(),
+        ],
+        &[],
+    );
+    fails_with(&out, &["missing.obj", "not found"]);
+
+    let bad = write(
+        dir.path(),
+        "range.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 7\n",
+    );
+    let out = lodbench(&["run", "--scene", "bunny-sweep", "--mesh", &bad], &[]);
+    fails_with(&out, &["range.obj"]);
+
+    let nan = write(
+        dir.path(),
+        "nan.obj",
+        "v 0 0 0\nv 1 NaN 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let out = lodbench(&["describe", "--scene", "bunny-grid", "--mesh", &nan], &[]);
+    fails_with(&out, &["nan.obj", "non-finite"]);
+
+    let empty = write(dir.path(), "empty.obj", "# nothing\n");
+    let out = lodbench(&["run", "--scene", "bunny-sweep", "--mesh", &empty], &[]);
+    fails_with(&out, &["empty.obj", "no triangles"]);
+}
+
+#[test]
+fn bad_numbers_are_rejected() {
+    let out = lodbench(&["run", "--width", "0"], &[]);
+    fails_with(&out, &["--width 0"]);
+    let out = lodbench(&["run", "--switch-distances", "5,3"], &[]);
+    fails_with(&out, &["--switch-distances", "increase"]);
+}
+
+#[test]
+fn unwritable_output_folder_fails_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = write(dir.path(), "a-file", "x");
+    let target = format!("{file}/results");
+    let out = lodbench(
+        &[
+            "run",
+            "--scene",
+            "bunny-sweep",
+            "--method",
+            "reference",
+            "--out",
+            &target,
+        ],
+        &[],
+    );
+    fails_with(&out, &["output folder", "a-file"]);
+}
+
+#[test]
+fn no_adapter_says_how_to_install_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let out = lodbench(
+        &[
+            "run",
+            "--scene",
+            "bunny-sweep",
+            "--method",
+            "reference",
+            "--frames",
+            "2",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        &[
+            ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
+            ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
+        ],
+    );
+    fails_with(&out, &["no GPU adapter", "mesa-vulkan-drivers"]);
+    // The failed run is visibly incomplete.
+    let manifest = std::fs::read_to_string(out_dir.join("run.json")).unwrap();
+    assert!(manifest.contains("\"status\": \"failed\""), "{manifest}");
+    assert!(!out_dir.join("frames.csv").exists());
+    assert!(!out_dir.join("summary.csv").exists());
+}
+
+#[test]
+fn list_and_describe_work() {
+    let out = lodbench(&["list"], &[]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("bunny-sweep") && text.contains("discrete"),
+        "{text}"
+    );
+
+    let out = lodbench(
+        &[
+            "describe",
+            "--scene",
+            "bunny-grid",
+            "--profile",
+            "paper",
+            "--json",
+        ],
+        &[],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        v["instance_counts"],
+        serde_json::json!([50, 250, 500, 1000, 2000])
+    );
+    assert_eq!(v["frames"], 3600);
+    let lods = v["models"][0]["lods"].as_array().unwrap();
+    assert_eq!(lods.len(), 4);
+    assert_eq!(lods[0]["triangles"], 3674);
+    assert!(lods[0]["switch_distance"].is_null());
+    let s: Vec<f64> = lods[1..]
+        .iter()
+        .map(|l| l["switch_distance"].as_f64().unwrap())
+        .collect();
+    assert!(s.windows(2).all(|w| w[1] > w[0]), "{s:?}");
+}

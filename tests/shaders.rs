@@ -1,0 +1,65 @@
+//! Every WGSL file in shaders/ must parse and validate with naga (errors shown with source locations), and the
+//! entry points the Rust side names must exist.
+
+use std::path::Path;
+
+fn validate(path: &Path) -> naga::Module {
+    let source = std::fs::read_to_string(path).unwrap();
+    let name = path.display().to_string();
+    let module = match naga::front::wgsl::parse_str(&source) {
+        Ok(m) => m,
+        Err(e) => panic!("{}", e.emit_to_string_with_path(&source, &name)),
+    };
+    let mut validator = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::default(),
+    );
+    if let Err(e) = validator.validate(&module) {
+        panic!("{}", e.emit_to_string_with_path(&source, &name));
+    }
+    module
+}
+
+fn entry_points(m: &naga::Module) -> Vec<String> {
+    m.entry_points.iter().map(|e| e.name.clone()).collect()
+}
+
+#[test]
+fn every_shader_validates() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "wgsl") {
+            validate(&path);
+            count += 1;
+        }
+    }
+    assert!(
+        count >= 2,
+        "expected the shaders in {}, found {count}",
+        dir.display()
+    );
+}
+
+#[test]
+fn entry_points_the_renderer_uses_exist() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let mesh = entry_points(&validate(&dir.join("mesh.wgsl")));
+    for e in ["vs_main", "fs_opaque"] {
+        assert!(
+            mesh.contains(&e.to_string()),
+            "mesh.wgsl lacks {e}: {mesh:?}"
+        );
+    }
+    let metrics = entry_points(&validate(&dir.join("metrics.wgsl")));
+    assert_eq!(metrics, vec!["main".to_string()]);
+}
+
+#[test]
+fn a_broken_shader_is_reported_with_its_location() {
+    let source = "@fragment fn f() -> @location(0) vec4<f32> { return vec4<f32>(undefined_name); }";
+    let err = naga::front::wgsl::parse_str(source).unwrap_err();
+    let text = err.emit_to_string_with_path(source, "broken.wgsl");
+    assert!(text.contains("broken.wgsl:1:"), "{text}");
+}
