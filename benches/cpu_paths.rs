@@ -1,1 +1,89 @@
-fn main() {}
+//! Criterion benches of the CPU paths: LOD generation, the schedule, the metrics oracle, CSV export.
+//! `cargo bench --bench cpu_paths`
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use lodbench::export::csv::{FrameRecord, FramesWriter};
+use lodbench::lod::{LodChain, DEFAULT_TARGETS};
+use lodbench::mesh::Mesh;
+use lodbench::metrics::SequenceMetrics;
+use lodbench::rng::SplitMix64;
+use lodbench::scene::BUNNY_OBJ;
+use lodbench::schedule::{LodSchedule, ScheduleParams};
+use std::hint::black_box;
+
+fn lod_generation(c: &mut Criterion) {
+    let mesh = Mesh::parse_obj("bunny", BUNNY_OBJ).unwrap();
+    c.bench_function("parse bunny OBJ", |b| {
+        b.iter(|| Mesh::parse_obj("bunny", black_box(BUNNY_OBJ)).unwrap())
+    });
+    c.bench_function("bunny LOD chain 100/50/25/10 %", |b| {
+        b.iter(|| LodChain::build("bunny", black_box(&mesh), &DEFAULT_TARGETS).unwrap())
+    });
+}
+
+fn schedule(c: &mut Criterion) {
+    let switches = [18.0f32, 37.0, 80.0];
+    let n = 2000;
+    let distances: Vec<f32> = (0..n).map(|i| 13.0 + i as f32 * 0.05).collect();
+    c.bench_function("schedule update, 2000 instances", |b| {
+        let mut s = LodSchedule::new(ScheduleParams::default(), n);
+        b.iter(|| {
+            let mut acc = 0.0;
+            for (i, d) in distances.iter().enumerate() {
+                acc += s.update(i, *d, &switches).k;
+            }
+            black_box(acc)
+        })
+    });
+}
+
+fn metrics_oracle(c: &mut Criterion) {
+    let (w, h) = (800usize, 600usize);
+    let mut rng = SplitMix64::new(3);
+    let a: Vec<u8> = (0..w * h * 4)
+        .map(|_| (rng.next_u64() & 255) as u8)
+        .collect();
+    let b: Vec<u8> = (0..w * h * 4)
+        .map(|_| (rng.next_u64() & 255) as u8)
+        .collect();
+    c.bench_function("CPU rmse + pop, 800x600 frame", |bch| {
+        let mut m = SequenceMetrics::new();
+        bch.iter(|| black_box(m.frame(black_box(&a), black_box(&b))))
+    });
+}
+
+fn csv_export(c: &mut Criterion) {
+    let rows: Vec<FrameRecord> = (0..3600)
+        .map(|f| FrameRecord {
+            scene: "bunny-sweep".into(),
+            method: "discrete".into(),
+            count: 1,
+            frame: f,
+            gpu_ms: Some(1.0 + f as f64 * 1e-4),
+            cpu_ms: 1.5,
+            triangles: 3674,
+            draw_calls: 1,
+            t_instances: 0,
+            lod_mean: f as f64 / 1200.0,
+            rmse: 0.01,
+            pop: 0.001,
+        })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    c.bench_function("frames.csv, 3600 rows", |b| {
+        b.iter(|| {
+            let mut w = FramesWriter::create(dir.path()).unwrap();
+            w.write_block(black_box(&rows)).unwrap();
+            w.finish().unwrap()
+        })
+    });
+}
+
+criterion_group!(
+    benches,
+    lod_generation,
+    schedule,
+    metrics_oracle,
+    csv_export
+);
+criterion_main!(benches);

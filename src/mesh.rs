@@ -30,7 +30,7 @@ impl Mesh {
         if indices.is_empty() {
             return Err(bad("has no triangles".into()));
         }
-        if indices.len() % 3 != 0 {
+        if !indices.len().is_multiple_of(3) {
             return Err(bad(format!(
                 "index count {} is not a multiple of 3",
                 indices.len()

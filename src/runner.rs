@@ -114,6 +114,8 @@ pub struct BlockRunner<'a> {
     reference: Box<dyn Method>,
     kernel: MetricKernel,
     timer: Option<GpuTimer>,
+    /// Times the metric kernel alone in the quality pass (its own cost, reported in run.json).
+    metric_timer: Option<GpuTimer>,
     readback: Option<(ColorReadback, ColorReadback)>,
 }
 
@@ -131,6 +133,7 @@ impl<'a> BlockRunner<'a> {
         let reference = methods::create("reference", &gpu, scene)?;
         let kernel = MetricKernel::new(ctx, &method_target, &reference_target, scene.frames)?;
         let timer = GpuTimer::new(ctx, scene.frames);
+        let metric_timer = GpuTimer::new(ctx, scene.frames);
         let readback = with_readback.then(|| {
             (
                 ColorReadback::new(&ctx.device, "method read-back", w, h),
@@ -148,6 +151,7 @@ impl<'a> BlockRunner<'a> {
             reference,
             kernel,
             timer,
+            metric_timer,
             readback,
         })
     }
@@ -250,7 +254,13 @@ impl<'a> BlockRunner<'a> {
             self.reference
                 .encode(&self.gpu, &input, &mut encoder, &self.reference_target);
             method.encode(&self.gpu, &input, &mut encoder, &self.method_target);
+            if let Some(t) = &self.metric_timer {
+                t.begin(&mut encoder, f);
+            }
             self.kernel.encode(&ctx.queue, &mut encoder, f);
+            if let Some(t) = &self.metric_timer {
+                t.end(&mut encoder, f);
+            }
             let dump = match &self.readback {
                 Some((m, r)) if f % dump_every == 0 => {
                     m.encode_copy(&mut encoder, &self.method_target);
@@ -282,6 +292,13 @@ impl<'a> BlockRunner<'a> {
         ctx.wait_idle()?;
         let quality_ms = pass_start.elapsed().as_secs_f64() * 1e3 / frames as f64;
         let metrics = self.kernel.read(ctx, frames)?;
+        let metric_gpu_ms_median = match &self.metric_timer {
+            Some(t) => {
+                let ms: Vec<f64> = t.read(ctx)?.into_iter().flatten().collect();
+                crate::export::csv::percentile(&ms, 50.0)
+            }
+            None => None,
+        };
         for (row, m) in rows.iter_mut().zip(metrics) {
             row.rmse = m.rmse;
             row.pop = m.pop;
@@ -300,6 +317,7 @@ impl<'a> BlockRunner<'a> {
                 timing_pass_ms_per_frame: timing_ms,
                 quality_pass_ms_per_frame: quality_ms,
                 quality_to_timing_ratio: quality_ms / timing_ms,
+                metric_gpu_ms_median,
                 extra_target_bytes: method.extra_target_bytes(),
             },
         })

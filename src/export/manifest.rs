@@ -35,6 +35,8 @@ pub struct BlockInfo {
     pub quality_pass_ms_per_frame: f64,
     /// quality_pass_ms_per_frame / timing_pass_ms_per_frame (2.0 is the floor: the reference doubles the work).
     pub quality_to_timing_ratio: f64,
+    /// Median GPU time of the metric kernel alone per quality-pass frame (None without timestamps).
+    pub metric_gpu_ms_median: Option<f64>,
     pub extra_target_bytes: u64,
 }
 
