@@ -99,6 +99,9 @@ pub struct RunArgs {
     /// Seed of every random choice (recorded in run.json).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Threshold pattern of noise blending (`dither`).
+    #[arg(long, value_enum, default_value_t = crate::noise::NoisePattern::White16)]
+    pub noise: crate::noise::NoisePattern,
     /// Output folder (default results/<scene>-<time>/).
     #[arg(long)]
     pub out: Option<PathBuf>,

@@ -176,6 +176,8 @@ pub struct RunConfig {
     /// Explicit --warmup; None = the profile's.
     pub warmup: Option<u32>,
     pub seed: u64,
+    /// Threshold pattern of `dither`.
+    pub noise: crate::noise::NoisePattern,
     pub out: Option<PathBuf>,
     pub adapter: Option<String>,
     pub dump_frames: bool,
@@ -198,6 +200,7 @@ impl RunConfig {
             scene: SceneConfig::from_args(&a.scene_args)?,
             warmup: a.warmup,
             seed: a.seed,
+            noise: a.noise,
             out: a.out.clone(),
             adapter: a.adapter.clone(),
             dump_frames: a.dump_frames,

@@ -16,7 +16,7 @@ use crate::gpu::metrics::MetricKernel;
 use crate::gpu::renderer::{ColorReadback, RenderTarget, SceneGpu};
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::GpuContext;
-use crate::methods::{self, FrameInput, Method};
+use crate::methods::{self, FrameInput, Method, MethodOptions};
 use crate::scene::{Scene, SceneDef};
 use crate::schedule::{InstanceState, LodSchedule};
 use glam::Mat4;
@@ -42,6 +42,7 @@ pub struct FrameDriver<'s> {
     schedule: LodSchedule,
     pub states: Vec<InstanceState>,
     pub matrices: Vec<Mat4>,
+    pub distances: Vec<f32>,
 }
 
 /// Method-independent facts of one frame.
@@ -59,6 +60,7 @@ impl<'s> FrameDriver<'s> {
             schedule: LodSchedule::new(scene.schedule, n),
             states: Vec::with_capacity(n),
             matrices: Vec::with_capacity(n),
+            distances: Vec::with_capacity(n),
         }
     }
 
@@ -70,6 +72,7 @@ impl<'s> FrameDriver<'s> {
     pub fn advance(&mut self, frame: u32) -> FrameFacts {
         self.states.clear();
         self.matrices.clear();
+        self.distances.clear();
         let mut lod_sum = 0.0f64;
         let mut t = 0u32;
         for (i, inst) in self.scene.instances.iter().enumerate() {
@@ -79,6 +82,7 @@ impl<'s> FrameDriver<'s> {
             lod_sum += s.lod_value() as f64;
             t += s.in_transition() as u32;
             self.states.push(s);
+            self.distances.push(d);
             self.matrices.push(self.scene.instance_matrix(i, frame));
         }
         FrameFacts {
@@ -93,6 +97,7 @@ impl<'s> FrameDriver<'s> {
             scene: self.scene,
             states: &self.states,
             matrices: &self.matrices,
+            distances: &self.distances,
         }
     }
 }
@@ -112,6 +117,7 @@ pub struct BlockRunner<'a> {
     method_target: RenderTarget,
     reference_target: RenderTarget,
     reference: Box<dyn Method>,
+    options: MethodOptions,
     kernel: MetricKernel,
     timer: Option<GpuTimer>,
     /// Times the metric kernel alone in the quality pass (its own cost, reported in run.json).
@@ -123,14 +129,19 @@ pub struct BlockRunner<'a> {
 const QUALITY_IN_FLIGHT: u32 = 2;
 
 impl<'a> BlockRunner<'a> {
-    pub fn new(ctx: &'a GpuContext, scene: &'a Scene, with_readback: bool) -> Result<Self> {
+    pub fn new(
+        ctx: &'a GpuContext,
+        scene: &'a Scene,
+        options: MethodOptions,
+        with_readback: bool,
+    ) -> Result<Self> {
         ctx.check_viewport(scene.width, scene.height)?;
         let gpu = SceneGpu::new(ctx, scene)?;
         let (w, h) = (scene.width, scene.height);
         let timing_target = RenderTarget::new(&ctx.device, "timing target", w, h);
         let method_target = RenderTarget::new(&ctx.device, "method target", w, h);
         let reference_target = RenderTarget::new(&ctx.device, "reference target", w, h);
-        let reference = methods::create("reference", &gpu, scene)?;
+        let reference = methods::create("reference", &gpu, scene, &options)?;
         let kernel = MetricKernel::new(ctx, &method_target, &reference_target, scene.frames)?;
         let timer = GpuTimer::new(ctx, scene.frames);
         let metric_timer = GpuTimer::new(ctx, scene.frames);
@@ -149,6 +160,7 @@ impl<'a> BlockRunner<'a> {
             method_target,
             reference_target,
             reference,
+            options,
             kernel,
             timer,
             metric_timer,
@@ -169,7 +181,7 @@ impl<'a> BlockRunner<'a> {
         let scene = self.scene;
         let ctx = self.ctx;
         let frames = scene.frames;
-        let mut method = methods::create(method_name, &self.gpu, scene)?;
+        let mut method = methods::create(method_name, &self.gpu, scene, &self.options)?;
         let mut driver = FrameDriver::new(scene);
 
         // Warm-up: the first frames of the path (wrapping), untimed.
@@ -448,7 +460,11 @@ fn run_blocks(
         let warmup = cfg.resolved(&def.name).warmup;
         for &count in &def.counts {
             let scene = def.instantiate(count);
-            let mut block = BlockRunner::new(&ctx, &scene, dumper.is_some())?;
+            let options = MethodOptions {
+                noise: cfg.noise,
+                seed: cfg.seed,
+            };
+            let mut block = BlockRunner::new(&ctx, &scene, options, dumper.is_some())?;
             for method in &cfg.methods {
                 progress.set_message(format!("{} n={} {}", def.name, count, method));
                 let out =

@@ -203,7 +203,7 @@ fn gpu_metrics_match_cpu_oracle() {
     let cfg = SceneConfig::from_args(&args.scene_args).unwrap();
     let scene = SceneDef::new("bunny-sweep", &cfg).unwrap().instantiate(1);
     let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
-    let mut block = BlockRunner::new(&ctx, &scene, true).unwrap();
+    let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true).unwrap();
     let mut oracle = SequenceMetrics::new();
     let mut cpu = Vec::new();
     let out = block
@@ -263,7 +263,7 @@ fn snapshot_reference_frame() {
     let cfg = SceneConfig::from_args(&args.scene_args).unwrap();
     let scene = SceneDef::new("bunny-sweep", &cfg).unwrap().instantiate(1);
     let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
-    let mut block = BlockRunner::new(&ctx, &scene, true).unwrap();
+    let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true).unwrap();
     let mut frame0 = None;
     block
         .run_method("reference", 0, 1, &ProgressBar::hidden(), |f, m, _| {
@@ -331,6 +331,54 @@ fn snapshot_reference_frame() {
             "snapshot differs: mean abs diff {mean:.3}, {:.3} % pixels off by > 16; see {}",
             bad_frac * 100.0,
             dir.display()
+        );
+    }
+}
+
+/// Every method on the ci sweep: frames with no instance in transition are identical to `discrete` (same rmse,
+/// exactly), and every smooth method's largest pop is below discrete's (issue 3).
+#[test]
+fn smooth_methods_match_discrete_outside_transitions_and_pop_less() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = run_config(&[
+        "--scene",
+        "bunny-sweep",
+        "--profile",
+        "ci",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(cfg.methods.len() >= 6);
+    runner::run(&cfg).expect("run completes");
+    let rows = read_csv(&out.join("frames.csv"));
+    let t = col(&rows, "discrete", "t_instances");
+    let discrete_rmse = col(&rows, "discrete", "rmse");
+    let discrete_pop_max = col(&rows, "discrete", "pop")
+        .into_iter()
+        .fold(0.0, f64::max);
+    for m in cfg
+        .methods
+        .iter()
+        .filter(|m| *m != "reference" && *m != "discrete")
+    {
+        let rmse = col(&rows, m, "rmse");
+        let mut steady = 0;
+        for f in 0..t.len() {
+            if t[f] == 0.0 {
+                assert_eq!(
+                    rmse[f], discrete_rmse[f],
+                    "{m}, frame {f}: differs from discrete outside transitions"
+                );
+                steady += 1;
+            }
+        }
+        assert!(steady > t.len() / 2);
+        assert_eq!(col(&rows, m, "t_instances"), t, "{m} saw another schedule");
+        let pop_max = col(&rows, m, "pop").into_iter().fold(0.0, f64::max);
+        assert!(
+            pop_max < discrete_pop_max,
+            "{m}: max pop {pop_max} not below discrete's {discrete_pop_max}"
         );
     }
 }

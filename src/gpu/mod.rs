@@ -6,4 +6,4 @@ pub mod renderer;
 pub mod timing;
 
 pub use context::{AdapterSummary, GpuContext, TimingSource};
-pub use renderer::{DrawList, DrawStats, InstanceRaw, RenderTarget, SceneGpu, Variant};
+pub use renderer::{DrawList, DrawStats, InstanceRaw, RenderTarget, SceneGpu};

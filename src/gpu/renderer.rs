@@ -64,16 +64,13 @@ impl LodRange {
     }
 }
 
-/// Shader variants: one pipeline each. Later methods add theirs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Variant {
-    Opaque,
-}
+/// Index of a pipeline in the slice a method passes to [`SceneGpu::draw`] (its shader variant).
+pub type PipelineIndex = u8;
 
 /// One instanced draw call.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Draw {
-    pub variant: Variant,
+    pub pipeline: PipelineIndex,
     pub model: u32,
     pub lod: u32,
     pub first_instance: u32,
@@ -87,12 +84,13 @@ pub struct DrawStats {
     pub draw_calls: u32,
 }
 
-/// A frame's draws: items added in any order, then sorted into buckets by (variant, model, LOD) so that each
-/// bucket is one instanced draw. The vectors are kept between frames, so nothing is allocated per frame once
-/// they have grown.
+/// A frame's draws: items added in any order, then sorted into buckets by (pipeline, model, LOD) so that each
+/// bucket is one instanced draw ([`DrawList::build`]), or kept in the order given, merging only neighbours of
+/// the same bucket ([`DrawList::build_in_order`], for back-to-front translucent draws). The vectors are kept
+/// between frames, so nothing is allocated per frame once they have grown.
 #[derive(Debug, Default)]
 pub struct DrawList {
-    items: Vec<((Variant, u32, u32), u32, InstanceRaw)>,
+    items: Vec<((PipelineIndex, u32, u32), u32, InstanceRaw)>,
     pub instances: Vec<InstanceRaw>,
     pub draws: Vec<Draw>,
 }
@@ -104,9 +102,13 @@ impl DrawList {
         self.draws.clear();
     }
 
-    pub fn push(&mut self, variant: Variant, model: u32, lod: u32, raw: InstanceRaw) {
+    pub fn push(&mut self, pipeline: PipelineIndex, model: u32, lod: u32, raw: InstanceRaw) {
         let order = self.items.len() as u32;
-        self.items.push(((variant, model, lod), order, raw));
+        self.items.push(((pipeline, model, lod), order, raw));
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
     }
 
     /// Sorts into buckets (stable: instances keep their order inside a bucket) and fills `instances` and
@@ -114,16 +116,22 @@ impl DrawList {
     pub fn build(&mut self) {
         self.items
             .sort_unstable_by_key(|(key, order, _)| (*key, *order));
+        self.build_in_order();
+    }
+
+    /// Keeps the order of `push`; neighbours of the same bucket share a draw (instances of one draw are
+    /// rasterised in order, so the order is kept).
+    pub fn build_in_order(&mut self) {
         self.instances.clear();
         self.draws.clear();
-        for (i, ((variant, model, lod), _, raw)) in self.items.iter().enumerate() {
+        for (i, ((pipeline, model, lod), _, raw)) in self.items.iter().enumerate() {
             self.instances.push(*raw);
             match self.draws.last_mut() {
-                Some(d) if d.variant == *variant && d.model == *model && d.lod == *lod => {
+                Some(d) if d.pipeline == *pipeline && d.model == *model && d.lod == *lod => {
                     d.instance_count += 1
                 }
                 _ => self.draws.push(Draw {
-                    variant: *variant,
+                    pipeline: *pipeline,
                     model: *model,
                     lod: *lod,
                     first_instance: i as u32,
@@ -238,7 +246,37 @@ pub fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 2] {
     ]
 }
 
+/// How a mesh pipeline (shaders/mesh.wgsl) treats depth and colour.
+pub struct MeshPipeline<'a> {
+    pub label: &'a str,
+    /// Fragment entry point; None = depth only (the pass then has no colour attachment).
+    pub fragment: Option<&'a str>,
+    pub depth_compare: wgpu::CompareFunction,
+    pub depth_write: bool,
+    pub blend: Option<wgpu::BlendState>,
+    /// Bind group layouts after the camera's (group 0).
+    pub extra_layouts: &'a [&'a wgpu::BindGroupLayout],
+}
+
+impl MeshPipeline<'_> {
+    pub fn opaque(label: &str) -> MeshPipeline<'_> {
+        MeshPipeline {
+            label,
+            fragment: Some("fs_opaque"),
+            depth_compare: wgpu::CompareFunction::Less,
+            depth_write: true,
+            blend: None,
+            extra_layouts: &[],
+        }
+    }
+}
+
 impl SceneGpu {
+    /// Builds a pipeline over the shared vertex layout and shader (methods call this in their constructors).
+    pub fn mesh_pipeline(&self, d: &MeshPipeline<'_>) -> wgpu::RenderPipeline {
+        mesh_pipeline(&self.device, &self.shader, &self.camera_layout, d)
+    }
+
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<SceneGpu> {
         let device = &ctx.device;
         let mut vertices: Vec<Vertex> = Vec::new();
@@ -303,47 +341,12 @@ impl SceneGpu {
             label: Some("mesh.wgsl"),
             source: wgpu::ShaderSource::Wgsl(MESH_WGSL.into()),
         });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("mesh pipeline layout"),
-            bind_group_layouts: &[Some(&camera_layout)],
-            immediate_size: 0,
-        });
-        let buffers = vertex_layouts();
-        let opaque_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("opaque pipeline"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &buffers.clone().map(Some),
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_opaque"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: COLOR_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let opaque_pipeline = mesh_pipeline(
+            device,
+            &shader,
+            &camera_layout,
+            &MeshPipeline::opaque("opaque pipeline"),
+        );
         ctx.check_errors()?;
         Ok(SceneGpu {
             device: device.clone(),
@@ -385,16 +388,19 @@ impl SceneGpu {
 
     /// Uploads a built draw list into `buffer` (before the submission that uses it).
     pub fn upload(&self, buffer: &InstanceBuffer, list: &DrawList) {
-        debug_assert!(list.instances.len() <= buffer.capacity as usize);
-        if !list.instances.is_empty() {
-            self.queue
-                .write_buffer(&buffer.buffer, 0, bytemuck::cast_slice(&list.instances));
-        }
+        self.upload_at(buffer, 0, list);
     }
 
-    pub fn pipeline(&self, variant: Variant) -> &wgpu::RenderPipeline {
-        match variant {
-            Variant::Opaque => &self.opaque_pipeline,
+    /// Uploads a built draw list into `buffer` from instance `first` on (several lists can share one buffer
+    /// in one submission when they use disjoint ranges).
+    pub fn upload_at(&self, buffer: &InstanceBuffer, first: u32, list: &DrawList) {
+        debug_assert!(first as usize + list.instances.len() <= buffer.capacity as usize);
+        if !list.instances.is_empty() {
+            self.queue.write_buffer(
+                &buffer.buffer,
+                first as u64 * std::mem::size_of::<InstanceRaw>() as u64,
+                bytemuck::cast_slice(&list.instances),
+            );
         }
     }
 
@@ -405,27 +411,48 @@ impl SceneGpu {
         target: &RenderTarget,
         label: &str,
     ) -> wgpu::RenderPass<'e> {
+        self.begin_pass(encoder, &target.color_view, &target.depth_view, label, true)
+    }
+
+    /// Begins a pass on a colour and a depth view, clearing both (`clear`) or keeping what they hold.
+    pub fn begin_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        color: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+        label: &str,
+        clear: bool,
+    ) -> wgpu::RenderPass<'e> {
         let [r, g, b] = BACKGROUND;
+        let color_load = if clear {
+            wgpu::LoadOp::Clear(wgpu::Color {
+                r: r as f64,
+                g: g as f64,
+                b: b as f64,
+                a: 1.0,
+            })
+        } else {
+            wgpu::LoadOp::Load
+        };
         encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target.color_view,
+                view: color,
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: r as f64,
-                        g: g as f64,
-                        b: b as f64,
-                        a: 1.0,
-                    }),
+                    load: color_load,
                     store: wgpu::StoreOp::Store,
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &target.depth_view,
+                view: depth,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
+                    load: if clear {
+                        wgpu::LoadOp::Clear(1.0)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
                     store: wgpu::StoreOp::Store,
                 }),
                 stencil_ops: None,
@@ -436,12 +463,46 @@ impl SceneGpu {
         })
     }
 
-    /// Records the draws of `list` (already uploaded to `buffer`) into `pass`.
+    /// Draws `count` instances from absolute instance `first` of `buffer` at (model, LOD) with `pipeline`;
+    /// for methods that need a pass per instance.
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw_instances(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        buffer: &InstanceBuffer,
+        first: u32,
+        count: u32,
+        model: u32,
+        lod: u32,
+        pipeline: &wgpu::RenderPipeline,
+    ) -> DrawStats {
+        pass.set_bind_group(0, &self.camera_bind_group, &[]);
+        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+        pass.set_vertex_buffer(1, buffer.buffer.slice(..));
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        pass.set_pipeline(pipeline);
+        let r = self.lods[model as usize][lod as usize];
+        pass.draw_indexed(
+            r.first_index..r.first_index + r.index_count,
+            r.base_vertex,
+            first..first + count,
+        );
+        DrawStats {
+            triangles: r.triangles() * count as u64,
+            draw_calls: 1,
+        }
+    }
+
+    /// Records the draws of `list` (uploaded to `buffer` at instance `first`, see [`SceneGpu::upload_at`])
+    /// into `pass`, with `pipelines[d.pipeline]` for each draw. Bind groups other than the camera's (group 0)
+    /// are the caller's to set.
     pub fn draw(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         buffer: &InstanceBuffer,
+        first: u32,
         list: &DrawList,
+        pipelines: &[&wgpu::RenderPipeline],
     ) -> DrawStats {
         let mut stats = DrawStats::default();
         if list.draws.is_empty() {
@@ -451,23 +512,75 @@ impl SceneGpu {
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, buffer.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-        let mut bound: Option<Variant> = None;
+        let mut bound: Option<PipelineIndex> = None;
         for d in &list.draws {
-            if bound != Some(d.variant) {
-                pass.set_pipeline(self.pipeline(d.variant));
-                bound = Some(d.variant);
+            if bound != Some(d.pipeline) {
+                pass.set_pipeline(pipelines[d.pipeline as usize]);
+                bound = Some(d.pipeline);
             }
             let r = self.lods[d.model as usize][d.lod as usize];
             pass.draw_indexed(
                 r.first_index..r.first_index + r.index_count,
                 r.base_vertex,
-                d.first_instance..d.first_instance + d.instance_count,
+                first + d.first_instance..first + d.first_instance + d.instance_count,
             );
             stats.triangles += r.triangles() * d.instance_count as u64;
             stats.draw_calls += 1;
         }
         stats
     }
+}
+
+fn mesh_pipeline(
+    device: &wgpu::Device,
+    shader: &wgpu::ShaderModule,
+    camera_layout: &wgpu::BindGroupLayout,
+    d: &MeshPipeline<'_>,
+) -> wgpu::RenderPipeline {
+    let mut layouts: Vec<Option<&wgpu::BindGroupLayout>> = vec![Some(camera_layout)];
+    layouts.extend(d.extra_layouts.iter().map(|l| Some(*l)));
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(d.label),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    });
+    let buffers = vertex_layouts().map(Some);
+    let targets = [Some(wgpu::ColorTargetState {
+        format: COLOR_FORMAT,
+        blend: d.blend,
+        write_mask: wgpu::ColorWrites::ALL,
+    })];
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(d.label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: shader,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &buffers,
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(d.depth_write),
+            depth_compare: Some(d.depth_compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState::default(),
+        fragment: d.fragment.map(|entry| wgpu::FragmentState {
+            module: shader,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 /// Copies a target's colour into a mappable buffer (rows padded to 256 bytes).
@@ -535,6 +648,22 @@ impl ColorReadback {
     }
 }
 
+impl std::ops::Add for DrawStats {
+    type Output = DrawStats;
+    fn add(self, o: DrawStats) -> DrawStats {
+        DrawStats {
+            triangles: self.triangles + o.triangles,
+            draw_calls: self.draw_calls + o.draw_calls,
+        }
+    }
+}
+
+impl std::ops::AddAssign for DrawStats {
+    fn add_assign(&mut self, o: DrawStats) {
+        *self = *self + o;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -546,10 +675,10 @@ mod tests {
     #[test]
     fn draw_list_buckets_by_variant_model_lod() {
         let mut l = DrawList::default();
-        l.push(Variant::Opaque, 0, 2, raw(0.0));
-        l.push(Variant::Opaque, 0, 0, raw(1.0));
-        l.push(Variant::Opaque, 0, 2, raw(2.0));
-        l.push(Variant::Opaque, 1, 0, raw(3.0));
+        l.push(0, 0, 2, raw(0.0));
+        l.push(0, 0, 0, raw(1.0));
+        l.push(0, 0, 2, raw(2.0));
+        l.push(0, 1, 0, raw(3.0));
         l.build();
         assert_eq!(l.draws.len(), 3);
         assert_eq!((l.draws[0].lod, l.draws[0].instance_count), (0, 1));

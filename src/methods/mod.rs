@@ -1,20 +1,47 @@
 //! Transition methods behind one trait and a registry. A method only decides how to draw the shared schedule's
 //! `(lod_from, lod_to, k)` per instance; it never selects LODs itself.
 
+mod alpha;
+mod alpha_2pass;
+mod alpha_zwrite;
 mod discrete;
+mod dither;
 mod reference;
 
 use crate::error::{Error, Result};
 use crate::gpu::renderer::{
     DrawList, DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu,
 };
-use crate::gpu::Variant;
+use crate::noise::NoisePattern;
 use crate::scene::Scene;
 use crate::schedule::InstanceState;
 use glam::Mat4;
 
 /// Every method name `--method` accepts, in the order runs use when none is given.
-pub const METHODS: &[&str] = &["reference", "discrete"];
+pub const METHODS: &[&str] = &[
+    "reference",
+    "discrete",
+    "alpha",
+    "alpha-2pass",
+    "alpha-zwrite",
+    "dither",
+];
+
+/// Settings some methods read (recorded in run.json with the rest of the config).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct MethodOptions {
+    pub noise: NoisePattern,
+    pub seed: u64,
+}
+
+impl Default for MethodOptions {
+    fn default() -> Self {
+        MethodOptions {
+            noise: NoisePattern::White16,
+            seed: 1,
+        }
+    }
+}
 
 /// What a method gets for one frame.
 pub struct FrameInput<'a> {
@@ -24,6 +51,8 @@ pub struct FrameInput<'a> {
     pub states: &'a [InstanceState],
     /// One object-to-world matrix per instance.
     pub matrices: &'a [Mat4],
+    /// Camera-to-instance-centre distance per instance (what LOD selection used).
+    pub distances: &'a [f32],
 }
 
 pub trait Method {
@@ -46,12 +75,83 @@ pub trait Method {
 }
 
 /// Builds the method called `name` for `scene`; GPU objects are created here, once.
-pub fn create(name: &str, gpu: &SceneGpu, scene: &Scene) -> Result<Box<dyn Method>> {
+pub fn create(
+    name: &str,
+    gpu: &SceneGpu,
+    scene: &Scene,
+    options: &MethodOptions,
+) -> Result<Box<dyn Method>> {
     match name {
         "reference" => Ok(Box::new(reference::Reference::new(gpu, scene))),
         "discrete" => Ok(Box::new(discrete::Discrete::new(gpu, scene))),
+        "alpha" => Ok(Box::new(alpha::Alpha::new(gpu, scene))),
+        "alpha-2pass" => Ok(Box::new(alpha_2pass::AlphaTwoPass::new(gpu, scene))),
+        "alpha-zwrite" => Ok(Box::new(alpha_zwrite::AlphaZWrite::new(gpu, scene))),
+        "dither" => Ok(Box::new(dither::Dither::new(gpu, scene, options))),
         _ => Err(Error::unknown("method", name, METHODS)),
     }
+}
+
+/// The Giegl-Wimmer "unpopping" schedule (seed 000 Fig. 2, seed 001 Fig. 1b): one LOD is always opaque. For
+/// k < 0.5 the incoming LOD (`lod_to`) is translucent with alpha 2k over the opaque outgoing one; from k = 0.5
+/// the incoming one is opaque and the outgoing one translucent with alpha 2(1 - k).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Unpop {
+    pub opaque: u32,
+    /// (LOD, alpha) of the translucent draw of a t-instance.
+    pub translucent: Option<(u32, f32)>,
+    /// True from k = 0.5 on: the roles have swapped.
+    pub swapped: bool,
+}
+
+pub(crate) fn unpop(s: &InstanceState) -> Unpop {
+    if !s.in_transition() {
+        return Unpop {
+            opaque: s.lod_from,
+            translucent: None,
+            swapped: false,
+        };
+    }
+    if s.k < 0.5 {
+        Unpop {
+            opaque: s.lod_from,
+            translucent: Some((s.lod_to, 2.0 * s.k)),
+            swapped: false,
+        }
+    } else {
+        Unpop {
+            opaque: s.lod_to,
+            translucent: Some((s.lod_from, 2.0 * (1.0 - s.k))),
+            swapped: true,
+        }
+    }
+}
+
+/// Indices of the instances `select` keeps, farthest first (ties by index, so the order is deterministic).
+pub(crate) fn back_to_front(
+    distances: &[f32],
+    out: &mut Vec<usize>,
+    select: impl Fn(usize) -> bool,
+) {
+    out.clear();
+    out.extend((0..distances.len()).filter(|&i| select(i)));
+    out.sort_by(|&a, &b| distances[b].total_cmp(&distances[a]).then(a.cmp(&b)));
+}
+
+pub(crate) fn instance_raw(
+    input: &FrameInput<'_>,
+    i: usize,
+    k: f32,
+    alpha: f32,
+    lod: u32,
+) -> InstanceRaw {
+    let inst = &input.scene.instances[i];
+    let model = &input.scene.models[inst.model as usize];
+    InstanceRaw::new(
+        &input.matrices[i],
+        model.color,
+        [k, alpha, lod as f32, i as f32],
+    )
 }
 
 /// Shared by methods that draw every instance once, opaque, at one LOD each.
@@ -80,22 +180,62 @@ impl OpaqueInstances {
     ) -> DrawStats {
         self.list.clear();
         for (i, (inst, state)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            let model = &input.scene.models[inst.model as usize];
             let lod = lod_of(state);
             self.list.push(
-                Variant::Opaque,
+                0,
                 inst.model,
                 lod,
-                InstanceRaw::new(
-                    &input.matrices[i],
-                    model.color,
-                    [state.k, 1.0, lod as f32, 0.0],
-                ),
+                instance_raw(input, i, state.k, 1.0, lod),
             );
         }
         self.list.build();
         gpu.upload(&self.buffer, &self.list);
         let mut pass = gpu.begin_clear_pass(encoder, target, label);
-        gpu.draw(&mut pass, &self.buffer, &self.list)
+        gpu.draw(
+            &mut pass,
+            &self.buffer,
+            0,
+            &self.list,
+            &[&gpu.opaque_pipeline],
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn st(from: u32, to: u32, k: f32) -> InstanceState {
+        InstanceState {
+            lod_from: from,
+            lod_to: to,
+            k,
+        }
+    }
+
+    #[test]
+    fn unpopping_keeps_one_lod_opaque() {
+        assert_eq!(unpop(&st(1, 1, 0.0)).translucent, None);
+        let a = unpop(&st(0, 1, 0.2));
+        assert_eq!((a.opaque, a.swapped), (0, false));
+        assert_eq!(a.translucent, Some((1, 0.4)));
+        let b = unpop(&st(0, 1, 0.5));
+        assert_eq!((b.opaque, b.swapped), (1, true));
+        assert_eq!(b.translucent, Some((0, 1.0)));
+        let c = unpop(&st(0, 1, 0.9));
+        assert_eq!(c.opaque, 1);
+        let (lod, alpha) = c.translucent.unwrap();
+        assert_eq!(lod, 0);
+        assert!((alpha - 0.2).abs() < 1e-6);
+        // Alpha is continuous through the swap: 2k -> 1 from below, 2(1-k) = 1 at k = 0.5.
+        let below = unpop(&st(0, 1, 0.4999)).translucent.unwrap().1;
+        assert!((below - 1.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn back_to_front_sorts_farthest_first() {
+        let mut order = Vec::new();
+        back_to_front(&[3.0, 9.0, 1.0, 9.0], &mut order, |i| i != 2);
+        assert_eq!(order, vec![1, 3, 0]);
     }
 }

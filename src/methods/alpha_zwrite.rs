@@ -1,0 +1,117 @@
+//! `alpha-zwrite`: Blow's variant of unpopping blending (seed 001, "Unified Rendering LOD, Part 2"). The
+//! translucent LOD is drawn after the opaque one with depth writes on, so its own far surfaces are hidden
+//! consistently from frame to frame. When the roles swap at k = 0.5 the draw order swaps with them, and the depth
+//! compare of the translucent draw switches from less-equal (before) to less (after): pixels where the two LODs
+//! meet at equal depth are filled by the same LOD on both sides of the swap, so the swap does not pop. Opaque
+//! draws first, translucent ones back to front.
+
+use super::alpha::OVER;
+use super::{back_to_front, instance_raw, unpop, FrameInput, Method};
+use crate::gpu::renderer::{
+    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu,
+};
+use crate::scene::Scene;
+
+/// Pipeline indices of the translucent draws.
+const BEFORE_SWAP: u8 = 0;
+const AFTER_SWAP: u8 = 1;
+
+pub struct AlphaZWrite {
+    opaque: DrawList,
+    translucent: DrawList,
+    order: Vec<usize>,
+    buffer: InstanceBuffer,
+    less_equal: wgpu::RenderPipeline,
+    less: wgpu::RenderPipeline,
+}
+
+impl AlphaZWrite {
+    pub fn new(gpu: &SceneGpu, scene: &Scene) -> Self {
+        let translucent = |label, depth_compare| {
+            gpu.mesh_pipeline(&MeshPipeline {
+                label,
+                fragment: Some("fs_translucent"),
+                depth_compare,
+                depth_write: true,
+                blend: Some(OVER),
+                extra_layouts: &[],
+            })
+        };
+        AlphaZWrite {
+            opaque: DrawList::default(),
+            translucent: DrawList::default(),
+            order: Vec::new(),
+            buffer: gpu
+                .create_instance_buffer("alpha-zwrite instances", 2 * scene.instances.len() as u32),
+            less_equal: translucent(
+                "alpha-zwrite translucent <=",
+                wgpu::CompareFunction::LessEqual,
+            ),
+            less: translucent("alpha-zwrite translucent <", wgpu::CompareFunction::Less),
+        }
+    }
+}
+
+impl Method for AlphaZWrite {
+    fn name(&self) -> &'static str {
+        "alpha-zwrite"
+    }
+
+    fn encode(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) -> DrawStats {
+        self.opaque.clear();
+        self.translucent.clear();
+        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
+            let u = unpop(s);
+            self.opaque.push(
+                0,
+                inst.model,
+                u.opaque,
+                instance_raw(input, i, s.k, 1.0, u.opaque),
+            );
+        }
+        back_to_front(input.distances, &mut self.order, |i| {
+            input.states[i].in_transition()
+        });
+        for &i in &self.order {
+            let s = &input.states[i];
+            let u = unpop(s);
+            if let Some((lod, alpha)) = u.translucent {
+                let pipeline = if u.swapped { AFTER_SWAP } else { BEFORE_SWAP };
+                let model = input.scene.instances[i].model;
+                self.translucent.push(
+                    pipeline,
+                    model,
+                    lod,
+                    instance_raw(input, i, s.k, alpha, lod),
+                );
+            }
+        }
+        self.opaque.build();
+        self.translucent.build_in_order();
+        let n_opaque = self.opaque.instances.len() as u32;
+        gpu.upload_at(&self.buffer, 0, &self.opaque);
+        gpu.upload_at(&self.buffer, n_opaque, &self.translucent);
+        let mut pass = gpu.begin_clear_pass(encoder, target, "alpha-zwrite pass");
+        let a = gpu.draw(
+            &mut pass,
+            &self.buffer,
+            0,
+            &self.opaque,
+            &[&gpu.opaque_pipeline],
+        );
+        let b = gpu.draw(
+            &mut pass,
+            &self.buffer,
+            n_opaque,
+            &self.translucent,
+            &[&self.less_equal, &self.less],
+        );
+        a + b
+    }
+}

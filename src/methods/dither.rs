@@ -1,0 +1,175 @@
+//! `dither`: noise blending (seed 003 section 9, eq. 3). Both LODs of a t-instance are drawn opaque, with
+//! fragment discard: a pixel keeps the incoming LOD (`lod_to`) where k > noise(x, y) and the outgoing LOD
+//! (`lod_from`) elsewhere. The two tests are complementary, so each pixel of the overlap shows exactly one of
+//! them, and depth writes stay on: no sorting, no translucency. The threshold pattern is `--noise`
+//! (`src/noise.rs`), tiled in screen space.
+
+use super::{instance_raw, FrameInput, Method, MethodOptions};
+use crate::gpu::renderer::{
+    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu,
+};
+use crate::noise::threshold_texture;
+use crate::scene::Scene;
+
+const STEADY: u8 = 0;
+const DITHERED: u8 = 1;
+const ROLE_OUTGOING: f32 = 0.0;
+const ROLE_INCOMING: f32 = 1.0;
+
+pub struct Dither {
+    list: DrawList,
+    buffer: InstanceBuffer,
+    steady: wgpu::RenderPipeline,
+    dithered: wgpu::RenderPipeline,
+    noise_group: wgpu::BindGroup,
+}
+
+impl Dither {
+    pub fn new(gpu: &SceneGpu, scene: &Scene, options: &MethodOptions) -> Self {
+        let device = &gpu.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dither noise layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        // Interleaved gradient noise needs no texture: a 1x1 placeholder keeps the layout the same.
+        let (size, values) =
+            threshold_texture(options.noise, options.seed).unwrap_or((0, vec![0.5]));
+        let side = size.max(1);
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("dither thresholds"),
+            size: wgpu::Extent3d {
+                width: side,
+                height: side,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        gpu.queue.write_texture(
+            texture.as_image_copy(),
+            bytemuck::cast_slice(&values),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(side * 4),
+                rows_per_image: Some(side),
+            },
+            texture.size(),
+        );
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("dither params"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        gpu.queue
+            .write_buffer(&params, 0, bytemuck::cast_slice(&[size, 0u32, 0, 0]));
+        let view = texture.create_view(&Default::default());
+        let noise_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dither noise"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: params.as_entire_binding(),
+                },
+            ],
+        });
+        let pipeline = |label, fragment| {
+            gpu.mesh_pipeline(&MeshPipeline {
+                label,
+                fragment: Some(fragment),
+                depth_compare: wgpu::CompareFunction::Less,
+                depth_write: true,
+                blend: None,
+                extra_layouts: &[&layout],
+            })
+        };
+        Dither {
+            list: DrawList::default(),
+            buffer: gpu
+                .create_instance_buffer("dither instances", 2 * scene.instances.len() as u32),
+            steady: pipeline("dither steady", "fs_opaque"),
+            dithered: pipeline("dither dithered", "fs_dither"),
+            noise_group,
+        }
+    }
+}
+
+impl Method for Dither {
+    fn name(&self) -> &'static str {
+        "dither"
+    }
+
+    fn encode(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) -> DrawStats {
+        self.list.clear();
+        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
+            if s.in_transition() {
+                self.list.push(
+                    DITHERED,
+                    inst.model,
+                    s.lod_to,
+                    instance_raw(input, i, s.k, ROLE_INCOMING, s.lod_to),
+                );
+                self.list.push(
+                    DITHERED,
+                    inst.model,
+                    s.lod_from,
+                    instance_raw(input, i, s.k, ROLE_OUTGOING, s.lod_from),
+                );
+            } else {
+                self.list.push(
+                    STEADY,
+                    inst.model,
+                    s.lod_from,
+                    instance_raw(input, i, s.k, 1.0, s.lod_from),
+                );
+            }
+        }
+        self.list.build();
+        gpu.upload(&self.buffer, &self.list);
+        let mut pass = gpu.begin_clear_pass(encoder, target, "dither pass");
+        pass.set_bind_group(1, &self.noise_group, &[]);
+        gpu.draw(
+            &mut pass,
+            &self.buffer,
+            0,
+            &self.list,
+            &[&self.steady, &self.dithered],
+        )
+    }
+}
