@@ -6,6 +6,7 @@ use lodbench::export::csv::{FrameRecord, FramesWriter};
 use lodbench::lod::{LodChain, DEFAULT_TARGETS};
 use lodbench::mesh::Mesh;
 use lodbench::metrics::SequenceMetrics;
+use lodbench::morph;
 use lodbench::rng::SplitMix64;
 use lodbench::scene::BUNNY_OBJ;
 use lodbench::schedule::{LodSchedule, ScheduleParams};
@@ -18,6 +19,25 @@ fn lod_generation(c: &mut Criterion) {
     });
     c.bench_function("bunny LOD chain 100/50/25/10 %", |b| {
         b.iter(|| LodChain::build("bunny", black_box(&mesh), &DEFAULT_TARGETS).unwrap())
+    });
+}
+
+fn geomorph_correspondence(c: &mut Criterion) {
+    let mesh = Mesh::parse_obj("bunny", BUNNY_OBJ).unwrap();
+    let chain = LodChain::build("bunny", &mesh, &DEFAULT_TARGETS).unwrap();
+    c.bench_function("geomorph nearest, all 3 bunny LOD pairs", |b| {
+        b.iter(|| {
+            for pair in chain.lods.windows(2) {
+                black_box(morph::nearest_vertex(&pair[0].mesh, &pair[1].mesh));
+            }
+        })
+    });
+    c.bench_function("geomorph surface, all 3 bunny LOD pairs", |b| {
+        b.iter(|| {
+            for pair in chain.lods.windows(2) {
+                black_box(morph::closest_surface(&pair[0].mesh, &pair[1].mesh));
+            }
+        })
     });
 }
 
@@ -82,6 +102,7 @@ fn csv_export(c: &mut Criterion) {
 criterion_group!(
     benches,
     lod_generation,
+    geomorph_correspondence,
     schedule,
     metrics_oracle,
     csv_export

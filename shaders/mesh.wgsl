@@ -33,17 +33,40 @@ struct VsOut {
     @location(2) params: vec4<f32>,
 };
 
-@vertex
-fn vs_main(v: VertexIn, inst: InstanceIn) -> VsOut {
+fn transform(position: vec3<f32>, normal: vec3<f32>, inst: InstanceIn) -> VsOut {
     let model = mat4x4<f32>(inst.model_0, inst.model_1, inst.model_2, inst.model_3);
-    let world = model * vec4<f32>(v.position, 1.0);
+    let world = model * vec4<f32>(position, 1.0);
     var out: VsOut;
     out.clip = camera.view_proj * world;
     // Instances are scaled uniformly, so the model matrix transforms normals too.
-    out.normal = (model * vec4<f32>(v.normal, 0.0)).xyz;
+    out.normal = (model * vec4<f32>(normal, 0.0)).xyz;
     out.color = inst.color;
     out.params = inst.params;
     return out;
+}
+
+@vertex
+fn vs_main(v: VertexIn, inst: InstanceIn) -> VsOut {
+    return transform(v.position, v.normal, inst);
+}
+
+// Geomorphing (seed 003 sections 10-11): each vertex of the finer LOD moves towards its target on the coarser
+// LOD by the morph weight params.x; the normal is interpolated and renormalised.
+struct MorphIn {
+    @location(8) target_position: vec3<f32>,
+    @location(9) target_normal: vec3<f32>,
+};
+
+@vertex
+fn vs_morph(v: VertexIn, inst: InstanceIn, m: MorphIn) -> VsOut {
+    let t = inst.params.x;
+    let n = mix(v.normal, m.target_normal, t);
+    let len = length(n);
+    var normal = v.normal;
+    if (len > 1e-6) {
+        normal = n / len;
+    }
+    return transform(mix(v.position, m.target_position, t), normal, inst);
 }
 
 fn shade(in: VsOut, front: bool) -> vec3<f32> {

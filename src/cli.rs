@@ -102,6 +102,9 @@ pub struct RunArgs {
     /// Threshold pattern of noise blending (`dither`).
     #[arg(long, value_enum, default_value_t = crate::noise::NoisePattern::White16)]
     pub noise: crate::noise::NoisePattern,
+    /// Vertex correspondence of geomorphing (`geomorph`).
+    #[arg(long, value_enum, default_value_t = crate::morph::Correspondence::Nearest)]
+    pub correspondence: crate::morph::Correspondence,
     /// Output folder (default results/<scene>-<time>/).
     #[arg(long)]
     pub out: Option<PathBuf>,

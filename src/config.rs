@@ -178,6 +178,8 @@ pub struct RunConfig {
     pub seed: u64,
     /// Threshold pattern of `dither`.
     pub noise: crate::noise::NoisePattern,
+    /// Vertex correspondence of `geomorph`.
+    pub correspondence: crate::morph::Correspondence,
     pub out: Option<PathBuf>,
     pub adapter: Option<String>,
     pub dump_frames: bool,
@@ -201,6 +203,7 @@ impl RunConfig {
             warmup: a.warmup,
             seed: a.seed,
             noise: a.noise,
+            correspondence: a.correspondence,
             out: a.out.clone(),
             adapter: a.adapter.clone(),
             dump_frames: a.dump_frames,

@@ -10,6 +10,7 @@ pub mod lod;
 pub mod mesh;
 pub mod methods;
 pub mod metrics;
+pub mod morph;
 pub mod noise;
 pub mod rng;
 pub mod runner;

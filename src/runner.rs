@@ -462,6 +462,7 @@ fn run_blocks(
             let scene = def.instantiate(count);
             let options = MethodOptions {
                 noise: cfg.noise,
+                correspondence: cfg.correspondence,
                 seed: cfg.seed,
             };
             let mut block = BlockRunner::new(&ctx, &scene, options, dumper.is_some())?;

@@ -46,7 +46,14 @@ fn every_shader_validates() {
 fn entry_points_the_renderer_uses_exist() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
     let mesh = entry_points(&validate(&dir.join("mesh.wgsl")));
-    for e in ["vs_main", "fs_opaque"] {
+    for e in [
+        "vs_main",
+        "vs_morph",
+        "fs_opaque",
+        "fs_translucent",
+        "fs_translucent_occluded",
+        "fs_dither",
+    ] {
         assert!(
             mesh.contains(&e.to_string()),
             "mesh.wgsl lacks {e}: {mesh:?}"

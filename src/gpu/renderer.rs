@@ -249,6 +249,8 @@ pub fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 2] {
 /// How a mesh pipeline (shaders/mesh.wgsl) treats depth and colour.
 pub struct MeshPipeline<'a> {
     pub label: &'a str,
+    /// Morphing vertex stage (`vs_morph`, with the morph-target buffer in slot 2) instead of `vs_main`.
+    pub morph: bool,
     /// Fragment entry point; None = depth only (the pass then has no colour attachment).
     pub fragment: Option<&'a str>,
     pub depth_compare: wgpu::CompareFunction,
@@ -262,6 +264,7 @@ impl MeshPipeline<'_> {
     pub fn opaque(label: &str) -> MeshPipeline<'_> {
         MeshPipeline {
             label,
+            morph: false,
             fragment: Some("fs_opaque"),
             depth_compare: wgpu::CompareFunction::Less,
             depth_write: true,
@@ -544,7 +547,19 @@ fn mesh_pipeline(
         bind_group_layouts: &layouts,
         immediate_size: 0,
     });
-    let buffers = vertex_layouts().map(Some);
+    const MORPH: [wgpu::VertexAttribute; 2] =
+        wgpu::vertex_attr_array![8 => Float32x3, 9 => Float32x3];
+    let [vertex, instance] = vertex_layouts();
+    let morph = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &MORPH,
+    };
+    let buffers = if d.morph {
+        vec![Some(vertex), Some(instance), Some(morph)]
+    } else {
+        vec![Some(vertex), Some(instance)]
+    };
     let targets = [Some(wgpu::ColorTargetState {
         format: COLOR_FORMAT,
         blend: d.blend,
@@ -555,7 +570,7 @@ fn mesh_pipeline(
         layout: Some(&layout),
         vertex: wgpu::VertexState {
             module: shader,
-            entry_point: Some("vs_main"),
+            entry_point: Some(if d.morph { "vs_morph" } else { "vs_main" }),
             compilation_options: Default::default(),
             buffers: &buffers,
         },

@@ -30,6 +30,7 @@ impl Alpha {
             buffer: gpu.create_instance_buffer("alpha instances", 2 * scene.instances.len() as u32),
             translucent_pipeline: gpu.mesh_pipeline(&MeshPipeline {
                 label: "alpha translucent",
+                morph: false,
                 fragment: Some("fs_translucent"),
                 depth_compare: wgpu::CompareFunction::LessEqual,
                 depth_write: false,

@@ -70,6 +70,7 @@ impl AlphaTwoPass {
                 .create_instance_buffer("alpha-2pass instances", 2 * scene.instances.len() as u32),
             depth_only: gpu.mesh_pipeline(&MeshPipeline {
                 label: "alpha-2pass depth only",
+                morph: false,
                 fragment: None,
                 depth_compare: wgpu::CompareFunction::Less,
                 depth_write: true,
@@ -78,6 +79,7 @@ impl AlphaTwoPass {
             }),
             colour: gpu.mesh_pipeline(&MeshPipeline {
                 label: "alpha-2pass colour",
+                morph: false,
                 fragment: Some("fs_translucent_occluded"),
                 depth_compare: wgpu::CompareFunction::Equal,
                 depth_write: false,

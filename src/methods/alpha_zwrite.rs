@@ -30,6 +30,7 @@ impl AlphaZWrite {
         let translucent = |label, depth_compare| {
             gpu.mesh_pipeline(&MeshPipeline {
                 label,
+                morph: false,
                 fragment: Some("fs_translucent"),
                 depth_compare,
                 depth_write: true,

@@ -106,6 +106,7 @@ impl Dither {
         let pipeline = |label, fragment| {
             gpu.mesh_pipeline(&MeshPipeline {
                 label,
+                morph: false,
                 fragment: Some(fragment),
                 depth_compare: wgpu::CompareFunction::Less,
                 depth_write: true,

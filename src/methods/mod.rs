@@ -6,12 +6,14 @@ mod alpha_2pass;
 mod alpha_zwrite;
 mod discrete;
 mod dither;
+mod geomorph;
 mod reference;
 
 use crate::error::{Error, Result};
 use crate::gpu::renderer::{
     DrawList, DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu,
 };
+use crate::morph::Correspondence;
 use crate::noise::NoisePattern;
 use crate::scene::Scene;
 use crate::schedule::InstanceState;
@@ -25,12 +27,14 @@ pub const METHODS: &[&str] = &[
     "alpha-2pass",
     "alpha-zwrite",
     "dither",
+    "geomorph",
 ];
 
 /// Settings some methods read (recorded in run.json with the rest of the config).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct MethodOptions {
     pub noise: NoisePattern,
+    pub correspondence: Correspondence,
     pub seed: u64,
 }
 
@@ -38,6 +42,7 @@ impl Default for MethodOptions {
     fn default() -> Self {
         MethodOptions {
             noise: NoisePattern::White16,
+            correspondence: Correspondence::Nearest,
             seed: 1,
         }
     }
@@ -88,6 +93,7 @@ pub fn create(
         "alpha-2pass" => Ok(Box::new(alpha_2pass::AlphaTwoPass::new(gpu, scene))),
         "alpha-zwrite" => Ok(Box::new(alpha_zwrite::AlphaZWrite::new(gpu, scene))),
         "dither" => Ok(Box::new(dither::Dither::new(gpu, scene, options))),
+        "geomorph" => Ok(Box::new(geomorph::Geomorph::new(gpu, scene, options))),
         _ => Err(Error::unknown("method", name, METHODS)),
     }
 }

@@ -1,0 +1,117 @@
+//! `geomorph`: geomorphing between discrete LODs (seed 003 sections 10-11). A t-instance draws one mesh, the
+//! finer of its two LODs, whose vertices the vertex shader moves towards their targets on the coarser LOD by the
+//! morph weight (k when coarsening, 1 - k when refining), normals interpolated and renormalised. When the
+//! transition ends the coarser LOD itself replaces the fully morphed finer one; what that swap leaves is
+//! measured by the `pop` column on those frames. Targets come from `--correspondence` (`src/morph.rs`), computed
+//! once per LOD pair and cached.
+
+use super::{instance_raw, FrameInput, Method, MethodOptions};
+use crate::gpu::renderer::{
+    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu, Vertex,
+};
+use crate::morph::morph_targets;
+use crate::scene::Scene;
+use wgpu::util::DeviceExt;
+
+const STEADY: u8 = 0;
+const MORPHING: u8 = 1;
+
+pub struct Geomorph {
+    list: DrawList,
+    buffer: InstanceBuffer,
+    /// Per vertex of the scene's vertex buffer: its target on the next coarser LOD of its model (the coarsest
+    /// LOD's vertices target themselves and are never morphed).
+    targets: wgpu::Buffer,
+    morph: wgpu::RenderPipeline,
+}
+
+impl Geomorph {
+    pub fn new(gpu: &SceneGpu, scene: &Scene, options: &MethodOptions) -> Self {
+        let mut targets: Vec<Vertex> = Vec::new();
+        for model in scene.models.iter() {
+            let lods = &model.chain.lods;
+            for (i, lod) in lods.iter().enumerate() {
+                match lods.get(i + 1) {
+                    Some(coarse) => {
+                        let t = morph_targets(&lod.mesh, &coarse.mesh, options.correspondence);
+                        targets.extend(t.positions.iter().zip(&t.normals).map(|(p, n)| Vertex {
+                            position: *p,
+                            normal: *n,
+                        }));
+                    }
+                    None => targets.extend(lod.mesh.positions.iter().zip(&lod.mesh.normals).map(
+                        |(p, n)| Vertex {
+                            position: *p,
+                            normal: *n,
+                        },
+                    )),
+                }
+            }
+        }
+        Geomorph {
+            list: DrawList::default(),
+            buffer: gpu.create_instance_buffer("geomorph instances", scene.instances.len() as u32),
+            targets: gpu
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("geomorph targets"),
+                    contents: bytemuck::cast_slice(&targets),
+                    usage: wgpu::BufferUsages::VERTEX,
+                }),
+            morph: gpu.mesh_pipeline(&MeshPipeline {
+                morph: true,
+                ..MeshPipeline::opaque("geomorph")
+            }),
+        }
+    }
+}
+
+impl Method for Geomorph {
+    fn name(&self) -> &'static str {
+        "geomorph"
+    }
+
+    fn encode(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) -> DrawStats {
+        self.list.clear();
+        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
+            if s.in_transition() {
+                let fine = s.lod_from.min(s.lod_to);
+                let weight = if s.lod_to > s.lod_from {
+                    s.k
+                } else {
+                    1.0 - s.k
+                };
+                self.list.push(
+                    MORPHING,
+                    inst.model,
+                    fine,
+                    instance_raw(input, i, weight, 1.0, fine),
+                );
+            } else {
+                self.list.push(
+                    STEADY,
+                    inst.model,
+                    s.lod_from,
+                    instance_raw(input, i, 0.0, 1.0, s.lod_from),
+                );
+            }
+        }
+        self.list.build();
+        gpu.upload(&self.buffer, &self.list);
+        let mut pass = gpu.begin_clear_pass(encoder, target, "geomorph pass");
+        pass.set_vertex_buffer(2, self.targets.slice(..));
+        gpu.draw(
+            &mut pass,
+            &self.buffer,
+            0,
+            &self.list,
+            &[&gpu.opaque_pipeline, &self.morph],
+        )
+    }
+}

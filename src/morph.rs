@@ -1,0 +1,452 @@
+//! Geomorph correspondences (seed 003 sections 10-11): for every vertex of a finer LOD, the point of the next
+//! coarser LOD it moves to during a transition, with the normal it takes there.
+//!
+//! - `nearest` (the paper's): the nearest coarse vertex, with the normal difference in the distance:
+//!   `|p - q|^2 + (lambda |n_p - n_q|)^2`, lambda the coarse mesh's mean edge length, so a vertex is not pulled to
+//!   a close vertex on the far side of a thin part (an ear) when one a little farther faces the same way.
+//!   Found with a k-d tree over the coarse vertices (the position term alone bounds the search).
+//! - `surface`: the closest point on the coarse surface, the normal interpolated there (barycentric, normalised).
+//!   Found with a bounding-volume hierarchy over the coarse triangles.
+//!
+//! Each LOD pair is computed once per process and cached (keyed by both meshes' contents).
+
+use crate::mesh::Mesh;
+use glam::Vec3;
+use serde::Serialize;
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// `--correspondence`: how geomorph pairs fine vertices with the coarse LOD.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Correspondence {
+    /// Nearest coarse vertex, normals in the distance (seed 003 section 11).
+    Nearest,
+    /// Closest point on the coarse surface.
+    Surface,
+}
+
+/// Per fine vertex: where it goes on the coarse LOD, and the normal it has there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MorphTargets {
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Vec<[f32; 3]>,
+}
+
+type MorphCache = Mutex<HashMap<(u64, u64, Correspondence), Arc<MorphTargets>>>;
+
+/// The targets of `fine`'s vertices on `coarse`, from the process-wide cache or computed now.
+pub fn morph_targets(fine: &Mesh, coarse: &Mesh, how: Correspondence) -> Arc<MorphTargets> {
+    static CACHE: OnceLock<MorphCache> = OnceLock::new();
+    let key = (mesh_hash(fine), mesh_hash(coarse), how);
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(t) = cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+        return t;
+    }
+    let t = Arc::new(match how {
+        Correspondence::Nearest => nearest_vertex(fine, coarse),
+        Correspondence::Surface => closest_surface(fine, coarse),
+    });
+    if let Ok(mut c) = cache.lock() {
+        c.insert(key, t.clone());
+    }
+    t
+}
+
+fn mesh_hash(m: &Mesh) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    bytemuck::cast_slice::<_, u8>(&m.positions).hash(&mut h);
+    bytemuck::cast_slice::<_, u8>(&m.normals).hash(&mut h);
+    m.indices.hash(&mut h);
+    h.finish()
+}
+
+fn v(p: &[f32; 3]) -> Vec3 {
+    Vec3::from(*p)
+}
+
+/// Mean edge length of a mesh (the lambda of the nearest-vertex metric).
+pub fn mean_edge_length(m: &Mesh) -> f32 {
+    let mut sum = 0.0f64;
+    for t in m.indices.chunks_exact(3) {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            sum += v(&m.positions[a as usize]).distance(v(&m.positions[b as usize])) as f64;
+        }
+    }
+    (sum / m.indices.len().max(1) as f64) as f32
+}
+
+/// The paper's correspondence: nearest coarse vertex under `|p - q|^2 + (lambda |n_p - n_q|)^2`.
+pub fn nearest_vertex(fine: &Mesh, coarse: &Mesh) -> MorphTargets {
+    let lambda = mean_edge_length(coarse);
+    let pts: Vec<Vec3> = coarse.positions.iter().map(v).collect();
+    let nrm: Vec<Vec3> = coarse.normals.iter().map(v).collect();
+    let mut idx: Vec<u32> = (0..pts.len() as u32).collect();
+    kd_build(&pts, &mut idx, 0);
+    let mut positions = Vec::with_capacity(fine.positions.len());
+    let mut normals = Vec::with_capacity(fine.positions.len());
+    for (p, n) in fine.positions.iter().zip(&fine.normals) {
+        let (p, n) = (v(p), v(n));
+        let metric = |j: u32| {
+            let j = j as usize;
+            pts[j].distance_squared(p) + lambda * lambda * nrm[j].distance_squared(n)
+        };
+        let mut best = (f32::INFINITY, u32::MAX);
+        kd_search(&pts, &idx, 0, p, &metric, &mut best);
+        let j = best.1 as usize;
+        positions.push(coarse.positions[j]);
+        normals.push(coarse.normals[j]);
+    }
+    MorphTargets { positions, normals }
+}
+
+fn kd_build(pts: &[Vec3], idx: &mut [u32], depth: usize) {
+    if idx.len() <= 1 {
+        return;
+    }
+    let axis = depth % 3;
+    let mid = idx.len() / 2;
+    idx.select_nth_unstable_by(mid, |&a, &b| {
+        pts[a as usize][axis]
+            .total_cmp(&pts[b as usize][axis])
+            .then(a.cmp(&b))
+    });
+    let (left, right) = idx.split_at_mut(mid);
+    kd_build(pts, left, depth + 1);
+    kd_build(pts, &mut right[1..], depth + 1);
+}
+
+/// Best = smallest (metric, index). The metric is at least the squared position distance, which bounds the
+/// far side of each split.
+fn kd_search(
+    pts: &[Vec3],
+    idx: &[u32],
+    depth: usize,
+    q: Vec3,
+    metric: &impl Fn(u32) -> f32,
+    best: &mut (f32, u32),
+) {
+    if idx.is_empty() {
+        return;
+    }
+    let mid = idx.len() / 2;
+    let j = idx[mid];
+    let m = metric(j);
+    if m < best.0 || (m == best.0 && j < best.1) {
+        *best = (m, j);
+    }
+    let axis = depth % 3;
+    let diff = q[axis] - pts[j as usize][axis];
+    let (near, far) = if diff < 0.0 {
+        (&idx[..mid], &idx[mid + 1..])
+    } else {
+        (&idx[mid + 1..], &idx[..mid])
+    };
+    kd_search(pts, near, depth + 1, q, metric, best);
+    if diff * diff <= best.0 {
+        kd_search(pts, far, depth + 1, q, metric, best);
+    }
+}
+
+/// Closest point on the coarse surface, normal interpolated there.
+pub fn closest_surface(fine: &Mesh, coarse: &Mesh) -> MorphTargets {
+    let bvh = Bvh::new(coarse);
+    let mut positions = Vec::with_capacity(fine.positions.len());
+    let mut normals = Vec::with_capacity(fine.positions.len());
+    for p in &fine.positions {
+        let (tri, point, bary) = bvh.closest(coarse, v(p));
+        let t = &coarse.indices[tri * 3..tri * 3 + 3];
+        let n = v(&coarse.normals[t[0] as usize]) * bary[0]
+            + v(&coarse.normals[t[1] as usize]) * bary[1]
+            + v(&coarse.normals[t[2] as usize]) * bary[2];
+        let face = (v(&coarse.positions[t[1] as usize]) - v(&coarse.positions[t[0] as usize]))
+            .cross(v(&coarse.positions[t[2] as usize]) - v(&coarse.positions[t[0] as usize]));
+        let n = n
+            .try_normalize()
+            .or(face.try_normalize())
+            .unwrap_or(Vec3::Y);
+        positions.push(point.to_array());
+        normals.push(n.to_array());
+    }
+    MorphTargets { positions, normals }
+}
+
+struct BvhNode {
+    lo: Vec3,
+    hi: Vec3,
+    /// Leaf: triangles `start..start + count` of `order`; inner: children at `start` and `start + 1`.
+    start: u32,
+    count: u32,
+}
+
+struct Bvh {
+    nodes: Vec<BvhNode>,
+    order: Vec<u32>,
+}
+
+const LEAF: usize = 4;
+
+impl Bvh {
+    fn new(m: &Mesh) -> Bvh {
+        let tris = m.triangle_count();
+        let corners = |t: u32| {
+            let t = t as usize * 3;
+            [0, 1, 2].map(|k| v(&m.positions[m.indices[t + k] as usize]))
+        };
+        let centroid: Vec<Vec3> = (0..tris as u32)
+            .map(|t| corners(t).iter().copied().sum::<Vec3>() / 3.0)
+            .collect();
+        let mut bvh = Bvh {
+            nodes: Vec::with_capacity(2 * tris / LEAF + 1),
+            order: (0..tris as u32).collect(),
+        };
+        bvh.nodes.push(BvhNode {
+            lo: Vec3::ZERO,
+            hi: Vec3::ZERO,
+            start: 0,
+            count: 0,
+        });
+        let mut stack = vec![(0usize, 0usize, tris)];
+        while let Some((node, begin, end)) = stack.pop() {
+            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            for &t in &bvh.order[begin..end] {
+                for c in corners(t) {
+                    lo = lo.min(c);
+                    hi = hi.max(c);
+                }
+            }
+            bvh.nodes[node].lo = lo;
+            bvh.nodes[node].hi = hi;
+            if end - begin <= LEAF {
+                bvh.nodes[node].start = begin as u32;
+                bvh.nodes[node].count = (end - begin) as u32;
+                continue;
+            }
+            let ext = hi - lo;
+            let axis = if ext.x >= ext.y && ext.x >= ext.z {
+                0
+            } else if ext.y >= ext.z {
+                1
+            } else {
+                2
+            };
+            let mid = (begin + end) / 2;
+            bvh.order[begin..end].select_nth_unstable_by(mid - begin, |&a, &b| {
+                centroid[a as usize][axis]
+                    .total_cmp(&centroid[b as usize][axis])
+                    .then(a.cmp(&b))
+            });
+            let left = bvh.nodes.len();
+            for _ in 0..2 {
+                bvh.nodes.push(BvhNode {
+                    lo: Vec3::ZERO,
+                    hi: Vec3::ZERO,
+                    start: 0,
+                    count: 0,
+                });
+            }
+            bvh.nodes[node].start = left as u32;
+            stack.push((left, begin, mid));
+            stack.push((left + 1, mid, end));
+        }
+        bvh
+    }
+
+    fn box_distance_squared(n: &BvhNode, q: Vec3) -> f32 {
+        let d = (n.lo - q).max(q - n.hi).max(Vec3::ZERO);
+        d.length_squared()
+    }
+
+    /// (triangle, closest point, barycentric weights); ties go to the lowest triangle index.
+    fn closest(&self, m: &Mesh, q: Vec3) -> (usize, Vec3, [f32; 3]) {
+        let mut best = (f32::INFINITY, usize::MAX, Vec3::ZERO, [1.0, 0.0, 0.0]);
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let n = &self.nodes[i];
+            if Self::box_distance_squared(n, q) > best.0 {
+                continue;
+            }
+            if n.count > 0 {
+                for &t in &self.order[n.start as usize..(n.start + n.count) as usize] {
+                    let t = t as usize;
+                    let c = [0, 1, 2].map(|k| v(&m.positions[m.indices[t * 3 + k] as usize]));
+                    let (p, bary) = closest_point_on_triangle(q, c[0], c[1], c[2]);
+                    let d = p.distance_squared(q);
+                    if d < best.0 || (d == best.0 && t < best.1) {
+                        best = (d, t, p, bary);
+                    }
+                }
+            } else {
+                let (a, b) = (n.start as usize, n.start as usize + 1);
+                let (da, db) = (
+                    Self::box_distance_squared(&self.nodes[a], q),
+                    Self::box_distance_squared(&self.nodes[b], q),
+                );
+                // Visit the nearer child first (pushed last).
+                if da <= db {
+                    stack.push(b);
+                    stack.push(a);
+                } else {
+                    stack.push(a);
+                    stack.push(b);
+                }
+            }
+        }
+        (best.1, best.2, best.3)
+    }
+}
+
+/// Closest point to `p` on triangle abc and its barycentric weights (Ericson, Real-Time Collision Detection,
+/// 5.1.5).
+pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, [f32; 3]) {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = ab.dot(ap);
+    let d2 = ac.dot(ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, [1.0, 0.0, 0.0]);
+    }
+    let bp = p - b;
+    let d3 = ab.dot(bp);
+    let d4 = ac.dot(bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, [0.0, 1.0, 0.0]);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let w = d1 / (d1 - d3);
+        return (a + ab * w, [1.0 - w, w, 0.0]);
+    }
+    let cp = p - c;
+    let d5 = ab.dot(cp);
+    let d6 = ac.dot(cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, [0.0, 0.0, 1.0]);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (a + ac * w, [1.0 - w, 0.0, w]);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + (c - b) * w, [0.0, 1.0 - w, w]);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let vv = vb * denom;
+    let ww = vc * denom;
+    (a + ab * vv + ac * ww, [1.0 - vv - ww, vv, ww])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lod::{LodChain, DEFAULT_TARGETS};
+    use crate::scene::BUNNY_OBJ;
+
+    fn chain() -> LodChain {
+        let m = Mesh::parse_obj("bunny", BUNNY_OBJ).unwrap();
+        LodChain::build("bunny", &m, &DEFAULT_TARGETS).unwrap()
+    }
+
+    #[test]
+    fn vertices_on_the_coarse_mesh_map_to_themselves() {
+        let c = chain();
+        for pair in c.lods.windows(2) {
+            let (fine, coarse) = (&pair[0].mesh, &pair[1].mesh);
+            let shared: Vec<usize> = (0..fine.positions.len())
+                .filter(|&i| {
+                    coarse
+                        .positions
+                        .iter()
+                        .zip(&coarse.normals)
+                        .any(|(p, n)| *p == fine.positions[i] && *n == fine.normals[i])
+                })
+                .collect();
+            assert!(
+                shared.len() >= coarse.positions.len() / 2,
+                "meshopt keeps original vertices"
+            );
+            for how in [Correspondence::Nearest, Correspondence::Surface] {
+                let t = morph_targets(fine, coarse, how);
+                for &i in &shared {
+                    assert_eq!(t.positions[i], fine.positions[i], "{how:?} vertex {i}");
+                }
+            }
+        }
+    }
+
+    fn brute_nearest(fine: &Mesh, coarse: &Mesh, i: usize) -> [f32; 3] {
+        let lambda = mean_edge_length(coarse);
+        let (p, n) = (v(&fine.positions[i]), v(&fine.normals[i]));
+        let j = (0..coarse.positions.len())
+            .min_by(|&a, &b| {
+                let m = |j: usize| {
+                    v(&coarse.positions[j]).distance_squared(p)
+                        + lambda * lambda * v(&coarse.normals[j]).distance_squared(n)
+                };
+                m(a).total_cmp(&m(b)).then(a.cmp(&b))
+            })
+            .unwrap();
+        coarse.positions[j]
+    }
+
+    #[test]
+    fn kd_tree_finds_the_brute_force_nearest() {
+        let c = chain();
+        let (fine, coarse) = (&c.lods[0].mesh, &c.lods[3].mesh);
+        let t = nearest_vertex(fine, coarse);
+        for i in (0..fine.positions.len()).step_by(7) {
+            assert_eq!(t.positions[i], brute_nearest(fine, coarse, i), "vertex {i}");
+        }
+    }
+
+    #[test]
+    fn surface_targets_lie_on_the_coarse_surface_and_are_closest() {
+        let c = chain();
+        let (fine, coarse) = (&c.lods[1].mesh, &c.lods[2].mesh);
+        let t = closest_surface(fine, coarse);
+        for i in (0..fine.positions.len()).step_by(5) {
+            let p = v(&fine.positions[i]);
+            let target = v(&t.positions[i]);
+            let mut best = f32::INFINITY;
+            let mut on_surface = f32::INFINITY;
+            for tri in coarse.indices.chunks_exact(3) {
+                let [a, b, cc] = [0, 1, 2].map(|k| v(&coarse.positions[tri[k] as usize]));
+                best = best.min(closest_point_on_triangle(p, a, b, cc).0.distance(p));
+                on_surface = on_surface.min(
+                    closest_point_on_triangle(target, a, b, cc)
+                        .0
+                        .distance(target),
+                );
+            }
+            assert!(
+                on_surface < 1e-4,
+                "vertex {i}: target {on_surface} off the surface"
+            );
+            assert!(
+                (target.distance(p) - best).abs() < 1e-4,
+                "vertex {i}: not the closest point"
+            );
+            let n = v(&t.normals[i]);
+            assert!((n.length() - 1.0).abs() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn closest_point_regions() {
+        let (a, b, c) = (Vec3::ZERO, Vec3::X, Vec3::Y);
+        assert_eq!(
+            closest_point_on_triangle(Vec3::new(-1.0, -1.0, 0.0), a, b, c).0,
+            a
+        );
+        let (p, w) = closest_point_on_triangle(Vec3::new(0.25, 0.25, 3.0), a, b, c);
+        assert!((p - Vec3::new(0.25, 0.25, 0.0)).length() < 1e-6);
+        assert!((w[0] - 0.5).abs() < 1e-6 && (w[1] - 0.25).abs() < 1e-6);
+        let (p, _) = closest_point_on_triangle(Vec3::new(1.0, 1.0, 0.0), a, b, c);
+        assert!((p - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6);
+    }
+}
