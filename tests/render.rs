@@ -20,6 +20,18 @@ fn run_config(args: &[&str]) -> RunConfig {
     }
 }
 
+/// A scene built from `describe`-style flags (the scene flags `run` shares).
+fn scene_from(args: &[&str]) -> lodbench::scene::Scene {
+    let mut argv = vec!["lodbench", "describe", "--scene", "bunny-sweep"];
+    argv.extend_from_slice(args);
+    let d = match Cli::try_parse_from(argv).expect("flags parse").command {
+        Command::Describe(d) => d,
+        _ => unreachable!(),
+    };
+    let cfg = SceneConfig::from_args(&d.scene_args).unwrap();
+    SceneDef::new("bunny-sweep", &cfg).unwrap().instantiate(1)
+}
+
 type Rows = Vec<HashMap<String, String>>;
 
 fn read_csv(path: &Path) -> Rows {
@@ -180,11 +192,7 @@ fn same_flags_same_metrics() {
 /// The GPU metric kernel agrees with the CPU oracle on read-back frames to 1e-5.
 #[test]
 fn gpu_metrics_match_cpu_oracle() {
-    let args = match Cli::try_parse_from([
-        "lodbench",
-        "describe",
-        "--scene",
-        "bunny-sweep",
+    let scene = scene_from(&[
         "--width",
         "160",
         "--height",
@@ -193,15 +201,7 @@ fn gpu_metrics_match_cpu_oracle() {
         "90",
         "--switch-distances",
         "12,16,20",
-    ])
-    .unwrap()
-    .command
-    {
-        Command::Describe(d) => d,
-        _ => unreachable!(),
-    };
-    let cfg = SceneConfig::from_args(&args.scene_args).unwrap();
-    let scene = SceneDef::new("bunny-sweep", &cfg).unwrap().instantiate(1);
+    ]);
     let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
     let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true).unwrap();
     let mut oracle = SequenceMetrics::new();
@@ -240,11 +240,7 @@ fn gpu_metrics_match_cpu_oracle() {
 /// Re-bless with `LODBENCH_BLESS=1 cargo test --test render snapshot`.
 #[test]
 fn snapshot_reference_frame() {
-    let args = match Cli::try_parse_from([
-        "lodbench",
-        "describe",
-        "--scene",
-        "bunny-sweep",
+    let scene = scene_from(&[
         "--width",
         "160",
         "--height",
@@ -253,15 +249,7 @@ fn snapshot_reference_frame() {
         "2",
         "--switch-distances",
         "20,30,40",
-    ])
-    .unwrap()
-    .command
-    {
-        Command::Describe(d) => d,
-        _ => unreachable!(),
-    };
-    let cfg = SceneConfig::from_args(&args.scene_args).unwrap();
-    let scene = SceneDef::new("bunny-sweep", &cfg).unwrap().instantiate(1);
+    ]);
     let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
     let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true).unwrap();
     let mut frame0 = None;

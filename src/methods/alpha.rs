@@ -4,19 +4,15 @@
 //! by instance distance, depth test on (less-equal, so a translucent surface coinciding with the opaque one
 //! still blends), depth writes off.
 
-use super::{back_to_front, instance_raw, unpop, FrameInput, Method};
-use crate::gpu::renderer::{
-    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu,
-};
+use super::{FrameInput, Method, UnpopLists};
+use crate::gpu::renderer::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
 /// Standard "over" blending of a translucent surface.
 pub const OVER: wgpu::BlendState = wgpu::BlendState::ALPHA_BLENDING;
 
 pub struct Alpha {
-    opaque: DrawList,
-    translucent: DrawList,
-    order: Vec<usize>,
+    lists: UnpopLists,
     buffer: InstanceBuffer,
     translucent_pipeline: wgpu::RenderPipeline,
 }
@@ -24,9 +20,7 @@ pub struct Alpha {
 impl Alpha {
     pub fn new(gpu: &SceneGpu, scene: &Scene) -> Self {
         Alpha {
-            opaque: DrawList::default(),
-            translucent: DrawList::default(),
-            order: Vec::new(),
+            lists: UnpopLists::default(),
             buffer: gpu.create_instance_buffer("alpha instances", 2 * scene.instances.len() as u32),
             translucent_pipeline: gpu.mesh_pipeline(&MeshPipeline {
                 label: "alpha translucent",
@@ -53,46 +47,20 @@ impl Method for Alpha {
         encoder: &mut wgpu::CommandEncoder,
         target: &RenderTarget,
     ) -> DrawStats {
-        self.opaque.clear();
-        self.translucent.clear();
-        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            let u = unpop(s);
-            self.opaque.push(
-                0,
-                inst.model,
-                u.opaque,
-                instance_raw(input, i, s.k, 1.0, u.opaque),
-            );
-        }
-        back_to_front(input.distances, &mut self.order, |i| {
-            input.states[i].in_transition()
-        });
-        for &i in &self.order {
-            let s = &input.states[i];
-            if let Some((lod, alpha)) = unpop(s).translucent {
-                let model = input.scene.instances[i].model;
-                self.translucent
-                    .push(0, model, lod, instance_raw(input, i, s.k, alpha, lod));
-            }
-        }
-        self.opaque.build();
-        self.translucent.build_in_order();
-        let n_opaque = self.opaque.instances.len() as u32;
-        gpu.upload_at(&self.buffer, 0, &self.opaque);
-        gpu.upload_at(&self.buffer, n_opaque, &self.translucent);
+        let n_opaque = self.lists.prepare(gpu, input, &self.buffer, |_| 0);
         let mut pass = gpu.begin_clear_pass(encoder, target, "alpha pass");
         let a = gpu.draw(
             &mut pass,
             &self.buffer,
             0,
-            &self.opaque,
+            &self.lists.opaque,
             &[&gpu.opaque_pipeline],
         );
         let b = gpu.draw(
             &mut pass,
             &self.buffer,
             n_opaque,
-            &self.translucent,
+            &self.lists.translucent,
             &[&self.translucent_pipeline],
         );
         a + b

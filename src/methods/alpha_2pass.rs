@@ -10,17 +10,13 @@
 //! render passes per t-instance.
 
 use super::alpha::OVER;
-use super::{back_to_front, instance_raw, unpop, FrameInput, Method};
+use super::{FrameInput, Method, UnpopLists};
 use crate::config::DEPTH_FORMAT;
-use crate::gpu::renderer::{
-    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu,
-};
+use crate::gpu::renderer::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
 pub struct AlphaTwoPass {
-    opaque: DrawList,
-    translucent: DrawList,
-    order: Vec<usize>,
+    lists: UnpopLists,
     buffer: InstanceBuffer,
     depth_only: wgpu::RenderPipeline,
     colour: wgpu::RenderPipeline,
@@ -63,9 +59,7 @@ impl AlphaTwoPass {
             view_formats: &[],
         });
         AlphaTwoPass {
-            opaque: DrawList::default(),
-            translucent: DrawList::default(),
-            order: Vec::new(),
+            lists: UnpopLists::default(),
             buffer: gpu
                 .create_instance_buffer("alpha-2pass instances", 2 * scene.instances.len() as u32),
             depth_only: gpu.mesh_pipeline(&MeshPipeline {
@@ -132,45 +126,19 @@ impl Method for AlphaTwoPass {
         target: &RenderTarget,
     ) -> DrawStats {
         let group = self.scene_depth_group(gpu, target);
-        self.opaque.clear();
-        self.translucent.clear();
-        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            let u = unpop(s);
-            self.opaque.push(
-                0,
-                inst.model,
-                u.opaque,
-                instance_raw(input, i, s.k, 1.0, u.opaque),
-            );
-        }
-        back_to_front(input.distances, &mut self.order, |i| {
-            input.states[i].in_transition()
-        });
-        for &i in &self.order {
-            let s = &input.states[i];
-            if let Some((lod, alpha)) = unpop(s).translucent {
-                let model = input.scene.instances[i].model;
-                self.translucent
-                    .push(0, model, lod, instance_raw(input, i, s.k, alpha, lod));
-            }
-        }
-        self.opaque.build();
-        // No merging: every t-instance gets its own pair of passes.
-        self.translucent.build_in_order();
-        let n_opaque = self.opaque.instances.len() as u32;
-        gpu.upload_at(&self.buffer, 0, &self.opaque);
-        gpu.upload_at(&self.buffer, n_opaque, &self.translucent);
+        // Translucent neighbours of one bucket share a draw; each of its instances gets its own pair of passes.
+        let n_opaque = self.lists.prepare(gpu, input, &self.buffer, |_| 0);
         let mut stats = {
             let mut pass = gpu.begin_clear_pass(encoder, target, "alpha-2pass opaque");
             gpu.draw(
                 &mut pass,
                 &self.buffer,
                 0,
-                &self.opaque,
+                &self.lists.opaque,
                 &[&gpu.opaque_pipeline],
             )
         };
-        for d in &self.translucent.draws {
+        for d in &self.lists.translucent.draws {
             for j in 0..d.instance_count {
                 let at = n_opaque + d.first_instance + j;
                 {

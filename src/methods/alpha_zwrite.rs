@@ -6,10 +6,8 @@
 //! draws first, translucent ones back to front.
 
 use super::alpha::OVER;
-use super::{back_to_front, instance_raw, unpop, FrameInput, Method};
-use crate::gpu::renderer::{
-    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu,
-};
+use super::{FrameInput, Method, UnpopLists};
+use crate::gpu::renderer::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
 /// Pipeline indices of the translucent draws.
@@ -17,9 +15,7 @@ const BEFORE_SWAP: u8 = 0;
 const AFTER_SWAP: u8 = 1;
 
 pub struct AlphaZWrite {
-    opaque: DrawList,
-    translucent: DrawList,
-    order: Vec<usize>,
+    lists: UnpopLists,
     buffer: InstanceBuffer,
     less_equal: wgpu::RenderPipeline,
     less: wgpu::RenderPipeline,
@@ -39,9 +35,7 @@ impl AlphaZWrite {
             })
         };
         AlphaZWrite {
-            opaque: DrawList::default(),
-            translucent: DrawList::default(),
-            order: Vec::new(),
+            lists: UnpopLists::default(),
             buffer: gpu
                 .create_instance_buffer("alpha-zwrite instances", 2 * scene.instances.len() as u32),
             less_equal: translucent(
@@ -65,52 +59,26 @@ impl Method for AlphaZWrite {
         encoder: &mut wgpu::CommandEncoder,
         target: &RenderTarget,
     ) -> DrawStats {
-        self.opaque.clear();
-        self.translucent.clear();
-        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            let u = unpop(s);
-            self.opaque.push(
-                0,
-                inst.model,
-                u.opaque,
-                instance_raw(input, i, s.k, 1.0, u.opaque),
-            );
-        }
-        back_to_front(input.distances, &mut self.order, |i| {
-            input.states[i].in_transition()
-        });
-        for &i in &self.order {
-            let s = &input.states[i];
-            let u = unpop(s);
-            if let Some((lod, alpha)) = u.translucent {
-                let pipeline = if u.swapped { AFTER_SWAP } else { BEFORE_SWAP };
-                let model = input.scene.instances[i].model;
-                self.translucent.push(
-                    pipeline,
-                    model,
-                    lod,
-                    instance_raw(input, i, s.k, alpha, lod),
-                );
+        let n_opaque = self.lists.prepare(gpu, input, &self.buffer, |u| {
+            if u.swapped {
+                AFTER_SWAP
+            } else {
+                BEFORE_SWAP
             }
-        }
-        self.opaque.build();
-        self.translucent.build_in_order();
-        let n_opaque = self.opaque.instances.len() as u32;
-        gpu.upload_at(&self.buffer, 0, &self.opaque);
-        gpu.upload_at(&self.buffer, n_opaque, &self.translucent);
+        });
         let mut pass = gpu.begin_clear_pass(encoder, target, "alpha-zwrite pass");
         let a = gpu.draw(
             &mut pass,
             &self.buffer,
             0,
-            &self.opaque,
+            &self.lists.opaque,
             &[&gpu.opaque_pipeline],
         );
         let b = gpu.draw(
             &mut pass,
             &self.buffer,
             n_opaque,
-            &self.translucent,
+            &self.lists.translucent,
             &[&self.less_equal, &self.less],
         );
         a + b

@@ -144,6 +144,61 @@ pub(crate) fn back_to_front(
     out.sort_by(|&a, &b| distances[b].total_cmp(&distances[a]).then(a.cmp(&b)));
 }
 
+/// The draw lists of the unpopping methods: every instance's opaque LOD, then the translucent LODs of the
+/// t-instances back to front. Kept between frames.
+#[derive(Default)]
+pub(crate) struct UnpopLists {
+    pub opaque: DrawList,
+    pub translucent: DrawList,
+    order: Vec<usize>,
+}
+
+impl UnpopLists {
+    /// Fills and builds both lists and uploads them to `buffer`, opaque first; `pipeline_of` picks the
+    /// translucent draw's pipeline index. Returns the first instance of the translucent list in `buffer`.
+    pub fn prepare(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        buffer: &InstanceBuffer,
+        pipeline_of: impl Fn(&Unpop) -> u8,
+    ) -> u32 {
+        self.opaque.clear();
+        self.translucent.clear();
+        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
+            let u = unpop(s);
+            self.opaque.push(
+                0,
+                inst.model,
+                u.opaque,
+                instance_raw(input, i, s.k, 1.0, u.opaque),
+            );
+        }
+        back_to_front(input.distances, &mut self.order, |i| {
+            input.states[i].in_transition()
+        });
+        for &i in &self.order {
+            let s = &input.states[i];
+            let u = unpop(s);
+            if let Some((lod, alpha)) = u.translucent {
+                let model = input.scene.instances[i].model;
+                self.translucent.push(
+                    pipeline_of(&u),
+                    model,
+                    lod,
+                    instance_raw(input, i, s.k, alpha, lod),
+                );
+            }
+        }
+        self.opaque.build();
+        self.translucent.build_in_order();
+        let n_opaque = self.opaque.instances.len() as u32;
+        gpu.upload_at(buffer, 0, &self.opaque);
+        gpu.upload_at(buffer, n_opaque, &self.translucent);
+        n_opaque
+    }
+}
+
 pub(crate) fn instance_raw(
     input: &FrameInput<'_>,
     i: usize,
