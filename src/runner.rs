@@ -485,8 +485,10 @@ fn run_blocks(
                         }
                     })?;
                 frames_csv.write_block(&out.rows)?;
-                if let Some(s) = SummaryRecord::from_frames(&out.rows, out.info.extra_target_bytes)
-                {
+                // Each block's bootstrap has its own seed, derived from --seed and the block's position.
+                let block_seed = cfg.seed.wrapping_add(summaries.len() as u64 + 1);
+                let extra = out.info.extra_target_bytes;
+                if let Some(s) = SummaryRecord::from_frames(&out.rows, extra, block_seed) {
                     summaries.push(s);
                 }
                 manifest.blocks.push(out.info);

@@ -37,6 +37,9 @@ pub struct SummaryRecord {
     pub count: u32,
     pub frames: u32,
     pub gpu_ms_median: Option<f64>,
+    /// Seeded bootstrap 95 % interval of the median (see [`bootstrap_ci`]).
+    pub gpu_ms_median_ci95_lo: Option<f64>,
+    pub gpu_ms_median_ci95_hi: Option<f64>,
     pub gpu_ms_p5: Option<f64>,
     pub gpu_ms_p95: Option<f64>,
     pub cpu_ms_median: f64,
@@ -44,6 +47,8 @@ pub struct SummaryRecord {
     pub draw_calls_mean: f64,
     pub t_instances_mean: f64,
     pub rmse_mean: f64,
+    pub rmse_mean_ci95_lo: f64,
+    pub rmse_mean_ci95_hi: f64,
     pub rmse_max: f64,
     pub pop_max: f64,
     pub pop_p95: f64,
@@ -63,6 +68,31 @@ pub fn percentile(values: &[f64], p: f64) -> Option<f64> {
     Some(v[lo] + (v[hi] - v[lo]) * (pos - lo as f64))
 }
 
+/// Resamples drawn by [`bootstrap_ci`].
+pub const BOOTSTRAP_RESAMPLES: usize = 1000;
+
+/// Percentile bootstrap 95 % interval of `stat` over `values` (frames resampled with replacement,
+/// [`BOOTSTRAP_RESAMPLES`] times, from `seed`); None for no values.
+pub fn bootstrap_ci(
+    values: &[f64],
+    seed: u64,
+    stat: impl Fn(&[f64]) -> Option<f64>,
+) -> Option<(f64, f64)> {
+    if values.is_empty() {
+        return None;
+    }
+    let mut rng = crate::rng::SplitMix64::new(seed);
+    let mut sample = vec![0.0; values.len()];
+    let mut stats = Vec::with_capacity(BOOTSTRAP_RESAMPLES);
+    for _ in 0..BOOTSTRAP_RESAMPLES {
+        for x in sample.iter_mut() {
+            *x = values[(rng.next_u64() % values.len() as u64) as usize];
+        }
+        stats.extend(stat(&sample));
+    }
+    Some((percentile(&stats, 2.5)?, percentile(&stats, 97.5)?))
+}
+
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
     let (s, n) = values.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
     if n == 0 {
@@ -73,18 +103,28 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
 }
 
 impl SummaryRecord {
-    /// Summarises one block's rows (all of the same scene, method and count).
-    pub fn from_frames(rows: &[FrameRecord], extra_target_bytes: u64) -> Option<SummaryRecord> {
+    /// Summarises one block's rows (all of the same scene, method and count); `seed` drives the bootstrap.
+    pub fn from_frames(
+        rows: &[FrameRecord],
+        extra_target_bytes: u64,
+        seed: u64,
+    ) -> Option<SummaryRecord> {
         let first = rows.first()?;
         let gpu: Vec<f64> = rows.iter().filter_map(|r| r.gpu_ms).collect();
         let cpu: Vec<f64> = rows.iter().map(|r| r.cpu_ms).collect();
         let pop: Vec<f64> = rows.iter().map(|r| r.pop).collect();
+        let rmse: Vec<f64> = rows.iter().map(|r| r.rmse).collect();
+        let gpu_ci = bootstrap_ci(&gpu, seed, |v| percentile(v, 50.0));
+        let rmse_ci = bootstrap_ci(&rmse, seed ^ 0x524D_5345, |v| Some(mean(v.iter().copied())))
+            .unwrap_or((0.0, 0.0));
         Some(SummaryRecord {
             scene: first.scene.clone(),
             method: first.method.clone(),
             count: first.count,
             frames: rows.len() as u32,
             gpu_ms_median: percentile(&gpu, 50.0),
+            gpu_ms_median_ci95_lo: gpu_ci.map(|c| c.0),
+            gpu_ms_median_ci95_hi: gpu_ci.map(|c| c.1),
             gpu_ms_p5: percentile(&gpu, 5.0),
             gpu_ms_p95: percentile(&gpu, 95.0),
             cpu_ms_median: percentile(&cpu, 50.0).unwrap_or(f64::NAN),
@@ -92,6 +132,8 @@ impl SummaryRecord {
             draw_calls_mean: mean(rows.iter().map(|r| r.draw_calls as f64)),
             t_instances_mean: mean(rows.iter().map(|r| r.t_instances as f64)),
             rmse_mean: mean(rows.iter().map(|r| r.rmse)),
+            rmse_mean_ci95_lo: rmse_ci.0,
+            rmse_mean_ci95_hi: rmse_ci.1,
             rmse_max: rows.iter().map(|r| r.rmse).fold(0.0, f64::max),
             pop_max: pop.iter().copied().fold(0.0, f64::max),
             pop_p95: percentile(&pop, 95.0).unwrap_or(0.0),
@@ -194,7 +236,7 @@ mod tests {
             row(1, Some(3.0), 0.2, 0.5),
             row(2, Some(2.0), 0.1, 0.1),
         ];
-        let s = SummaryRecord::from_frames(&rows, 0).unwrap();
+        let s = SummaryRecord::from_frames(&rows, 0, 7).unwrap();
         assert_eq!(s.frames, 3);
         assert_eq!(s.gpu_ms_median, Some(2.0));
         assert!((s.rmse_mean - 0.1).abs() < 1e-12);
@@ -208,12 +250,30 @@ mod tests {
                 ..r.clone()
             })
             .collect();
-        assert_eq!(
-            SummaryRecord::from_frames(&no_gpu, 0)
-                .unwrap()
-                .gpu_ms_median,
-            None
-        );
+        let s_no_gpu = SummaryRecord::from_frames(&no_gpu, 0, 7).unwrap();
+        assert_eq!(s_no_gpu.gpu_ms_median, None);
+        assert_eq!(s_no_gpu.gpu_ms_median_ci95_lo, None);
+        // The intervals hold the statistic, and are the same for the same seed.
+        assert!(s.rmse_mean_ci95_lo <= s.rmse_mean && s.rmse_mean <= s.rmse_mean_ci95_hi);
+        assert_eq!(s, SummaryRecord::from_frames(&rows, 0, 7).unwrap());
+    }
+
+    #[test]
+    fn bootstrap_interval_narrows_with_more_frames_and_covers_the_mean() {
+        let mut rng = crate::rng::SplitMix64::new(11);
+        let draw = |n: usize, rng: &mut crate::rng::SplitMix64| -> Vec<f64> {
+            (0..n).map(|_| 1.0 + rng.next_f32() as f64).collect()
+        };
+        let few = draw(40, &mut rng);
+        let many = draw(4000, &mut rng);
+        let m = |v: &[f64]| Some(v.iter().sum::<f64>() / v.len() as f64);
+        let (a, b) = bootstrap_ci(&few, 3, m).unwrap();
+        let (c, d) = bootstrap_ci(&many, 3, m).unwrap();
+        assert!(d - c < (b - a) / 4.0, "[{a}, {b}] vs [{c}, {d}]");
+        // Uniform on [1, 2): true mean 1.5, inside the large sample's interval.
+        assert!(c < 1.5 && 1.5 < d, "[{c}, {d}]");
+        assert_eq!(bootstrap_ci(&few, 3, m), bootstrap_ci(&few, 3, m));
+        assert_eq!(bootstrap_ci(&[], 3, m), None);
     }
 
     #[test]
