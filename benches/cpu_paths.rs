@@ -87,6 +87,7 @@ fn csv_export(c: &mut Criterion) {
             lod_mean: f as f64 / 1200.0,
             rmse: 0.01,
             pop: 0.001,
+            de2000_mean: 0.1,
         })
         .collect();
     let dir = tempfile::tempdir().unwrap();

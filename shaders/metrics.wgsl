@@ -5,12 +5,15 @@
 // Per pixel, with a and b the method and reference bytes and e = a - b per channel:
 //   rmse term  (|e.r| + |e.g| + |e.b|)^2                 -> rmse = sqrt(sum / (9 * 255^2 * pixels))
 //   pop term   |e_t - e_{t-1}|^2 summed over R, G, B      -> pop  = sqrt(sum / (3 * 255^2 * pixels))
-// e_t is kept per pixel in `prev_error` for the next frame.
+//   de2000     CIEDE2000 (sRGB D65 -> XYZ -> CIELAB, as colour-science), only for pixels that differ, in f32,
+//              rounded to 1/65536                         -> de2000_mean = sum / (65536 * pixels)
+// e_t is kept per pixel in `prev_error` for the next frame. Each frame slot holds three 64-bit sums (6 words).
 //
 // One workgroup per row, 64 invocations; invocation i sums the pixels i, i + 64, i + 128, ... of its row
 // (neighbouring invocations read neighbouring pixels), then adds its two sums to a 64-bit total made of two u32
 // atomics per frame slot. No workgroup barriers: they are cheap on GPUs but very slow on software adapters,
-// where CI runs. A run of at most 8192 / 64 = 128 pixels keeps each partial sum below 128 * 780300 < 2^32.
+// where CI runs. A run of at most 8192 / 64 = 128 pixels keeps each partial sum below 2^32 (128 * 780300 for
+// pop; 128 * 65536 * 120 for de2000, CIEDE2000 staying below 120 between sRGB colours).
 
 struct Params {
     width: u32,
@@ -38,6 +41,82 @@ fn add_u64(lo: u32, value: u32) {
 }
 
 const LANES: u32 = 64u;
+const DE_SCALE: f32 = 65536.0;
+
+fn srgb_to_lab(c: vec3<i32>) -> vec3<f32> {
+    let v = vec3<f32>(c) / 255.0;
+    let lin = select(pow((v + 0.055) / 1.055, vec3<f32>(2.4)), v / 12.92, v <= vec3<f32>(0.04045));
+    // IEC 61966-2-1 sRGB to XYZ (columns), then divided by the D65 white (xy 0.3127, 0.3290).
+    let m = mat3x3<f32>(
+        vec3<f32>(0.4124, 0.2126, 0.0193),
+        vec3<f32>(0.3576, 0.7152, 0.1192),
+        vec3<f32>(0.1805, 0.0722, 0.9505),
+    );
+    let xyz = (m * lin) / vec3<f32>(0.950455927, 1.0, 1.089057751);
+    let f = select((24389.0 / 27.0 * xyz + 16.0) / 116.0, pow(xyz, vec3<f32>(1.0 / 3.0)), xyz > vec3<f32>(216.0 / 24389.0));
+    return vec3<f32>(116.0 * f.y - 16.0, 500.0 * (f.x - f.y), 200.0 * (f.y - f.z));
+}
+
+fn hue_deg(b: f32, ap: f32) -> f32 {
+    if (b == 0.0 && ap == 0.0) {
+        return 0.0;
+    }
+    let h = degrees(atan2(b, ap));
+    return select(h, h + 360.0, h < 0.0);
+}
+
+// CIEDE2000 (Sharma, Wu, Dalal 2005), kL = kC = kH = 1; the CPU twin is metrics::ciede2000.
+fn ciede2000(lab1: vec3<f32>, lab2: vec3<f32>) -> f32 {
+    let p25 = 6103515625.0; // 25^7
+    let c_bar = (length(lab1.yz) + length(lab2.yz)) * 0.5;
+    let c7 = pow(c_bar, 7.0);
+    let g = 0.5 * (1.0 - sqrt(c7 / (c7 + p25)));
+    let a1p = (1.0 + g) * lab1.y;
+    let a2p = (1.0 + g) * lab2.y;
+    let c1p = length(vec2<f32>(a1p, lab1.z));
+    let c2p = length(vec2<f32>(a2p, lab2.z));
+    let h1p = hue_deg(lab1.z, a1p);
+    let h2p = hue_deg(lab2.z, a2p);
+    let dlp = lab2.x - lab1.x;
+    let dcp = c2p - c1p;
+    var dhp = 0.0;
+    if (c1p * c2p != 0.0) {
+        dhp = h2p - h1p;
+        if (dhp > 180.0) {
+            dhp = dhp - 360.0;
+        } else if (dhp < -180.0) {
+            dhp = dhp + 360.0;
+        }
+    }
+    let d_hp = 2.0 * sqrt(c1p * c2p) * sin(radians(dhp * 0.5));
+    let lbp = (lab1.x + lab2.x) * 0.5;
+    let cbp = (c1p + c2p) * 0.5;
+    var hbp = h1p + h2p;
+    if (c1p * c2p != 0.0) {
+        if (abs(h1p - h2p) <= 180.0) {
+            hbp = (h1p + h2p) * 0.5;
+        } else if (h1p + h2p < 360.0) {
+            hbp = (h1p + h2p + 360.0) * 0.5;
+        } else {
+            hbp = (h1p + h2p - 360.0) * 0.5;
+        }
+    }
+    let t = 1.0 - 0.17 * cos(radians(hbp - 30.0)) + 0.24 * cos(radians(2.0 * hbp))
+        + 0.32 * cos(radians(3.0 * hbp + 6.0)) - 0.20 * cos(radians(4.0 * hbp - 63.0));
+    let q = (hbp - 275.0) / 25.0;
+    let d_theta = 30.0 * exp(-q * q);
+    let cb7 = pow(cbp, 7.0);
+    let rc = 2.0 * sqrt(cb7 / (cb7 + p25));
+    let l50 = (lbp - 50.0) * (lbp - 50.0);
+    let sl = 1.0 + 0.015 * l50 / sqrt(20.0 + l50);
+    let sc = 1.0 + 0.045 * cbp;
+    let sh = 1.0 + 0.015 * cbp * t;
+    let rt = -sin(radians(2.0 * d_theta)) * rc;
+    let x = dlp / sl;
+    let y = dcp / sc;
+    let z = d_hp / sh;
+    return sqrt(max(x * x + y * y + z * z + rt * y * z, 0.0));
+}
 
 @compute @workgroup_size(64, 1, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -47,11 +126,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var rmse_sum = 0u;
     var pop_sum = 0u;
+    var de_sum = 0u;
     for (var x = gid.x; x < params.width; x = x + LANES) {
         let p = vec2<i32>(i32(x), i32(y));
-        let e = to_bytes(textureLoad(method_img, p, 0)) - to_bytes(textureLoad(reference_img, p, 0));
+        let a = to_bytes(textureLoad(method_img, p, 0));
+        let b = to_bytes(textureLoad(reference_img, p, 0));
+        let e = a - b;
         let s = u32(abs(e.x) + abs(e.y) + abs(e.z));
         rmse_sum = rmse_sum + s * s;
+        if (s != 0u) {
+            de_sum = de_sum + u32(round(ciede2000(srgb_to_lab(a), srgb_to_lab(b)) * DE_SCALE));
+        }
         let idx = y * params.width + x;
         if (params.has_prev != 0u) {
             let q = prev_error[idx];
@@ -67,9 +152,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         prev_error[idx] = biased.x | (biased.y << 10u) | (biased.z << 20u);
     }
     if (rmse_sum != 0u) {
-        add_u64(params.slot * 4u, rmse_sum);
+        add_u64(params.slot * 6u, rmse_sum);
     }
     if (pop_sum != 0u) {
-        add_u64(params.slot * 4u + 2u, pop_sum);
+        add_u64(params.slot * 6u + 2u, pop_sum);
+    }
+    if (de_sum != 0u) {
+        add_u64(params.slot * 6u + 4u, de_sum);
     }
 }

@@ -57,6 +57,117 @@ pub fn pop(previous: &[f32], current: &[f32]) -> f64 {
     (sum / current.len() as f64).sqrt()
 }
 
+/// sRGB RGB-to-XYZ matrix of IEC 61966-2-1 (four decimals), the one colour-science 0.4 uses for "sRGB".
+const SRGB_TO_XYZ: [[f64; 3]; 3] = [
+    [0.4124, 0.3576, 0.1805],
+    [0.2126, 0.7152, 0.0722],
+    [0.0193, 0.1192, 0.9505],
+];
+/// D65 white (CIE 1931 2 degree, xy = 0.3127, 0.3290) as XYZ with Y = 1.
+const D65_WHITE: [f64; 3] = [0.3127 / 0.3290, 1.0, (1.0 - 0.3127 - 0.3290) / 0.3290];
+
+/// An sRGB-encoded 8-bit colour to CIELAB (D65): decode, sRGB matrix, CIE 1976 L*a*b*.
+pub fn srgb8_to_lab(rgb: [u8; 3]) -> [f64; 3] {
+    let lin = rgb.map(|c| {
+        let c = c as f64 / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    });
+    let xyz: [f64; 3] = std::array::from_fn(|i| {
+        (0..3).map(|j| SRGB_TO_XYZ[i][j] * lin[j]).sum::<f64>() / D65_WHITE[i]
+    });
+    let f = |t: f64| {
+        const E: f64 = 216.0 / 24389.0;
+        const K: f64 = 24389.0 / 27.0;
+        if t > E {
+            t.cbrt()
+        } else {
+            (K * t + 16.0) / 116.0
+        }
+    };
+    let (fx, fy, fz) = (f(xyz[0]), f(xyz[1]), f(xyz[2]));
+    [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
+}
+
+/// CIEDE2000 colour difference (Sharma, Wu, Dalal 2005), kL = kC = kH = 1.
+pub fn ciede2000(lab1: [f64; 3], lab2: [f64; 3]) -> f64 {
+    let [l1, a1, b1] = lab1;
+    let [l2, a2, b2] = lab2;
+    let pow7 = |x: f64| x.powi(7);
+    let c_bar = (a1.hypot(b1) + a2.hypot(b2)) / 2.0;
+    let g = 0.5 * (1.0 - (pow7(c_bar) / (pow7(c_bar) + pow7(25.0))).sqrt());
+    let (a1p, a2p) = ((1.0 + g) * a1, (1.0 + g) * a2);
+    let (c1p, c2p) = (a1p.hypot(b1), a2p.hypot(b2));
+    let hue = |b: f64, ap: f64| {
+        if b == 0.0 && ap == 0.0 {
+            0.0
+        } else {
+            b.atan2(ap).to_degrees().rem_euclid(360.0)
+        }
+    };
+    let (h1p, h2p) = (hue(b1, a1p), hue(b2, a2p));
+    let dlp = l2 - l1;
+    let dcp = c2p - c1p;
+    let dhp = if c1p * c2p == 0.0 {
+        0.0
+    } else {
+        let d = h2p - h1p;
+        if d.abs() <= 180.0 {
+            d
+        } else if d > 180.0 {
+            d - 360.0
+        } else {
+            d + 360.0
+        }
+    };
+    let d_hp = 2.0 * (c1p * c2p).sqrt() * (dhp / 2.0).to_radians().sin();
+    let lbp = (l1 + l2) / 2.0;
+    let cbp = (c1p + c2p) / 2.0;
+    let hbp = if c1p * c2p == 0.0 {
+        h1p + h2p
+    } else if (h1p - h2p).abs() <= 180.0 {
+        (h1p + h2p) / 2.0
+    } else if h1p + h2p < 360.0 {
+        (h1p + h2p + 360.0) / 2.0
+    } else {
+        (h1p + h2p - 360.0) / 2.0
+    };
+    let cosd = |d: f64| d.to_radians().cos();
+    let t = 1.0 - 0.17 * cosd(hbp - 30.0) + 0.24 * cosd(2.0 * hbp) + 0.32 * cosd(3.0 * hbp + 6.0)
+        - 0.20 * cosd(4.0 * hbp - 63.0);
+    let d_theta = 30.0 * (-((hbp - 275.0) / 25.0).powi(2)).exp();
+    let rc = 2.0 * (pow7(cbp) / (pow7(cbp) + pow7(25.0))).sqrt();
+    let sl = 1.0 + 0.015 * (lbp - 50.0).powi(2) / (20.0 + (lbp - 50.0).powi(2)).sqrt();
+    let sc = 1.0 + 0.045 * cbp;
+    let sh = 1.0 + 0.015 * cbp * t;
+    let rt = -(2.0 * d_theta).to_radians().sin() * rc;
+    let (x, y, z) = (dlp / sl, dcp / sc, d_hp / sh);
+    (x * x + y * y + z * z + rt * y * z).sqrt()
+}
+
+/// Mean CIEDE2000 over all pixels between two RGBA8 sRGB images (alpha ignored).
+pub fn de2000_mean(method: &[u8], reference: &[u8]) -> f64 {
+    let pixels = method.len() / 4;
+    if pixels == 0 {
+        return 0.0;
+    }
+    let sum: f64 = method
+        .chunks_exact(4)
+        .zip(reference.chunks_exact(4))
+        .filter(|(a, b)| a[..3] != b[..3])
+        .map(|(a, b)| {
+            ciede2000(
+                srgb8_to_lab([a[0], a[1], a[2]]),
+                srgb8_to_lab([b[0], b[1], b[2]]),
+            )
+        })
+        .sum();
+    sum / pixels as f64
+}
+
 /// Per-frame metrics of a sequence, keeping E_{t-1} between frames. `pop` is 0 on the first frame.
 #[derive(Debug, Default)]
 pub struct SequenceMetrics {
@@ -67,6 +178,8 @@ pub struct SequenceMetrics {
 pub struct FrameMetrics {
     pub rmse: f64,
     pub pop: f64,
+    /// Mean CIEDE2000 between method and reference frame.
+    pub de2000: f64,
 }
 
 impl SequenceMetrics {
@@ -79,7 +192,11 @@ impl SequenceMetrics {
         let pop = self.previous.as_deref().map_or(0.0, |p| pop(p, &e));
         let rmse = rmse_srgb(method, reference);
         self.previous = Some(e);
-        FrameMetrics { rmse, pop }
+        FrameMetrics {
+            rmse,
+            pop,
+            de2000: de2000_mean(method, reference),
+        }
     }
 }
 
@@ -111,20 +228,13 @@ mod tests {
         let a = img(&[[10, 20, 30], [200, 100, 0]]);
         assert_eq!(rmse_srgb(&a, &a), 0.0);
         let mut s = SequenceMetrics::new();
-        assert_eq!(
-            s.frame(&a, &a),
-            FrameMetrics {
-                rmse: 0.0,
-                pop: 0.0
-            }
-        );
-        assert_eq!(
-            s.frame(&a, &a),
-            FrameMetrics {
-                rmse: 0.0,
-                pop: 0.0
-            }
-        );
+        let zero = FrameMetrics {
+            rmse: 0.0,
+            pop: 0.0,
+            de2000: 0.0,
+        };
+        assert_eq!(s.frame(&a, &a), zero);
+        assert_eq!(s.frame(&a, &a), zero);
     }
 
     #[test]
@@ -173,6 +283,66 @@ mod tests {
         let b = s.frame(&down, &r);
         assert!((a.rmse - b.rmse).abs() < 1e-12);
         assert!((b.pop - ((40.0f64 / 255.0).powi(2) / 3.0).sqrt()).abs() < 1e-7);
+    }
+
+    /// Test pairs of Sharma, Wu and Dalal (2005), Table 1, with their published CIEDE2000.
+    #[test]
+    fn ciede2000_matches_sharma_test_data() {
+        let pairs: [([f64; 3], [f64; 3], f64); 8] = [
+            ([50.0, 2.6772, -79.7751], [50.0, 0.0, -82.7485], 2.0425),
+            ([50.0, 3.1571, -77.2803], [50.0, 0.0, -82.7485], 2.8615),
+            ([50.0, 2.8361, -74.0200], [50.0, 0.0, -82.7485], 3.4412),
+            ([50.0, 0.0, 0.0], [50.0, -1.0, 2.0], 2.3669),
+            ([50.0, 2.5, 0.0], [73.0, 25.0, -18.0], 27.1492),
+            (
+                [60.2574, -34.0099, 36.2677],
+                [60.4626, -34.1751, 39.4387],
+                1.2644,
+            ),
+            (
+                [2.0776, 0.0795, -1.1350],
+                [0.9033, -0.0636, -0.5514],
+                0.9082,
+            ),
+            ([50.0, 2.5, 0.0], [50.0, 0.0, -2.5], 4.3065),
+        ];
+        for (a, b, expect) in pairs {
+            let got = ciede2000(a, b);
+            assert!(
+                (got - expect).abs() < 1e-4,
+                "{a:?} {b:?}: {got} vs {expect}"
+            );
+            assert!((ciede2000(b, a) - expect).abs() < 1e-4, "not symmetric");
+        }
+    }
+
+    /// Against colour-science 0.4.7: `colour.XYZ_to_Lab(colour.sRGB_to_XYZ(rgb))`.
+    #[test]
+    fn srgb_to_lab_matches_colour_science() {
+        let cases: [([u8; 3], [f64; 3]); 3] = [
+            (
+                [255, 0, 0],
+                [53.232881785842, 80.111177743139, 67.22370366687],
+            ),
+            (
+                [0, 255, 0],
+                [87.737033473544, -86.18285499658, 83.187834658196],
+            ),
+            (
+                [51, 102, 153],
+                [42.009985776866, -0.143511443107, -32.842250098583],
+            ),
+        ];
+        for (rgb, expect) in cases {
+            let got = srgb8_to_lab(rgb);
+            for c in 0..3 {
+                assert!(
+                    (got[c] - expect[c]).abs() < 1e-6,
+                    "{rgb:?}: {got:?} vs {expect:?}"
+                );
+            }
+        }
+        assert_eq!(srgb8_to_lab([0, 0, 0]), [0.0, 0.0, 0.0]);
     }
 
     #[test]

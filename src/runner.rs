@@ -243,6 +243,7 @@ impl<'a> BlockRunner<'a> {
                 lod_mean: facts.lod_mean,
                 rmse: 0.0,
                 pop: 0.0,
+                de2000_mean: 0.0,
             });
             progress.inc(1);
         }
@@ -314,6 +315,7 @@ impl<'a> BlockRunner<'a> {
         for (row, m) in rows.iter_mut().zip(metrics) {
             row.rmse = m.rmse;
             row.pop = m.pop;
+            row.de2000_mean = m.de2000;
         }
         ctx.check_errors()?;
         Ok(BlockOutput {

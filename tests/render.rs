@@ -178,6 +178,7 @@ fn same_flags_same_metrics() {
     for name in [
         "rmse",
         "pop",
+        "de2000_mean",
         "triangles",
         "draw_calls",
         "t_instances",
@@ -232,6 +233,7 @@ fn gpu_metrics_match_cpu_oracle() {
     // Not vacuous: the sequence has real errors and real pops.
     assert!(cpu.iter().any(|m| m.rmse > 1e-3));
     assert!(cpu.iter().any(|m| m.pop > 1e-3));
+    assert!(cpu.iter().any(|m| m.de2000 > 1e-2));
 }
 
 /// A rendered frame against a blessed PNG. Tolerance: mean absolute difference at most 0.5 (of 255) per

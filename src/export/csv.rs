@@ -27,6 +27,8 @@ pub struct FrameRecord {
     pub lod_mean: f64,
     pub rmse: f64,
     pub pop: f64,
+    /// Mean CIEDE2000 over pixels between method and reference frame (sRGB D65 -> XYZ -> CIELAB).
+    pub de2000_mean: f64,
 }
 
 /// One row of summary.csv: one method on one scene block.
@@ -52,6 +54,9 @@ pub struct SummaryRecord {
     pub rmse_max: f64,
     pub pop_max: f64,
     pub pop_p95: f64,
+    /// Mean over frames of de2000_mean, and its largest frame.
+    pub de2000_mean: f64,
+    pub de2000_max: f64,
     pub extra_target_bytes: u64,
 }
 
@@ -137,6 +142,8 @@ impl SummaryRecord {
             rmse_max: rows.iter().map(|r| r.rmse).fold(0.0, f64::max),
             pop_max: pop.iter().copied().fold(0.0, f64::max),
             pop_p95: percentile(&pop, 95.0).unwrap_or(0.0),
+            de2000_mean: mean(rows.iter().map(|r| r.de2000_mean)),
+            de2000_max: rows.iter().map(|r| r.de2000_mean).fold(0.0, f64::max),
             extra_target_bytes,
         })
     }
@@ -216,6 +223,7 @@ mod tests {
             lod_mean: 0.0,
             rmse,
             pop,
+            de2000_mean: rmse / 2.0,
         }
     }
 
@@ -284,7 +292,7 @@ mod tests {
         assert!(!dir.path().join(FRAMES_CSV).exists());
         let partial = std::fs::read_to_string(dir.path().join("frames.csv.partial")).unwrap();
         assert!(partial.starts_with(
-            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,t_instances,lod_mean,rmse,pop\n"
+            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,t_instances,lod_mean,rmse,pop,de2000_mean\n"
         ));
         assert!(
             partial.contains("s,m,1,0,,2.0,100,1,0,0.0,0.5,0.0"),

@@ -48,7 +48,7 @@ impl MetricKernel {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let sums_size = frames as u64 * 16;
+        let sums_size = frames as u64 * 24;
         let sums = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("metric sums"),
             size: sums_size,
@@ -137,12 +137,14 @@ impl MetricKernel {
             let words: &[u32] = bytemuck::cast_slice(bytes);
             (0..n)
                 .map(|f| {
-                    let w = &words[f * 4..f * 4 + 4];
+                    let w = &words[f * 6..f * 6 + 6];
                     let rmse_sum = w[0] as u64 | (w[1] as u64) << 32;
                     let pop_sum = w[2] as u64 | (w[3] as u64) << 32;
+                    let de_sum = w[4] as u64 | (w[5] as u64) << 32;
                     FrameMetrics {
                         rmse: (rmse_sum as f64 / (9.0 * 255.0 * 255.0 * pixels)).sqrt(),
                         pop: (pop_sum as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt(),
+                        de2000: de_sum as f64 / (65536.0 * pixels),
                     }
                 })
                 .collect()

@@ -1,0 +1,106 @@
+#!/usr/bin/env python3
+"""Independent check of lodbench's image differences, from the PNGs alone.
+
+For every frame dumped with `lodbench run --dump-frames` (results/<run>/frames/*_method.png and
+*_reference.png), recompute
+  - rmse as seed 003 section 6 steps 5-6, with numpy: per pixel the mean over R, G, B of |a - b| on the
+    sRGB-encoded values in [0, 1], then the root mean square over pixels;
+  - the mean CIEDE2000 with colour-science:
+    colour.delta_E(XYZ_to_Lab(sRGB_to_XYZ(a)), XYZ_to_Lab(sRGB_to_XYZ(b)), method="CIE 2000"), averaged over pixels;
+and compare them with the `rmse` and `de2000_mean` columns of frames.csv. Exits 1 on any mismatch, naming the
+frame; 2 when the folder cannot be checked.
+
+    python3 scripts/check_colour.py RESULTS_DIR [--rmse-tol 1e-4] [--de2000-tol 1e-3]
+"""
+import argparse
+import csv
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")  # colour-science warns about optional packages it does not need here
+    import colour
+
+
+def load_rgb(path: Path) -> np.ndarray:
+    """The PNG's R, G, B as sRGB-encoded floats in [0, 1]."""
+    with Image.open(path) as im:
+        return np.asarray(im.convert("RGB"), dtype=np.float64) / 255.0
+
+
+def rmse(a: np.ndarray, b: np.ndarray) -> float:
+    d = np.abs(a - b).mean(axis=-1)
+    return float(np.sqrt(np.mean(d * d)))
+
+
+def de2000_mean(a: np.ndarray, b: np.ndarray) -> float:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lab_a = colour.XYZ_to_Lab(colour.sRGB_to_XYZ(a))
+        lab_b = colour.XYZ_to_Lab(colour.sRGB_to_XYZ(b))
+        return float(np.mean(colour.delta_E(lab_a, lab_b, method="CIE 2000")))
+
+
+def parse_stem(name: str):
+    """`{scene}_{method}_c{count}_f{frame:05}_method.png` -> (scene, method, count, frame)."""
+    parts = name[: -len("_method.png")].split("_")
+    if len(parts) != 4 or not parts[2].startswith("c") or not parts[3].startswith("f"):
+        return None
+    return parts[0], parts[1], parts[2][1:], str(int(parts[3][1:]))
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("results", type=Path, help="a results folder written with --dump-frames")
+    ap.add_argument("--rmse-tol", type=float, default=1e-4)
+    ap.add_argument("--de2000-tol", type=float, default=1e-3)
+    args = ap.parse_args()
+
+    frames_csv = args.results / "frames.csv"
+    if not frames_csv.is_file():
+        print(f"error: {frames_csv} not found (is this a complete lodbench run?)", file=sys.stderr)
+        return 2
+    with open(frames_csv, newline="") as f:
+        rows = {(r["scene"], r["method"], r["count"], r["frame"]): r for r in csv.DictReader(f)}
+    dumps = sorted((args.results / "frames").glob("*_method.png"))
+    if not dumps:
+        print(f"error: no *_method.png under {args.results / 'frames'} (run with --dump-frames)", file=sys.stderr)
+        return 2
+
+    mismatches = 0
+    checked = 0
+    for method_png in dumps:
+        key = parse_stem(method_png.name)
+        if key is None:
+            print(f"error: unexpected file name {method_png.name}", file=sys.stderr)
+            return 2
+        scene, method, count, frame = key
+        row = rows.get(key)
+        reference_png = method_png.with_name(method_png.name.replace("_method.png", "_reference.png"))
+        if row is None or not reference_png.is_file():
+            print(f"MISMATCH frame {frame} ({scene} {method} n={count}): no frames.csv row or no reference PNG")
+            mismatches += 1
+            continue
+        a, b = load_rgb(method_png), load_rgb(reference_png)
+        got_rmse, got_de = rmse(a, b), de2000_mean(a, b)
+        csv_rmse, csv_de = float(row["rmse"]), float(row["de2000_mean"])
+        checked += 1
+        problems = []
+        if abs(got_rmse - csv_rmse) > args.rmse_tol:
+            problems.append(f"rmse csv {csv_rmse:.6g} vs png {got_rmse:.6g}")
+        if abs(got_de - csv_de) > args.de2000_tol:
+            problems.append(f"de2000_mean csv {csv_de:.6g} vs png {got_de:.6g}")
+        if problems:
+            mismatches += 1
+            print(f"MISMATCH frame {frame} ({scene} {method} n={count}): " + "; ".join(problems))
+    print(f"checked {checked} frames: {checked - mismatches} agree, {mismatches} differ "
+          f"(tolerances rmse {args.rmse_tol}, de2000 {args.de2000_tol})")
+    return 1 if mismatches else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,69 @@
+"""check_colour.py passes on a fresh lodbench dump and fails, naming the frame, when one dumped frame is altered."""
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+ROOT = Path(__file__).resolve().parents[2]
+SCRIPT = ROOT / "scripts" / "check_colour.py"
+
+
+def lodbench_binary() -> Path:
+    if os.environ.get("LODBENCH_BIN"):
+        return Path(os.environ["LODBENCH_BIN"])
+    for profile in ("debug", "release"):
+        p = ROOT / "target" / profile / "lodbench"
+        if p.is_file():
+            return p
+    subprocess.run(["cargo", "build", "--quiet"], cwd=ROOT, check=True)
+    return ROOT / "target" / "debug" / "lodbench"
+
+
+@pytest.fixture(scope="module")
+def dump(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("dump") / "run"
+    subprocess.run(
+        [str(lodbench_binary()), "run", "--scene", "bunny-sweep", "--method", "discrete,dither",
+         "--width", "160", "--height", "120", "--frames", "60", "--warmup", "0",
+         "--switch-distances", "14,16,18", "--dump-frames", "--dump-every", "5", "--out", str(out)],
+        check=True, capture_output=True,
+    )
+    return out
+
+
+def check(folder: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, str(SCRIPT), str(folder)], capture_output=True, text=True)
+
+
+def test_fresh_dump_passes(dump):
+    r = check(dump)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "0 differ" in r.stdout
+    # Not vacuous: some checked frames really differ from the reference.
+    rows = (dump / "frames.csv").read_text().splitlines()
+    assert any(float(line.split(",")[-1]) > 0.01 for line in rows[1:])
+
+
+def test_altered_frame_is_named(dump, tmp_path):
+    copy = tmp_path / "altered"
+    shutil.copytree(dump, copy)
+    target = copy / "frames" / "bunny-sweep_dither_c1_f00030_method.png"
+    img = np.asarray(Image.open(target).convert("RGBA")).copy()
+    img[50:66, 70:86, :3] = np.minimum(img[50:66, 70:86, :3].astype(int) + 4, 255).astype(np.uint8)
+    Image.fromarray(img).save(target)
+    r = check(copy)
+    assert r.returncode == 1, r.stdout + r.stderr
+    bad = [line for line in r.stdout.splitlines() if line.startswith("MISMATCH")]
+    assert len(bad) == 1, r.stdout
+    assert "frame 30 " in bad[0] and "dither" in bad[0], bad[0]
+
+
+def test_missing_folder_is_an_error(tmp_path):
+    r = check(tmp_path / "nothing")
+    assert r.returncode == 2
+    assert "frames.csv" in r.stderr
