@@ -88,6 +88,7 @@ fn csv_export(c: &mut Criterion) {
             rmse: 0.01,
             pop: 0.001,
             de2000_mean: 0.1,
+            flip_mean: None,
         })
         .collect();
     let dir = tempfile::tempdir().unwrap();

@@ -105,6 +105,9 @@ pub struct RunArgs {
     /// Vertex correspondence of geomorphing (`geomorph`).
     #[arg(long, value_enum, default_value_t = crate::morph::Correspondence::Nearest)]
     pub correspondence: crate::morph::Correspondence,
+    /// Image metrics per frame (rmse, pop and de2000 are always computed; flip adds NVIDIA FLIP, on the CPU).
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [crate::metrics::Metric::Rmse, crate::metrics::Metric::Pop, crate::metrics::Metric::De2000])]
+    pub metrics: Vec<crate::metrics::Metric>,
     /// Output folder (default results/<scene>-<time>/).
     #[arg(long)]
     pub out: Option<PathBuf>,

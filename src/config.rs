@@ -180,6 +180,8 @@ pub struct RunConfig {
     pub noise: crate::noise::NoisePattern,
     /// Vertex correspondence of `geomorph`.
     pub correspondence: crate::morph::Correspondence,
+    /// `--metrics` (rmse, pop, de2000 always; flip when listed).
+    pub metrics: Vec<crate::metrics::Metric>,
     pub out: Option<PathBuf>,
     pub adapter: Option<String>,
     pub dump_frames: bool,
@@ -204,6 +206,7 @@ impl RunConfig {
             seed: a.seed,
             noise: a.noise,
             correspondence: a.correspondence,
+            metrics: a.metrics.clone(),
             out: a.out.clone(),
             adapter: a.adapter.clone(),
             dump_frames: a.dump_frames,

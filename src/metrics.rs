@@ -168,6 +168,31 @@ pub fn de2000_mean(method: &[u8], reference: &[u8]) -> f64 {
     sum / pixels as f64
 }
 
+/// `--metrics`: the per-frame image metrics. rmse, pop and de2000 are always computed (on the GPU, at little
+/// cost); `flip` adds NVIDIA FLIP, computed on the CPU from read-back frames.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Metric {
+    Rmse,
+    Pop,
+    De2000,
+    Flip,
+}
+
+/// Mean FLIP error (LDR-FLIP, Andersson et al. 2020, via the `nv-flip` crate) of the method frame against the
+/// reference frame, at FLIP's default viewing condition (67 pixels per degree).
+pub fn flip_mean(method: &[u8], reference: &[u8], width: u32, height: u32) -> f64 {
+    let rgb = |img: &[u8]| -> Vec<u8> {
+        img.chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect()
+    };
+    let reference = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(reference));
+    let test = nv_flip::FlipImageRgb8::with_data(width, height, &rgb(method));
+    let error = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    nv_flip::FlipPool::from_image(&error).mean() as f64
+}
+
 /// Per-frame metrics of a sequence, keeping E_{t-1} between frames. `pop` is 0 on the first frame.
 #[derive(Debug, Default)]
 pub struct SequenceMetrics {
@@ -343,6 +368,23 @@ mod tests {
             }
         }
         assert_eq!(srgb8_to_lab([0, 0, 0]), [0.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn flip_is_zero_for_equal_images_and_grows_with_difference() {
+        let (w, h) = (32u32, 32u32);
+        let a: Vec<u8> = (0..w * h)
+            .flat_map(|i| [(i % 251) as u8, 90, 140, 255])
+            .collect();
+        assert_eq!(flip_mean(&a, &a, w, h), 0.0);
+        let shift = |d: u8| -> Vec<u8> {
+            a.chunks_exact(4)
+                .flat_map(|p| [p[0], p[1].saturating_add(d), p[2], 255])
+                .collect()
+        };
+        let small = flip_mean(&shift(8), &a, w, h);
+        let large = flip_mean(&shift(80), &a, w, h);
+        assert!(small > 0.0 && large > small, "{small} {large}");
     }
 
     #[test]

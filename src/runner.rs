@@ -123,18 +123,25 @@ pub struct BlockRunner<'a> {
     /// Times the metric kernel alone in the quality pass (its own cost, reported in run.json).
     metric_timer: Option<GpuTimer>,
     readback: Option<(ColorReadback, ColorReadback)>,
+    /// Read back every quality-pass frame and compute FLIP on it.
+    flip: bool,
+    /// Hand every `dump_every`-th frame's images to the caller.
+    dump: bool,
 }
 
 /// Keep at most this many quality-pass frames queued on the GPU.
 const QUALITY_IN_FLIGHT: u32 = 2;
 
 impl<'a> BlockRunner<'a> {
+    /// `dump`: hand frames to `run_method`'s callback; `flip`: compute FLIP on every quality-pass frame.
     pub fn new(
         ctx: &'a GpuContext,
         scene: &'a Scene,
         options: MethodOptions,
-        with_readback: bool,
+        dump: bool,
+        flip: bool,
     ) -> Result<Self> {
+        let with_readback = dump || flip;
         ctx.check_viewport(scene.width, scene.height)?;
         let gpu = SceneGpu::new(ctx, scene)?;
         let (w, h) = (scene.width, scene.height);
@@ -165,6 +172,8 @@ impl<'a> BlockRunner<'a> {
             timer,
             metric_timer,
             readback,
+            flip,
+            dump,
         })
     }
 
@@ -244,6 +253,7 @@ impl<'a> BlockRunner<'a> {
                 rmse: 0.0,
                 pop: 0.0,
                 de2000_mean: 0.0,
+                flip_mean: None,
             });
             progress.inc(1);
         }
@@ -274,8 +284,9 @@ impl<'a> BlockRunner<'a> {
             if let Some(t) = &self.metric_timer {
                 t.end(&mut encoder, f);
             }
-            let dump = match &self.readback {
-                Some((m, r)) if f % dump_every == 0 => {
+            let dump = self.dump && f % dump_every == 0;
+            let read = match &self.readback {
+                Some((m, r)) if dump || self.flip => {
                     m.encode_copy(&mut encoder, &self.method_target);
                     r.encode_copy(&mut encoder, &self.reference_target);
                     true
@@ -283,10 +294,20 @@ impl<'a> BlockRunner<'a> {
                 _ => false,
             };
             let index = ctx.queue.submit([encoder.finish()]);
-            if let (true, Some((m, r))) = (dump, &self.readback) {
+            if let (true, Some((m, r))) = (read, &self.readback) {
                 let method_rgba = m.read(ctx)?;
                 let reference_rgba = r.read(ctx)?;
-                on_frames(f, &method_rgba, &reference_rgba)?;
+                if self.flip {
+                    rows[f as usize].flip_mean = Some(crate::metrics::flip_mean(
+                        &method_rgba,
+                        &reference_rgba,
+                        scene.width,
+                        scene.height,
+                    ));
+                }
+                if dump {
+                    on_frames(f, &method_rgba, &reference_rgba)?;
+                }
             } else {
                 in_flight.push_back(index);
                 if in_flight.len() > QUALITY_IN_FLIGHT as usize {
@@ -467,7 +488,8 @@ fn run_blocks(
                 correspondence: cfg.correspondence,
                 seed: cfg.seed,
             };
-            let mut block = BlockRunner::new(&ctx, &scene, options, dumper.is_some())?;
+            let flip = cfg.metrics.contains(&crate::metrics::Metric::Flip);
+            let mut block = BlockRunner::new(&ctx, &scene, options, dumper.is_some(), flip)?;
             for method in &cfg.methods {
                 progress.set_message(format!("{} n={} {}", def.name, count, method));
                 let out =

@@ -90,6 +90,17 @@ fn bad_numbers_are_rejected() {
 }
 
 #[test]
+fn unknown_metric_is_rejected() {
+    let out = lodbench(&["run", "--metrics", "rmse,psnr"], &[]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("psnr") && stderr.contains("flip") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+}
+
+#[test]
 fn unwritable_output_folder_fails_before_rendering() {
     let dir = tempfile::tempdir().unwrap();
     let file = write(dir.path(), "a-file", "x");

@@ -204,7 +204,7 @@ fn gpu_metrics_match_cpu_oracle() {
         "12,16,20",
     ]);
     let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
-    let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true).unwrap();
+    let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true, false).unwrap();
     let mut oracle = SequenceMetrics::new();
     let mut cpu = Vec::new();
     let out = block
@@ -253,7 +253,7 @@ fn snapshot_reference_frame() {
         "20,30,40",
     ]);
     let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
-    let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true).unwrap();
+    let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true, false).unwrap();
     let mut frame0 = None;
     block
         .run_method("reference", 0, 1, &ProgressBar::hidden(), |f, m, _| {
@@ -323,4 +323,51 @@ fn snapshot_reference_frame() {
             dir.display()
         );
     }
+}
+
+/// `--metrics flip` adds a flip_mean column: 0 exactly where the method frame equals the reference, above 0
+/// where it differs; without it the column is empty.
+#[test]
+fn flip_metric_on_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let run_with = |name: &str, metrics: &str| {
+        let out = dir.path().join(name);
+        let cfg = run_config(&[
+            "--scene",
+            "bunny-sweep",
+            "--method",
+            "discrete",
+            "--width",
+            "160",
+            "--height",
+            "120",
+            "--frames",
+            "40",
+            "--warmup",
+            "0",
+            "--switch-distances",
+            "14,16,18",
+            "--metrics",
+            metrics,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        runner::run(&cfg).unwrap();
+        read_csv(&out.join("frames.csv"))
+    };
+    let rows = run_with("flip", "rmse,pop,de2000,flip");
+    let mut differing = 0;
+    for r in &rows {
+        let rmse: f64 = r["rmse"].parse().unwrap();
+        let flip: f64 = r["flip_mean"].parse().expect("flip_mean filled");
+        if rmse == 0.0 {
+            assert_eq!(flip, 0.0, "frame {}", r["frame"]);
+        } else {
+            assert!(flip > 0.0, "frame {}", r["frame"]);
+            differing += 1;
+        }
+    }
+    assert!(differing > 0);
+    let rows = run_with("default", "rmse,pop,de2000");
+    assert!(rows.iter().all(|r| r["flip_mean"].is_empty()));
 }

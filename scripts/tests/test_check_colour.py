@@ -1,39 +1,14 @@
 """check_colour.py passes on a fresh lodbench dump and fails, naming the frame, when one dumped frame is altered."""
-import os
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 from PIL import Image
 
 ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = ROOT / "scripts" / "check_colour.py"
-
-
-def lodbench_binary() -> Path:
-    if os.environ.get("LODBENCH_BIN"):
-        return Path(os.environ["LODBENCH_BIN"])
-    for profile in ("debug", "release"):
-        p = ROOT / "target" / profile / "lodbench"
-        if p.is_file():
-            return p
-    subprocess.run(["cargo", "build", "--quiet"], cwd=ROOT, check=True)
-    return ROOT / "target" / "debug" / "lodbench"
-
-
-@pytest.fixture(scope="module")
-def dump(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("dump") / "run"
-    subprocess.run(
-        [str(lodbench_binary()), "run", "--scene", "bunny-sweep", "--method", "discrete,dither",
-         "--width", "160", "--height", "120", "--frames", "60", "--warmup", "0",
-         "--switch-distances", "14,16,18", "--dump-frames", "--dump-every", "5", "--out", str(out)],
-        check=True, capture_output=True,
-    )
-    return out
 
 
 def check(folder: Path) -> subprocess.CompletedProcess:

@@ -29,6 +29,8 @@ pub struct FrameRecord {
     pub pop: f64,
     /// Mean CIEDE2000 over pixels between method and reference frame (sRGB D65 -> XYZ -> CIELAB).
     pub de2000_mean: f64,
+    /// Mean FLIP error, with `--metrics ...,flip` (empty otherwise).
+    pub flip_mean: Option<f64>,
 }
 
 /// One row of summary.csv: one method on one scene block.
@@ -57,6 +59,8 @@ pub struct SummaryRecord {
     /// Mean over frames of de2000_mean, and its largest frame.
     pub de2000_mean: f64,
     pub de2000_max: f64,
+    /// Mean over frames of flip_mean (empty without `--metrics flip`).
+    pub flip_mean: Option<f64>,
     pub extra_target_bytes: u64,
 }
 
@@ -144,6 +148,11 @@ impl SummaryRecord {
             pop_p95: percentile(&pop, 95.0).unwrap_or(0.0),
             de2000_mean: mean(rows.iter().map(|r| r.de2000_mean)),
             de2000_max: rows.iter().map(|r| r.de2000_mean).fold(0.0, f64::max),
+            flip_mean: rows
+                .iter()
+                .map(|r| r.flip_mean)
+                .collect::<Option<Vec<f64>>>()
+                .map(|v| mean(v.into_iter())),
             extra_target_bytes,
         })
     }
@@ -224,6 +233,7 @@ mod tests {
             rmse,
             pop,
             de2000_mean: rmse / 2.0,
+            flip_mean: None,
         }
     }
 
@@ -292,7 +302,7 @@ mod tests {
         assert!(!dir.path().join(FRAMES_CSV).exists());
         let partial = std::fs::read_to_string(dir.path().join("frames.csv.partial")).unwrap();
         assert!(partial.starts_with(
-            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,t_instances,lod_mean,rmse,pop,de2000_mean\n"
+            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,t_instances,lod_mean,rmse,pop,de2000_mean,flip_mean\n"
         ));
         assert!(
             partial.contains("s,m,1,0,,2.0,100,1,0,0.0,0.5,0.0"),

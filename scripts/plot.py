@@ -1,0 +1,222 @@
+#!/usr/bin/env python3
+"""Figures and a report from a lodbench results folder.
+
+    python3 scripts/plot.py RESULTS_DIR [RESULTS_DIR ...]
+
+Writes into each folder a `figures/` subfolder and `report.md` (the summary table and every figure that folder's
+data allows):
+  - sweep_<scene>.png       rmse and pop along the path per method, discrete LOD switch frames marked;
+  - fig6_<scene>.png        seed 003 Fig. 6: popping per method (mean rmse, max pop; bunny-sweep or any moving scene);
+  - fig5_<scene>.png        seed 003 Fig. 5: median frame time against instance count per method (scenes run with
+                            several --count values, e.g. bunny-grid), with bootstrap 95 % intervals;
+  - cost_<scene>.png        error against cost: mean rmse and max pop against median GPU time, per method;
+  - contact_<scene>.png     frames around the first transition per method with their error heat-maps (runs with
+                            --dump-frames).
+Seed 000's Fig. 8 (frame time against viewport size) needs the experiment files of a later issue.
+"""
+import argparse
+import csv
+import sys
+from collections import OrderedDict
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from PIL import Image  # noqa: E402
+
+
+def read_csv(path: Path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def num(v):
+    return float(v) if v not in ("", None) else float("nan")
+
+
+def group(rows, *keys):
+    out = OrderedDict()
+    for r in rows:
+        out.setdefault(tuple(r[k] for k in keys), []).append(r)
+    return out
+
+
+def switch_frames(rows):
+    """Frames where the LOD a hard switch shows changes (lod_mean crosses a half-integer)."""
+    lod = [round(num(r["lod_mean"])) for r in rows]
+    return [i for i in range(1, len(lod)) if lod[i] != lod[i - 1]]
+
+
+def sweep_figure(scene, by_method, path):
+    fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
+    first = next(iter(by_method.values()))
+    for f in switch_frames(first):
+        for ax in axes:
+            ax.axvline(f, color="0.85", lw=0.8, zorder=0)
+    for method, rows in by_method.items():
+        frames = [int(r["frame"]) for r in rows]
+        axes[0].plot(frames, [num(r["rmse"]) for r in rows], lw=0.9, label=method)
+        axes[1].plot(frames, [num(r["pop"]) for r in rows], lw=0.9, label=method)
+    axes[0].set_ylabel("rmse (seed 003 sec. 6)")
+    axes[1].set_ylabel("pop")
+    axes[1].set_xlabel("frame (grey: discrete LOD switches)")
+    axes[0].legend(ncol=4, fontsize=8)
+    axes[0].set_title(f"{scene}: error along the path")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def fig6(scene, summary, path):
+    methods = [r["method"] for r in summary]
+    x = np.arange(len(methods))
+    fig, ax = plt.subplots(figsize=(9, 4))
+    ax.bar(x - 0.2, [num(r["rmse_mean"]) for r in summary], 0.4, label="mean rmse")
+    ax.bar(x + 0.2, [num(r["pop_max"]) for r in summary], 0.4, label="max pop")
+    ax.set_xticks(x, methods, rotation=20)
+    ax.set_title(f"{scene}: popping per method (cf. seed 003 Fig. 6)")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def fig5(scene, summary, path):
+    fig, ax = plt.subplots(figsize=(8, 5))
+    for method, rows in group(summary, "method").items():
+        rows = sorted(rows, key=lambda r: int(r["count"]))
+        n = [int(r["count"]) for r in rows]
+        med = np.array([num(r["gpu_ms_median"]) for r in rows])
+        lo = np.array([num(r.get("gpu_ms_median_ci95_lo")) for r in rows])
+        hi = np.array([num(r.get("gpu_ms_median_ci95_hi")) for r in rows])
+        ax.errorbar(n, med, yerr=[np.nan_to_num(med - lo), np.nan_to_num(hi - med)], marker="o", capsize=3,
+                    label=method[0])
+    ax.set_xlabel("models")
+    ax.set_ylabel("median GPU frame time, ms")
+    ax.set_title(f"{scene}: frame time against model count (cf. seed 003 Fig. 5)")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def cost(scene, summary, path):
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    for r in summary:
+        g = num(r["gpu_ms_median"])
+        for ax, col in zip(axes, ("rmse_mean", "pop_max")):
+            ax.scatter(g, num(r[col]))
+            ax.annotate(f'{r["method"]} n={r["count"]}', (g, num(r[col])), fontsize=7)
+    for ax, col in zip(axes, ("mean rmse", "max pop")):
+        ax.set_xlabel("median GPU frame time, ms")
+        ax.set_ylabel(col)
+    fig.suptitle(f"{scene}: error against cost")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def contact(scene, frames_dir, by_method, path):
+    first = next(iter(by_method.values()))
+    in_transition = [int(r["frame"]) for r in first if int(r["t_instances"]) > 0]
+    if not in_transition:
+        return False
+    dumped = sorted({int(p.name.split("_f")[1][:5]) for p in frames_dir.glob(f"{scene}_*_method.png")})
+    if not dumped:
+        return False
+    mid = in_transition[len(in_transition) // 2] if len(in_transition) < 3 else in_transition[0]
+    i = min(range(len(dumped)), key=lambda j: abs(dumped[j] - mid))
+    picks = dumped[max(0, i - 1): i + 2]
+    methods = [m for (m,) in by_method]
+    fig, axes = plt.subplots(len(methods), 2 * len(picks), figsize=(2.2 * 2 * len(picks), 2.0 * len(methods)),
+                             squeeze=False)
+    for row, method in enumerate(methods):
+        count = by_method[(method,)][0]["count"]
+        for col, f in enumerate(picks):
+            stem = frames_dir / f"{scene}_{method}_c{count}_f{f:05d}"
+            for k, kind in enumerate(("method", "error")):
+                ax = axes[row][2 * col + k]
+                ax.axis("off")
+                p = Path(f"{stem}_{kind}.png")
+                if p.is_file():
+                    ax.imshow(Image.open(p))
+                if row == 0:
+                    ax.set_title(f"frame {f} {kind}", fontsize=8)
+            axes[row][0].text(-0.05, 0.5, method, transform=axes[row][0].transAxes, ha="right", va="center",
+                              fontsize=8)
+    fig.suptitle(f"{scene}: around the first transition (error heat-map: black = equal, white >= 0.25)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return True
+
+
+def markdown_table(rows, columns):
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    for r in rows:
+        cells = []
+        for c in columns:
+            v = r.get(c, "")
+            try:
+                x = float(v)
+                cells.append(f"{x:.4g}")
+            except ValueError:
+                cells.append(v)
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def report(folder: Path) -> list:
+    frames = read_csv(folder / "frames.csv")
+    summary = read_csv(folder / "summary.csv")
+    figs = folder / "figures"
+    figs.mkdir(exist_ok=True)
+    made = []
+    for (scene,), scene_summary in group(summary, "scene").items():
+        scene_frames = [r for r in frames if r["scene"] == scene]
+        counts = sorted({r["count"] for r in scene_summary}, key=int)
+        if len(counts) > 1:
+            fig5(scene, scene_summary, figs / f"fig5_{scene}.png")
+            made.append((f"fig5_{scene}.png", f"{scene}: median GPU frame time against model count"))
+        moving = any(float(r["pop"]) > 0 for r in scene_frames)
+        if moving:
+            first_count = counts[0]
+            by_method = group([r for r in scene_frames if r["count"] == first_count], "method")
+            sweep_figure(scene, OrderedDict((m, rs) for (m,), rs in by_method.items()),
+                         figs / f"sweep_{scene}.png")
+            made.append((f"sweep_{scene}.png", f"{scene}: rmse and pop per frame"))
+            fig6(scene, [r for r in scene_summary if r["count"] == first_count], figs / f"fig6_{scene}.png")
+            made.append((f"fig6_{scene}.png", f"{scene}: popping per method"))
+            if (folder / "frames").is_dir() and contact(scene, folder / "frames", by_method,
+                                                        figs / f"contact_{scene}.png"):
+                made.append((f"contact_{scene}.png", f"{scene}: frames around the first transition"))
+        cost(scene, scene_summary, figs / f"cost_{scene}.png")
+        made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
+    columns = ["scene", "method", "count", "frames", "gpu_ms_median", "gpu_ms_median_ci95_lo",
+               "gpu_ms_median_ci95_hi", "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
+               "de2000_mean"]
+    text = [f"# lodbench report: {folder.name}", "", "## Summary", "", markdown_table(summary, columns), ""]
+    for name, caption in made:
+        text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
+    (folder / "report.md").write_text("\n".join(text))
+    return made
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("results", type=Path, nargs="+")
+    args = ap.parse_args()
+    for folder in args.results:
+        if not (folder / "frames.csv").is_file() or not (folder / "summary.csv").is_file():
+            print(f"error: {folder} has no frames.csv and summary.csv (a complete lodbench run?)", file=sys.stderr)
+            return 2
+        made = report(folder)
+        print(f"{folder}: report.md and {len(made)} figures in {folder / 'figures'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

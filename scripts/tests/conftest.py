@@ -1,0 +1,42 @@
+"""Fixtures shared by the tests of scripts/: small lodbench runs on whatever adapter the machine has."""
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def lodbench_binary() -> Path:
+    if os.environ.get("LODBENCH_BIN"):
+        return Path(os.environ["LODBENCH_BIN"])
+    for profile in ("debug", "release"):
+        p = ROOT / "target" / profile / "lodbench"
+        if p.is_file():
+            return p
+    subprocess.run(["cargo", "build", "--quiet"], cwd=ROOT, check=True)
+    return ROOT / "target" / "debug" / "lodbench"
+
+
+def lodbench(*args: str) -> None:
+    subprocess.run([str(lodbench_binary()), *args], check=True, capture_output=True)
+
+
+@pytest.fixture(scope="session")
+def dump(tmp_path_factory) -> Path:
+    """bunny-sweep, discrete and dither, 60 frames at 160x120, every 5th frame dumped."""
+    out = tmp_path_factory.mktemp("dump") / "run"
+    lodbench("run", "--scene", "bunny-sweep", "--method", "discrete,dither", "--width", "160", "--height", "120",
+             "--frames", "60", "--warmup", "0", "--switch-distances", "14,16,18", "--dump-frames",
+             "--dump-every", "5", "--out", str(out))
+    return out
+
+
+@pytest.fixture(scope="session")
+def grid(tmp_path_factory) -> Path:
+    """bunny-grid with three counts, a few frames at 64x48."""
+    out = tmp_path_factory.mktemp("grid") / "run"
+    lodbench("run", "--scene", "bunny-grid", "--method", "discrete,alpha", "--count", "2,4,8", "--width", "64",
+             "--height", "48", "--frames", "3", "--warmup", "1", "--out", str(out))
+    return out

@@ -1,0 +1,47 @@
+"""plot.py makes every figure its folder's data allows, and a report.md that embeds them."""
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+from PIL import Image
+
+SCRIPT = Path(__file__).resolve().parents[1] / "plot.py"
+
+
+def plot(*folders: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, str(SCRIPT), *map(str, folders)], capture_output=True, text=True)
+
+
+def figures(folder: Path):
+    return sorted(p.name for p in (folder / "figures").glob("*.png"))
+
+
+def test_sweep_folder(dump, tmp_path):
+    folder = tmp_path / "sweep"
+    shutil.copytree(dump, folder)
+    r = plot(folder)
+    assert r.returncode == 0, r.stderr
+    assert figures(folder) == [
+        "contact_bunny-sweep.png", "cost_bunny-sweep.png", "fig6_bunny-sweep.png", "sweep_bunny-sweep.png",
+    ]
+    report = (folder / "report.md").read_text()
+    for name in figures(folder):
+        assert f"(figures/{name})" in report
+        with Image.open(folder / "figures" / name) as im:
+            assert im.width > 300 and im.height > 200
+    assert "| bunny-sweep | dither |" in report
+
+
+def test_grid_folder_gets_fig5(grid, tmp_path):
+    folder = tmp_path / "grid"
+    shutil.copytree(grid, folder)
+    r = plot(folder)
+    assert r.returncode == 0, r.stderr
+    assert "fig5_bunny-grid.png" in figures(folder)
+    assert "sweep_bunny-grid.png" not in figures(folder)  # a static scene has no popping to plot
+
+
+def test_not_a_results_folder(tmp_path):
+    r = plot(tmp_path)
+    assert r.returncode == 2 and "frames.csv" in r.stderr
