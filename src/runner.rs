@@ -75,8 +75,9 @@ impl<'s> FrameDriver<'s> {
         self.distances.clear();
         let mut lod_sum = 0.0f64;
         let mut t = 0u32;
+        let eye = self.scene.camera(frame).eye;
         for (i, inst) in self.scene.instances.iter().enumerate() {
-            let d = self.scene.instance_distance(i, frame);
+            let d = self.scene.instance_position(i, frame).distance(eye);
             let switches = &self.scene.models[inst.model as usize].switches;
             let s = self.schedule.update(i, d, switches);
             lod_sum += s.lod_value() as f64;
