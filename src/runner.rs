@@ -530,7 +530,7 @@ fn run_blocks(
 /// The table printed at the end of a run.
 pub fn summary_table(s: &RunSummary) -> String {
     let mut out = format!(
-        "{:<12} {:<10} {:>5} {:>6} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>7}\n",
+        "{:<12} {:<13} {:>5} {:>6} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>7}\n",
         "scene",
         "method",
         "count",
@@ -551,7 +551,7 @@ pub fn summary_table(s: &RunSummary) -> String {
             .find(|b| b.scene == r.scene && b.method == r.method && b.count == r.count)
             .map_or(f64::NAN, |b| b.quality_to_timing_ratio);
         out.push_str(&format!(
-            "{:<12} {:<10} {:>5} {:>6} {:>9} {:>9.3} {:>10.0} {:>9.5} {:>9.5} {:>9.5} {:>7.2}\n",
+            "{:<12} {:<13} {:>5} {:>6} {:>9} {:>9.3} {:>10.0} {:>9.5} {:>9.5} {:>9.5} {:>7.2}\n",
             r.scene,
             r.method,
             r.count,
