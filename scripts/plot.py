@@ -12,7 +12,9 @@ data allows):
   - cost_<scene>.png        error against cost: mean rmse and max pop against median GPU time, per method;
   - contact_<scene>.png     frames around the first transition per method with their error heat-maps (runs with
                             --dump-frames).
-Seed 000's Fig. 8 (frame time against viewport size) needs the experiment files of a later issue.
+  - fig8_<scene>.png        seed 000 Fig. 8: median frame time against viewport size per method (experiment folders
+                            sweeping `viewport`, e.g. `lodbench experiment` with [sweep] variable = "viewport").
+Experiment folders carry the swept variable as the first CSV column; the per-frame figures use its first value.
 """
 import argparse
 import csv
@@ -103,6 +105,23 @@ def fig5(scene, summary, path):
     plt.close(fig)
 
 
+def fig8(scene, summary, path):
+    fig, ax = plt.subplots(figsize=(8, 5))
+    for (method,), rows in group(summary, "method").items():
+        px = [int(r["viewport"].split(",")[0]) * int(r["viewport"].split(",")[1]) for r in rows]
+        order = np.argsort(px)
+        ax.plot(np.array(px)[order], np.array([num(r["gpu_ms_median"]) for r in rows])[order], marker="o",
+                label=method)
+    ax.set_xscale("log")
+    ax.set_xlabel("viewport pixels")
+    ax.set_ylabel("median GPU frame time, ms")
+    ax.set_title(f"{scene}: frame time against viewport size (cf. seed 000 Fig. 8)")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def cost(scene, summary, path):
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
     for r in summary:
@@ -175,8 +194,14 @@ def report(folder: Path) -> list:
     figs = folder / "figures"
     figs.mkdir(exist_ok=True)
     made = []
-    for (scene,), scene_summary in group(summary, "scene").items():
-        scene_frames = [r for r in frames if r["scene"] == scene]
+    swept = "viewport" in (summary[0] if summary else {})
+    first_viewport = summary[0]["viewport"] if swept else None
+    for (scene,), all_viewports in group(summary, "scene").items():
+        if swept:
+            fig8(scene, all_viewports, figs / f"fig8_{scene}.png")
+            made.append((f"fig8_{scene}.png", f"{scene}: median GPU frame time against viewport size"))
+        scene_summary = [r for r in all_viewports if not swept or r["viewport"] == first_viewport]
+        scene_frames = [r for r in frames if r["scene"] == scene and (not swept or r["viewport"] == first_viewport)]
         counts = sorted({r["count"] for r in scene_summary}, key=int)
         if len(counts) > 1:
             fig5(scene, scene_summary, figs / f"fig5_{scene}.png")
@@ -195,7 +220,7 @@ def report(folder: Path) -> list:
                 made.append((f"contact_{scene}.png", f"{scene}: frames around the first transition"))
         cost(scene, scene_summary, figs / f"cost_{scene}.png")
         made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
-    columns = ["scene", "method", "count", "frames", "gpu_ms_median", "gpu_ms_median_ci95_lo",
+    columns = (["viewport"] if swept else []) + ["scene", "method", "count", "frames", "gpu_ms_median", "gpu_ms_median_ci95_lo",
                "gpu_ms_median_ci95_hi", "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
                "de2000_mean"]
     text = [f"# lodbench report: {folder.name}", "", "## Summary", "", markdown_table(summary, columns), ""]

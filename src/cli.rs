@@ -25,6 +25,20 @@ pub enum Command {
     List,
     /// Show a scene's models, LOD chains, switch distances, instance and frame counts.
     Describe(DescribeArgs),
+    /// Run a sweep described in a TOML file (scenes/experiments/) into one results folder.
+    Experiment(ExperimentArgs),
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct ExperimentArgs {
+    /// The experiment file.
+    pub file: PathBuf,
+    /// Output folder (default results/<experiment name>-<time>/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Validate the file and print the planned runs without rendering.
+    #[arg(long)]
+    pub check: bool,
 }
 
 /// Size and length presets; explicit flags override them.

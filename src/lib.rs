@@ -4,6 +4,7 @@
 pub mod cli;
 pub mod config;
 pub mod error;
+pub mod experiment;
 pub mod export;
 pub mod gpu;
 pub mod lod;

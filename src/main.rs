@@ -15,6 +15,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run(&args),
         Command::List => list(),
         Command::Describe(args) => describe(&args),
+        Command::Experiment(args) => experiment(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -49,6 +50,43 @@ fn run(args: &lodbench::cli::RunArgs) -> lodbench::Result<()> {
     let summary = runner::run(&cfg)?;
     print!("{}", runner::summary_table(&summary));
     println!("results in {}", summary.out_dir.display());
+    Ok(())
+}
+
+fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
+    let e = lodbench::experiment::Experiment::load(&args.file)?;
+    println!(
+        "experiment {} ({} run{}{}): {}",
+        e.name,
+        e.runs.len(),
+        if e.runs.len() == 1 { "" } else { "s" },
+        e.variable
+            .as_deref()
+            .map_or(String::new(), |v| format!(", sweeping {v}")),
+        e.description
+    );
+    if args.check {
+        for r in &e.runs {
+            println!(
+                "  {} scenes {:?} methods {:?}",
+                r.value.as_deref().unwrap_or("-"),
+                r.config.scenes,
+                r.config.methods
+            );
+        }
+        return Ok(());
+    }
+    let _ = ctrlc::set_handler(|| {
+        if runner::INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| runner::default_out_dir(std::slice::from_ref(&e.name)));
+    let folders = e.run(&out)?;
+    println!("{} run(s) in {}", folders.len(), out.display());
     Ok(())
 }
 

@@ -371,3 +371,26 @@ fn flip_metric_on_request() {
     let rows = run_with("default", "rmse,pop,de2000");
     assert!(rows.iter().all(|r| r["flip_mean"].is_empty()));
 }
+
+/// An experiment file with a viewport sweep: one run per value, merged CSVs with a `viewport` column.
+#[test]
+fn experiment_sweep_runs_and_merges() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("sweep.toml");
+    std::fs::write(
+        &file,
+        "name = \"tiny\"\n[run]\nscene = [\"bunny-sweep\"]\nmethod = [\"reference\", \"discrete\"]\n\
+         frames = 4\nwarmup = 0\n[sweep]\nvariable = \"viewport\"\nvalues = [[64, 48], [96, 72]]\n",
+    )
+    .unwrap();
+    let e = lodbench::experiment::Experiment::load(&file).unwrap();
+    let out = dir.path().join("out");
+    let folders = e.run(&out).unwrap();
+    assert_eq!(folders.len(), 2);
+    let rows = read_csv(&out.join("summary.csv"));
+    assert_eq!(rows.len(), 4);
+    let viewports: Vec<&str> = rows.iter().map(|r| r["viewport"].as_str()).collect();
+    assert_eq!(viewports, vec!["64,48", "64,48", "96,72", "96,72"]);
+    assert_eq!(read_csv(&out.join("frames.csv")).len(), 2 * 2 * 4);
+    assert!(out.join("experiment.json").is_file());
+}

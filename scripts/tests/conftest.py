@@ -40,3 +40,15 @@ def grid(tmp_path_factory) -> Path:
     lodbench("run", "--scene", "bunny-grid", "--method", "discrete,alpha", "--count", "2,4,8", "--width", "64",
              "--height", "48", "--frames", "3", "--warmup", "1", "--out", str(out))
     return out
+
+
+@pytest.fixture(scope="session")
+def viewport_experiment(tmp_path_factory) -> Path:
+    """A two-value viewport sweep written by `lodbench experiment`."""
+    base = tmp_path_factory.mktemp("experiment")
+    spec = base / "viewports.toml"
+    spec.write_text('name = "viewports"\n[run]\nscene = ["bunny-sweep"]\nmethod = ["discrete", "alpha"]\n'
+                    'frames = 6\nwarmup = 0\n[sweep]\nvariable = "viewport"\nvalues = [[64, 48], [128, 96]]\n')
+    out = base / "run"
+    lodbench("experiment", str(spec), "--out", str(out))
+    return out

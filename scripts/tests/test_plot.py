@@ -45,3 +45,12 @@ def test_grid_folder_gets_fig5(grid, tmp_path):
 def test_not_a_results_folder(tmp_path):
     r = plot(tmp_path)
     assert r.returncode == 2 and "frames.csv" in r.stderr
+
+
+def test_viewport_experiment_gets_fig8(viewport_experiment, tmp_path):
+    folder = tmp_path / "exp"
+    shutil.copytree(viewport_experiment, folder)
+    r = plot(folder)
+    assert r.returncode == 0, r.stderr
+    assert "fig8_bunny-sweep.png" in figures(folder)
+    assert "| 64,48 | bunny-sweep | discrete |" in (folder / "report.md").read_text()
