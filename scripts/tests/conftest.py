@@ -11,12 +11,15 @@ ROOT = Path(__file__).resolve().parents[2]
 def lodbench_binary() -> Path:
     if os.environ.get("LODBENCH_BIN"):
         return Path(os.environ["LODBENCH_BIN"])
+    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+    if not target.is_absolute():
+        target = ROOT / target
     for profile in ("debug", "release"):
-        p = ROOT / "target" / profile / "lodbench"
+        p = target / profile / "lodbench"
         if p.is_file():
             return p
     subprocess.run(["cargo", "build", "--quiet"], cwd=ROOT, check=True)
-    return ROOT / "target" / "debug" / "lodbench"
+    return target / "debug" / "lodbench"
 
 
 def lodbench(*args: str) -> None:
