@@ -86,6 +86,39 @@ impl LodChain {
         Ok(LodChain { lods })
     }
 
+    /// A hand-made ("artist-style") chain: LOD0 first, each next mesh coarser. `error_abs[i]` is LOD i's
+    /// deviation from LOD0 in object-space units (0 for LOD0), as the caller measured it; it drives the
+    /// switch distances like the simplifier's error does for [`LodChain::build`].
+    pub fn from_meshes(name: &str, meshes: Vec<Mesh>, error_abs: &[f32]) -> Result<LodChain> {
+        if meshes.is_empty() || meshes.len() != error_abs.len() {
+            return Err(Error::Config(format!(
+                "LOD chain of {name}: {} meshes and {} errors",
+                meshes.len(),
+                error_abs.len()
+            )));
+        }
+        let t0 = meshes[0].triangle_count() as f32;
+        if meshes
+            .windows(2)
+            .any(|w| w[1].triangle_count() >= w[0].triangle_count())
+        {
+            return Err(Error::Config(format!(
+                "LOD chain of {name}: each LOD must have fewer triangles than the one before"
+            )));
+        }
+        Ok(LodChain {
+            lods: meshes
+                .into_iter()
+                .zip(error_abs)
+                .map(|(mesh, &e)| Lod {
+                    target_fraction: mesh.triangle_count() as f32 / t0,
+                    error_abs: e,
+                    mesh,
+                })
+                .collect(),
+        })
+    }
+
     pub fn info(&self) -> Vec<LodInfo> {
         self.lods
             .iter()
@@ -106,6 +139,7 @@ fn compact(name: &str, src: &Mesh, indices: &[u32]) -> Result<Mesh> {
     let mut remap = vec![u32::MAX; src.positions.len()];
     let mut positions = Vec::new();
     let mut normals = Vec::new();
+    let mut aux = Vec::new();
     let mut out = Vec::with_capacity(indices.len());
     for &i in indices {
         let slot = &mut remap[i as usize];
@@ -113,10 +147,11 @@ fn compact(name: &str, src: &Mesh, indices: &[u32]) -> Result<Mesh> {
             *slot = positions.len() as u32;
             positions.push(src.positions[i as usize]);
             normals.push(src.normals[i as usize]);
+            aux.push(src.aux[i as usize]);
         }
         out.push(*slot);
     }
-    Mesh::new(name, positions, Some(normals), out)
+    Mesh::new(name, positions, Some(normals), out)?.with_aux(name, aux)
 }
 
 /// Distance at which an object-space error `error_abs` (at instance scale `scale`) projects to `pixel_error`

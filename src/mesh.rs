@@ -12,6 +12,43 @@ pub struct Mesh {
     pub positions: Vec<[f32; 3]>,
     pub normals: Vec<[f32; 3]>,
     pub indices: Vec<u32>,
+    /// Per-vertex shading extras, one per vertex (zeros unless set with [`Mesh::with_aux`]):
+    /// `[u, v, kind, hub_y]`. kind ([`AUX_SOLID`], [`AUX_LEAF`], [`AUX_LEAF_CLUSTER`], [`AUX_BLADE`]) selects the
+    /// alpha-test mask over (u, v) or the blade rotation about the object-space axis parallel to +z through
+    /// (0, hub_y, z); see shaders/mesh.wgsl.
+    pub aux: Vec<[f32; 4]>,
+}
+
+/// `aux` kinds (the shader reads them as floats).
+pub const AUX_SOLID: f32 = 0.0;
+/// An alpha-tested card showing one leaf (mask: [`leaf_mask`] at (u, v)).
+pub const AUX_LEAF: f32 = 1.0;
+/// An alpha-tested card showing a cluster of leaves (mask: [`leaf_cluster_mask`]), for billboard clouds.
+pub const AUX_LEAF_CLUSTER: f32 = 2.0;
+/// A windmill blade vertex: rotated about the hub by the instance's animation angle after the object-space
+/// position FSI's visibility texture reads (seed 000 section 3.3).
+pub const AUX_BLADE: f32 = 3.0;
+
+/// The single-leaf alpha mask over a card's (u, v) in [0, 1]^2: a pointed leaf along v. Must match
+/// `leaf_mask` in shaders/mesh.wgsl.
+pub fn leaf_mask(u: f32, v: f32) -> bool {
+    let x = u * 2.0 - 1.0;
+    let y = v * 2.0 - 1.0;
+    x.abs() <= 0.8 * (1.0 - y * y)
+}
+
+/// The leaf-cluster mask: a 3x3 grid of leaves, each cell's leaf tilted by a fixed per-cell amount, with two
+/// cells left empty so the card does not read as a square. Must match `leaf_cluster_mask` in the shader.
+pub fn leaf_cluster_mask(u: f32, v: f32) -> bool {
+    let cu = (u * 3.0).floor().clamp(0.0, 2.0);
+    let cv = (v * 3.0).floor().clamp(0.0, 2.0);
+    let cell = cu + 3.0 * cv;
+    if cell == 2.0 || cell == 6.0 {
+        return false;
+    }
+    let fu = u * 3.0 - cu;
+    let fv = v * 3.0 - cv;
+    leaf_mask(fu, fv)
 }
 
 impl Mesh {
@@ -75,11 +112,33 @@ impl Mesh {
             }
             None => vertex_normals(&positions, &indices),
         };
+        let aux = vec![[0.0; 4]; positions.len()];
         Ok(Mesh {
             positions,
             normals,
             indices,
+            aux,
         })
+    }
+
+    /// Sets the per-vertex `aux` data (one entry per vertex, finite).
+    pub fn with_aux(mut self, name: &str, aux: Vec<[f32; 4]>) -> Result<Mesh> {
+        let bad = |problem: String| Error::Mesh {
+            path: name.to_string(),
+            problem,
+        };
+        if aux.len() != self.positions.len() {
+            return Err(bad(format!(
+                "{} aux entries for {} vertices",
+                aux.len(),
+                self.positions.len()
+            )));
+        }
+        if aux.iter().any(|a| !a.iter().all(|c| c.is_finite())) {
+            return Err(bad("has a non-finite aux value".into()));
+        }
+        self.aux = aux;
+        Ok(self)
     }
 
     pub fn triangle_count(&self) -> usize {
