@@ -89,6 +89,7 @@ fn csv_export(c: &mut Criterion) {
             pop: 0.001,
             de2000_mean: 0.1,
             flip_mean: None,
+            combine_gpu_ms: None,
         })
         .collect();
     let dir = tempfile::tempdir().unwrap();

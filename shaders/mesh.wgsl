@@ -1,6 +1,16 @@
 // Mesh shading shared by every method: Lambert plus ambient with a per-instance colour, written to an sRGB
-// target (the hardware encodes). Instance data carries the object-to-world matrix, the colour and the
-// transition parameters (x = k, y = alpha, z = LOD, w = instance id) that later methods read.
+// target (the hardware encodes). Instance data carries the object-to-world matrix, the colour (w: the
+// instance's animation angle in radians) and the transition parameters (x = k, y = alpha, z = LOD,
+// w = instance id) that the methods read.
+//
+// Per-vertex `aux` = (u, v, kind, hub_y) (src/mesh.rs): kind 1 and 2 are alpha-tested leaf cards (masks over
+// (u, v) below), kind 3 a windmill blade vertex, rotated about the axis parallel to +z through (0, hub_y) by the
+// instance's animation angle. Animation happens after the object-space position is taken (`object`), which is
+// what FSI's visibility texture reads (seed 000 section 3.3, Fig. 5).
+
+// Set per scene when its models have alpha-tested geometry (every fragment entry then applies the mask), so
+// scenes without it keep shaders with no discard.
+override ALPHA_TEST: bool = false;
 
 struct Camera {
     view_proj: mat4x4<f32>,
@@ -14,6 +24,7 @@ struct Camera {
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
+    @location(10) aux: vec4<f32>,
 };
 
 struct InstanceIn {
@@ -31,23 +42,74 @@ struct VsOut {
     @location(0) normal: vec3<f32>,
     @location(1) color: vec4<f32>,
     @location(2) params: vec4<f32>,
+    @location(3) uv: vec2<f32>,
+    @location(4) @interpolate(flat) kind: f32,
+    // Object-space position before any animation (FSI's visibility-texture lookup).
+    @location(5) object: vec3<f32>,
 };
 
-fn transform(position: vec3<f32>, normal: vec3<f32>, inst: InstanceIn) -> VsOut {
+const KIND_LEAF: f32 = 1.0;
+const KIND_LEAF_CLUSTER: f32 = 2.0;
+const KIND_BLADE: f32 = 3.0;
+
+fn transform(position: vec3<f32>, normal: vec3<f32>, aux: vec4<f32>, inst: InstanceIn) -> VsOut {
+    var p = position;
+    var n = normal;
+    if (aux.z == KIND_BLADE) {
+        let c = cos(inst.color.w);
+        let s = sin(inst.color.w);
+        let r = mat2x2<f32>(c, s, -s, c);
+        let xy = r * vec2<f32>(p.x, p.y - aux.w);
+        p = vec3<f32>(xy.x, xy.y + aux.w, p.z);
+        n = vec3<f32>(r * n.xy, n.z);
+    }
     let model = mat4x4<f32>(inst.model_0, inst.model_1, inst.model_2, inst.model_3);
-    let world = model * vec4<f32>(position, 1.0);
+    let world = model * vec4<f32>(p, 1.0);
     var out: VsOut;
     out.clip = camera.view_proj * world;
     // Instances are scaled uniformly, so the model matrix transforms normals too.
-    out.normal = (model * vec4<f32>(normal, 0.0)).xyz;
+    out.normal = (model * vec4<f32>(n, 0.0)).xyz;
     out.color = inst.color;
     out.params = inst.params;
+    out.uv = aux.xy;
+    out.kind = aux.z;
+    out.object = position;
     return out;
 }
 
 @vertex
 fn vs_main(v: VertexIn, inst: InstanceIn) -> VsOut {
-    return transform(v.position, v.normal, inst);
+    return transform(v.position, v.normal, v.aux, inst);
+}
+
+// The leaf masks of src/mesh.rs (`leaf_mask`, `leaf_cluster_mask`): keep the two in step.
+fn leaf_mask(uv: vec2<f32>) -> bool {
+    let x = uv.x * 2.0 - 1.0;
+    let y = uv.y * 2.0 - 1.0;
+    return abs(x) <= 0.8 * (1.0 - y * y);
+}
+
+fn leaf_cluster_mask(uv: vec2<f32>) -> bool {
+    let c = clamp(floor(uv * 3.0), vec2<f32>(0.0), vec2<f32>(2.0));
+    let cell = c.x + 3.0 * c.y;
+    if (cell == 2.0 || cell == 6.0) {
+        return false;
+    }
+    return leaf_mask(uv * 3.0 - c);
+}
+
+// True where an alpha-tested card has no leaf (the fragment is discarded by every method).
+fn masked(in: VsOut) -> bool {
+    if (!ALPHA_TEST) {
+        return false;
+    }
+    if (in.kind == KIND_LEAF) {
+        return !leaf_mask(in.uv);
+    }
+    if (in.kind == KIND_LEAF_CLUSTER) {
+        return !leaf_cluster_mask(in.uv);
+    }
+    return false;
 }
 
 // Geomorphing (seed 003 sections 10-11): each vertex of the finer LOD moves towards its target on the coarser
@@ -66,7 +128,7 @@ fn vs_morph(v: VertexIn, inst: InstanceIn, m: MorphIn) -> VsOut {
     if (len > 1e-6) {
         normal = n / len;
     }
-    return transform(mix(v.position, m.target_position, t), normal, inst);
+    return transform(mix(v.position, m.target_position, t), normal, v.aux, inst);
 }
 
 fn shade(in: VsOut, front: bool) -> vec3<f32> {
@@ -82,12 +144,26 @@ fn shade(in: VsOut, front: bool) -> vec3<f32> {
 
 @fragment
 fn fs_opaque(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    if (masked(in)) {
+        discard;
+    }
     return vec4<f32>(shade(in, front), 1.0);
+}
+
+// Depth-only passes of scenes with alpha-tested geometry (the mask must cut the depth too).
+@fragment
+fn fs_depth_masked(in: VsOut) {
+    if (masked(in)) {
+        discard;
+    }
 }
 
 // Translucent draws (alpha blending methods): the instance's alpha is params.y.
 @fragment
 fn fs_translucent(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    if (masked(in)) {
+        discard;
+    }
     return vec4<f32>(shade(in, front), in.params.y);
 }
 
@@ -99,7 +175,7 @@ fn fs_translucent(in: VsOut, @builtin(front_facing) front: bool) -> @location(0)
 @fragment
 fn fs_translucent_occluded(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let behind = textureLoad(scene_depth, vec2<i32>(in.clip.xy), 0);
-    if (in.clip.z > behind) {
+    if (in.clip.z > behind || masked(in)) {
         discard;
     }
     return vec4<f32>(shade(in, front), in.params.y);
@@ -131,8 +207,50 @@ fn threshold(p: vec2<f32>) -> f32 {
 fn fs_dither(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let keep_incoming = in.params.x > threshold(in.clip.xy);
     let incoming = in.params.y > 0.5;
-    if (keep_incoming != incoming) {
+    if (keep_incoming != incoming || masked(in)) {
         discard;
     }
     return vec4<f32>(shade(in, front), 1.0);
+}
+
+// Frame Sequential Interpolation (seed 000 sections 3.2-3.5): the scene is drawn into a LOD buffer of colour,
+// depth and instance id. n-instances write id 0; a t-instance writes its own id (params.w) and keeps a fragment
+// only where visTex(p) <= tau (eq. 1: discard where visTex(p) > tau), p the object-space position before
+// animation, the texture read at (p.x + p.z, p.y + p.z) * params.x (params.x = texture repeats per object-space
+// unit), wrapping, nearest texel; params.y = tau.
+struct FsiOut {
+    @location(0) color: vec4<f32>,
+    @location(1) id: u32,
+};
+
+@group(1) @binding(0) var visibility_texture: texture_2d<f32>;
+
+@fragment
+fn fs_fsi_n(in: VsOut, @builtin(front_facing) front: bool) -> FsiOut {
+    if (masked(in)) {
+        discard;
+    }
+    var out: FsiOut;
+    out.color = vec4<f32>(shade(in, front), 1.0);
+    out.id = 0u;
+    return out;
+}
+
+fn visibility(p: vec3<f32>, repeats_per_unit: f32) -> f32 {
+    let size = vec2<i32>(textureDimensions(visibility_texture));
+    let uv = vec2<f32>(p.x + p.z, p.y + p.z) * repeats_per_unit;
+    let texel = vec2<i32>(floor(uv * vec2<f32>(size)));
+    return textureLoad(visibility_texture, ((texel % size) + size) % size, 0).r;
+}
+
+@fragment
+fn fs_fsi_t(in: VsOut, @builtin(front_facing) front: bool) -> FsiOut {
+    if (visibility(in.object, in.params.x) > in.params.y || masked(in)) {
+        discard;
+    }
+    var out: FsiOut;
+    out.color = vec4<f32>(shade(in, front), 1.0);
+    // params is interpolated: a constant can come out a hair below the integer.
+    out.id = u32(round(in.params.w));
+    return out;
 }

@@ -95,6 +95,11 @@ pub struct SceneArgs {
     /// Hysteresis margin as a fraction of the switch distance.
     #[arg(long, default_value_t = 0.0)]
     pub hysteresis: f32,
+    /// Camera motion: `fixed` (the scene's own path) or `orbit` (the camera swings around what it looks at,
+    /// +-30 degrees over 240 frames, keeping its distance: every pixel moves, which exercises FSI's
+    /// reprojection).
+    #[arg(long, value_enum, default_value_t = crate::scene::CameraMode::Fixed)]
+    pub camera: crate::scene::CameraMode,
 }
 
 #[derive(Debug, Clone, Args)]
@@ -119,6 +124,9 @@ pub struct RunArgs {
     /// Vertex correspondence of geomorphing (`geomorph`).
     #[arg(long, value_enum, default_value_t = crate::morph::Correspondence::Nearest)]
     pub correspondence: crate::morph::Correspondence,
+    /// Visibility texture of Frame Sequential Interpolation (`fsi*`, seed 000 section 3.3).
+    #[arg(long, value_enum, default_value_t = crate::noise::VisTexture::Noise)]
+    pub vis_texture: crate::noise::VisTexture,
     /// Image metrics per frame (rmse, pop and de2000 are always computed; flip adds NVIDIA FLIP, on the CPU).
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = [crate::metrics::Metric::Rmse, crate::metrics::Metric::Pop, crate::metrics::Metric::De2000])]
     pub metrics: Vec<crate::metrics::Metric>,

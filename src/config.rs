@@ -71,6 +71,7 @@ pub fn profile_counts(profile: Profile) -> Vec<u32> {
 #[derive(Debug, Clone, Serialize)]
 pub struct SceneConfig {
     pub profile: Profile,
+    pub camera: crate::scene::CameraMode,
     /// Explicit overrides; None = the profile's value for each scene.
     pub width: Option<u32>,
     pub height: Option<u32>,
@@ -146,6 +147,7 @@ impl SceneConfig {
             },
             fov_deg: a.fov,
             schedule,
+            camera: a.camera,
         })
     }
 
@@ -180,6 +182,8 @@ pub struct RunConfig {
     pub noise: crate::noise::NoisePattern,
     /// Vertex correspondence of `geomorph`.
     pub correspondence: crate::morph::Correspondence,
+    /// Visibility texture of `fsi*`.
+    pub vis_texture: crate::noise::VisTexture,
     /// `--metrics` (rmse, pop, de2000 always; flip when listed).
     pub metrics: Vec<crate::metrics::Metric>,
     pub out: Option<PathBuf>,
@@ -206,6 +210,7 @@ impl RunConfig {
             seed: a.seed,
             noise: a.noise,
             correspondence: a.correspondence,
+            vis_texture: a.vis_texture,
             metrics: a.metrics.clone(),
             out: a.out.clone(),
             adapter: a.adapter.clone(),

@@ -59,6 +59,8 @@ struct RunKeys {
     hysteresis: Option<f64>,
     noise: Option<String>,
     correspondence: Option<String>,
+    vis_texture: Option<String>,
+    camera: Option<String>,
     metrics: Option<Vec<String>>,
     adapter: Option<String>,
     dump_frames: Option<bool>,

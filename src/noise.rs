@@ -37,6 +37,52 @@ pub fn threshold_texture(pattern: NoisePattern, seed: u64) -> Option<(u32, Vec<f
     }
 }
 
+/// `--vis-texture`: the visibility texture of FSI (seed 000 section 3.3, eq. 1). A t-instance's fragment is kept
+/// where the texture's value at its object-space position is <= tau, so low values appear first while a LOD
+/// fades in and disappear last while it fades out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum VisTexture {
+    /// 64x64 uniform white noise from the run's seed: the paper's choice for all its images.
+    Noise,
+    /// 64x64, decreasing from the centre outward (1 at the centre, 0 at the farthest corner): the outside of a
+    /// repeat appears first.
+    Radial,
+    /// 64x64 checkerboard of 8x8-texel cells: one colour of cells holds noise values in [0, 0.5), the other in
+    /// [0.5, 1), so the first cells fill in during the first half of a fade and the others during the second
+    /// (the pattern of the paper's Fig. 5, without a hard pop at one tau).
+    Checker,
+}
+
+/// Side of every visibility texture, in texels.
+pub const VIS_TEXTURE_SIZE: u32 = 64;
+
+/// The visibility texture `kind`, row-major, `VIS_TEXTURE_SIZE`^2 values in [0, 1].
+pub fn visibility_texture(kind: VisTexture, seed: u64) -> Vec<f32> {
+    let n = VIS_TEXTURE_SIZE as usize;
+    match kind {
+        VisTexture::Noise => white(n, seed),
+        VisTexture::Radial => {
+            let c = (n as f32 - 1.0) / 2.0;
+            let max = (2.0f32).sqrt() * c;
+            (0..n * n)
+                .map(|i| {
+                    let (x, y) = ((i % n) as f32 - c, (i / n) as f32 - c);
+                    1.0 - (x * x + y * y).sqrt() / max
+                })
+                .collect()
+        }
+        VisTexture::Checker => white(n, seed)
+            .into_iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let cell = (i % n) / 8 + (i / n) / 8;
+                0.5 * v + if cell.is_multiple_of(2) { 0.0 } else { 0.5 }
+            })
+            .collect(),
+    }
+}
+
 /// Uniform values in [0, 1).
 pub fn white(n: usize, seed: u64) -> Vec<f32> {
     let mut rng = SplitMix64::new(seed);
@@ -169,6 +215,26 @@ pub fn void_and_cluster(n: usize, seed: u64) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn visibility_textures_are_in_range_and_seeded() {
+        for kind in [VisTexture::Noise, VisTexture::Radial, VisTexture::Checker] {
+            let t = visibility_texture(kind, 7);
+            assert_eq!(t.len(), 64 * 64);
+            assert!(t.iter().all(|v| (0.0..=1.0).contains(v)), "{kind:?}");
+            assert_eq!(t, visibility_texture(kind, 7));
+        }
+        assert_ne!(
+            visibility_texture(VisTexture::Noise, 1),
+            visibility_texture(VisTexture::Noise, 2)
+        );
+        let r = visibility_texture(VisTexture::Radial, 0);
+        // Decreasing from the centre outward.
+        assert!(r[32 * 64 + 32] > r[32 * 64 + 48] && r[32 * 64 + 48] > r[32 * 64 + 63]);
+        assert!(r[0] < 1e-6);
+        let c = visibility_texture(VisTexture::Checker, 3);
+        assert!(c[0] < 0.5 && c[8] >= 0.5 && c[8 * 64] >= 0.5 && c[8 * 64 + 8] < 0.5);
+    }
 
     fn is_permutation(r: &[u32]) -> bool {
         let mut s = r.to_vec();

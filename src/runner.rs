@@ -99,6 +99,7 @@ impl<'s> FrameDriver<'s> {
             states: &self.states,
             matrices: &self.matrices,
             distances: &self.distances,
+            timed: false,
         }
     }
 }
@@ -186,7 +187,7 @@ impl<'a> BlockRunner<'a> {
         warmup: u32,
         dump_every: u32,
         progress: &ProgressBar,
-        mut on_frames: impl FnMut(u32, &[u8], &[u8]) -> Result<()>,
+        mut on_frames: impl FnMut(u32, &[u8], &[u8], &[(&str, Vec<u8>)]) -> Result<()>,
     ) -> Result<BlockOutput> {
         let scene = self.scene;
         let ctx = self.ctx;
@@ -228,12 +229,11 @@ impl<'a> BlockRunner<'a> {
             if let Some(t) = &self.timer {
                 t.begin(&mut encoder, f);
             }
-            let stats = method.encode(
-                &self.gpu,
-                &driver.input(f),
-                &mut encoder,
-                &self.timing_target,
-            );
+            let input = FrameInput {
+                timed: true,
+                ..driver.input(f)
+            };
+            let stats = method.encode(&self.gpu, &input, &mut encoder, &self.timing_target);
             if let Some(t) = &self.timer {
                 t.end(&mut encoder, f);
             }
@@ -255,6 +255,7 @@ impl<'a> BlockRunner<'a> {
                 pop: 0.0,
                 de2000_mean: 0.0,
                 flip_mean: None,
+                combine_gpu_ms: None,
             });
             progress.inc(1);
         }
@@ -262,6 +263,11 @@ impl<'a> BlockRunner<'a> {
         if let Some(t) = &self.timer {
             for (row, ms) in rows.iter_mut().zip(t.read(ctx)?) {
                 row.gpu_ms = ms;
+            }
+        }
+        if let Some(stage) = method.stage_gpu_ms(ctx)? {
+            for (row, ms) in rows.iter_mut().zip(stage) {
+                row.combine_gpu_ms = ms;
             }
         }
 
@@ -294,6 +300,20 @@ impl<'a> BlockRunner<'a> {
                 }
                 _ => false,
             };
+            // The method's intermediate images (FSI's LOD buffers), only for dumped frames.
+            let extras: Vec<(&str, ColorReadback)> = if dump {
+                method
+                    .debug_targets()
+                    .into_iter()
+                    .map(|(name, t)| {
+                        let rb = ColorReadback::new(&ctx.device, name, t.width, t.height);
+                        rb.encode_copy(&mut encoder, t);
+                        (name, rb)
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            };
             let index = ctx.queue.submit([encoder.finish()]);
             if let (true, Some((m, r))) = (read, &self.readback) {
                 let method_rgba = m.read(ctx)?;
@@ -307,7 +327,11 @@ impl<'a> BlockRunner<'a> {
                     ));
                 }
                 if dump {
-                    on_frames(f, &method_rgba, &reference_rgba)?;
+                    let extras = extras
+                        .iter()
+                        .map(|(name, rb)| Ok((*name, rb.read(ctx)?)))
+                        .collect::<Result<Vec<_>>>()?;
+                    on_frames(f, &method_rgba, &reference_rgba, &extras)?;
                 }
             } else {
                 in_flight.push_back(index);
@@ -487,6 +511,7 @@ fn run_blocks(
             let options = MethodOptions {
                 noise: cfg.noise,
                 correspondence: cfg.correspondence,
+                vis_texture: cfg.vis_texture,
                 seed: cfg.seed,
             };
             let flip = cfg.metrics.contains(&crate::metrics::Metric::Flip);
@@ -494,7 +519,7 @@ fn run_blocks(
             for method in &cfg.methods {
                 progress.set_message(format!("{} n={} {}", def.name, count, method));
                 let out =
-                    block.run_method(method, warmup, cfg.dump_every, &progress, |f, m, r| {
+                    block.run_method(method, warmup, cfg.dump_every, &progress, |f, m, r, x| {
                         match &dumper {
                             Some(d) => d.write(
                                 &scene.name,
@@ -505,6 +530,7 @@ fn run_blocks(
                                 scene.height,
                                 m,
                                 r,
+                                x,
                             ),
                             None => Ok(()),
                         }

@@ -31,6 +31,10 @@ pub struct Model {
     pub name: String,
     /// Base colour, linear RGB.
     pub color: [f32; 3],
+    /// Colour per LOD (SIMPLE's LODs differ in colour); empty = `color` for every LOD.
+    pub lod_colors: Vec<[f32; 3]>,
+    /// Rotation of the animated parts (windmill blades) per frame, radians; 0 = not animated.
+    pub spin_per_frame: f32,
     pub chain: LodChain,
     /// Switch distance of LOD1, LOD2, ... in world units.
     pub switches: Vec<f32>,
@@ -64,6 +68,21 @@ pub enum Motion {
     },
 }
 
+/// `--camera`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum CameraMode {
+    /// The scene's own camera (fixed for the bunny scenes).
+    Fixed,
+    /// The eye swings around the point it looks at (the swept bunny, or the first grid bunny) by
+    /// `ORBIT_AMPLITUDE_DEG` * sin(2 pi f / `ORBIT_PERIOD_FRAMES`), at the distance the fixed camera would have,
+    /// so LOD selection sees the same distances for that point.
+    Orbit,
+}
+
+pub const ORBIT_AMPLITUDE_DEG: f32 = 30.0;
+pub const ORBIT_PERIOD_FRAMES: f32 = 240.0;
+
 #[derive(Debug, Clone, Copy)]
 pub struct Camera {
     pub eye: Vec3,
@@ -94,6 +113,7 @@ pub struct Scene {
     pub far: f32,
     pub eye: Vec3,
     pub forward: Vec3,
+    pub camera_mode: CameraMode,
     pub schedule: ScheduleParams,
 }
 
@@ -109,6 +129,7 @@ pub struct SceneDef {
     pub schedule: ScheduleParams,
     /// Instance counts to build (one block each).
     pub counts: Vec<u32>,
+    pub camera_mode: CameraMode,
     pub mesh_source: String,
 }
 
@@ -140,6 +161,7 @@ impl SceneDef {
             fov_y,
             schedule: cfg.schedule,
             counts,
+            camera_mode: cfg.camera,
             mesh_source,
         })
     }
@@ -203,6 +225,7 @@ impl SceneDef {
             far: far_plane,
             eye: Vec3::ZERO,
             forward: Vec3::X,
+            camera_mode: self.camera_mode,
             schedule: self.schedule,
         }
     }
@@ -241,6 +264,8 @@ fn bunny_model(mesh: &Mesh, cfg: &SceneConfig, height: u32, fov_y: f32) -> Resul
     Ok(Model {
         name: "bunny".into(),
         color: [0.72, 0.45, 0.28],
+        lod_colors: Vec::new(),
+        spin_per_frame: 0.0,
         chain,
         switches,
         switch_source,
@@ -250,7 +275,28 @@ fn bunny_model(mesh: &Mesh, cfg: &SceneConfig, height: u32, fov_y: f32) -> Resul
     })
 }
 
+impl Model {
+    /// Base colour of LOD `lod`, linear RGB.
+    pub fn color_of(&self, lod: u32) -> [f32; 3] {
+        self.lod_colors
+            .get(lod as usize)
+            .copied()
+            .unwrap_or(self.color)
+    }
+}
+
 impl Scene {
+    /// Animation angle of instance `i` on `frame` (radians; windmill blades), with a fixed per-instance phase
+    /// so that neighbours do not turn in step.
+    pub fn animation_angle(&self, i: usize, frame: u32) -> f32 {
+        let m = &self.models[self.instances[i].model as usize];
+        if m.spin_per_frame == 0.0 {
+            return 0.0;
+        }
+        let phase = (i as f32 * 2.399_963).rem_euclid(std::f32::consts::TAU);
+        (phase + m.spin_per_frame * frame as f32).rem_euclid(std::f32::consts::TAU)
+    }
+
     /// Where instance `i`'s centre is on `frame`.
     pub fn instance_position(&self, i: usize, frame: u32) -> Vec3 {
         let inst = &self.instances[i];
@@ -280,19 +326,32 @@ impl Scene {
             .distance(self.camera(frame).eye)
     }
 
-    pub fn camera(&self, _frame: u32) -> Camera {
-        let view = Mat4::look_at_rh(self.eye, self.eye + self.forward, Vec3::Y);
+    pub fn camera(&self, frame: u32) -> Camera {
+        let (eye, view) = match self.camera_mode {
+            CameraMode::Fixed => (
+                self.eye,
+                Mat4::look_at_rh(self.eye, self.eye + self.forward, Vec3::Y),
+            ),
+            CameraMode::Orbit => {
+                let target = match self.instances.first() {
+                    Some(_) => self.instance_position(0, frame),
+                    None => self.eye + self.forward,
+                };
+                let d = target.distance(self.eye);
+                let phase = std::f32::consts::TAU * frame as f32 / ORBIT_PERIOD_FRAMES;
+                let phi = ORBIT_AMPLITUDE_DEG.to_radians() * phase.sin();
+                let dir = glam::Quat::from_rotation_y(phi) * self.forward;
+                let eye = target - dir * d;
+                (eye, Mat4::look_at_rh(eye, target, Vec3::Y))
+            }
+        };
         let proj = Mat4::perspective_rh(
             self.fov_y,
             self.width as f32 / self.height as f32,
             self.near,
             self.far,
         );
-        Camera {
-            eye: self.eye,
-            view,
-            proj,
-        }
+        Camera { eye, view, proj }
     }
 
     pub fn triangles_lod0(&self) -> u64 {
@@ -334,6 +393,7 @@ pub struct SceneDescription {
     pub schedule: ScheduleParams,
     pub models: Vec<ModelDescription>,
     pub motion: Motion,
+    pub camera: CameraMode,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -385,6 +445,7 @@ impl SceneDef {
                 })
                 .collect(),
             motion: first.motion,
+            camera: self.camera_mode,
         }
     }
 }
@@ -452,6 +513,23 @@ mod tests {
             .iter()
             .all(|i| i.position.y == 0.0 && i.position.z == 0.0));
         assert_eq!(s.forward, Vec3::X);
+    }
+
+    #[test]
+    fn orbit_keeps_the_distance_and_moves_the_eye() {
+        let def = SceneDef::new("bunny-sweep", &cfg(&["--camera", "orbit"])).unwrap();
+        let s = def.instantiate(1);
+        let fixed = SceneDef::new("bunny-sweep", &cfg(&[]))
+            .unwrap()
+            .instantiate(1);
+        for f in [0, 30, 60, 90, 500] {
+            let (a, b) = (s.instance_distance(0, f), fixed.instance_distance(0, f));
+            assert!((a - b).abs() < 1e-3 * b, "frame {f}: {a} vs {b}");
+        }
+        assert_eq!(s.camera(0).eye, fixed.camera(0).eye);
+        assert!(
+            s.camera(60).eye.distance(fixed.camera(60).eye) > 0.1 * fixed.instance_distance(0, 60)
+        );
     }
 
     #[test]

@@ -208,7 +208,7 @@ fn gpu_metrics_match_cpu_oracle() {
     let mut oracle = SequenceMetrics::new();
     let mut cpu = Vec::new();
     let out = block
-        .run_method("discrete", 0, 1, &ProgressBar::hidden(), |_, m, r| {
+        .run_method("discrete", 0, 1, &ProgressBar::hidden(), |_, m, r, _| {
             cpu.push(oracle.frame(m, r));
             Ok(())
         })
@@ -256,7 +256,7 @@ fn snapshot_reference_frame() {
     let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true, false).unwrap();
     let mut frame0 = None;
     block
-        .run_method("reference", 0, 1, &ProgressBar::hidden(), |f, m, _| {
+        .run_method("reference", 0, 1, &ProgressBar::hidden(), |f, m, _, _| {
             if f == 0 {
                 frame0 = Some(m.to_vec());
             }

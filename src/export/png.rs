@@ -35,8 +35,17 @@ impl FrameDumper {
         height: u32,
         method_rgba: &[u8],
         reference_rgba: &[u8],
+        extras: &[(&str, Vec<u8>)],
     ) -> Result<()> {
         let stem = Self::stem(scene, method, count, frame);
+        for (name, rgba) in extras {
+            save(
+                &self.dir.join(format!("{stem}_{name}.png")),
+                width,
+                height,
+                rgba,
+            )?;
+        }
         save(
             &self.dir.join(format!("{stem}_method.png")),
             width,

@@ -20,6 +20,8 @@ pub const AMBIENT: f32 = 0.22;
 pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
+    /// (u, v, kind, hub_y), see [`crate::mesh::Mesh::aux`].
+    pub aux: [f32; 4],
 }
 
 /// Per-instance vertex data (96 bytes).
@@ -33,10 +35,11 @@ pub struct InstanceRaw {
 }
 
 impl InstanceRaw {
-    pub fn new(model: &Mat4, color: [f32; 3], params: [f32; 4]) -> Self {
+    /// `color` is linear RGB plus the instance's animation angle in radians (windmill blades).
+    pub fn new(model: &Mat4, color: [f32; 4], params: [f32; 4]) -> Self {
         InstanceRaw {
             model: model.to_cols_array_2d(),
-            color: [color[0], color[1], color[2], 1.0],
+            color,
             params,
         }
     }
@@ -170,7 +173,8 @@ impl RenderTarget {
             format: COLOR_FORMAT,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
             view_formats: &[wgpu::TextureFormat::Rgba8Unorm],
         });
         let depth = device.create_texture(&wgpu::TextureDescriptor {
@@ -180,7 +184,9 @@ impl RenderTarget {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
         RenderTarget {
@@ -224,11 +230,13 @@ pub struct SceneGpu {
     pub camera_bind_group: wgpu::BindGroup,
     pub shader: wgpu::ShaderModule,
     pub opaque_pipeline: wgpu::RenderPipeline,
+    /// The scene has alpha-tested geometry: every mesh pipeline is built with `ALPHA_TEST` on.
+    pub alpha_test: bool,
 }
 
 pub fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 2] {
-    const VERTEX: [wgpu::VertexAttribute; 2] =
-        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+    const VERTEX: [wgpu::VertexAttribute; 3] =
+        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 10 => Float32x4];
     const INSTANCE: [wgpu::VertexAttribute; 6] = wgpu::vertex_attr_array![
         2 => Float32x4, 3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4
     ];
@@ -251,8 +259,14 @@ pub struct MeshPipeline<'a> {
     pub label: &'a str,
     /// Morphing vertex stage (`vs_morph`, with the morph-target buffer in slot 2) instead of `vs_main`.
     pub morph: bool,
-    /// Fragment entry point; None = depth only (the pass then has no colour attachment).
+    /// Fragment entry point; None = depth only (the pass then has no colour attachment; with alpha-tested
+    /// geometry the masked depth-only entry is used).
     pub fragment: Option<&'a str>,
+    /// A second colour target of this format (FSI's instance-id target).
+    pub id_target: Option<wgpu::TextureFormat>,
+    /// Faces culled (None for every shared pipeline: scanned meshes have holes through which their inside is
+    /// seen).
+    pub cull: Option<wgpu::Face>,
     pub depth_compare: wgpu::CompareFunction,
     pub depth_write: bool,
     pub blend: Option<wgpu::BlendState>,
@@ -266,6 +280,8 @@ impl MeshPipeline<'_> {
             label,
             morph: false,
             fragment: Some("fs_opaque"),
+            id_target: None,
+            cull: None,
             depth_compare: wgpu::CompareFunction::Less,
             depth_write: true,
             blend: None,
@@ -277,7 +293,13 @@ impl MeshPipeline<'_> {
 impl SceneGpu {
     /// Builds a pipeline over the shared vertex layout and shader (methods call this in their constructors).
     pub fn mesh_pipeline(&self, d: &MeshPipeline<'_>) -> wgpu::RenderPipeline {
-        mesh_pipeline(&self.device, &self.shader, &self.camera_layout, d)
+        mesh_pipeline(
+            &self.device,
+            &self.shader,
+            &self.camera_layout,
+            self.alpha_test,
+            d,
+        )
     }
 
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<SceneGpu> {
@@ -295,10 +317,13 @@ impl SceneGpu {
                     first_index: indices.len() as u32,
                     index_count: m.indices.len() as u32,
                 });
-                vertices.extend(m.positions.iter().zip(&m.normals).map(|(p, n)| Vertex {
-                    position: *p,
-                    normal: *n,
-                }));
+                vertices.extend(m.positions.iter().zip(&m.normals).zip(&m.aux).map(
+                    |((p, n), a)| Vertex {
+                        position: *p,
+                        normal: *n,
+                        aux: *a,
+                    },
+                ));
                 indices.extend_from_slice(&m.indices);
             }
             lods.push(ranges);
@@ -344,10 +369,19 @@ impl SceneGpu {
             label: Some("mesh.wgsl"),
             source: wgpu::ShaderSource::Wgsl(MESH_WGSL.into()),
         });
+        let alpha_test = scene.models.iter().any(|m| {
+            m.chain.lods.iter().any(|l| {
+                l.mesh
+                    .aux
+                    .iter()
+                    .any(|a| a[2] == crate::mesh::AUX_LEAF || a[2] == crate::mesh::AUX_LEAF_CLUSTER)
+            })
+        });
         let opaque_pipeline = mesh_pipeline(
             device,
             &shader,
             &camera_layout,
+            alpha_test,
             &MeshPipeline::opaque("opaque pipeline"),
         );
         ctx.check_errors()?;
@@ -362,6 +396,7 @@ impl SceneGpu {
             camera_bind_group,
             shader,
             opaque_pipeline,
+            alpha_test,
         })
     }
 
@@ -538,6 +573,7 @@ fn mesh_pipeline(
     device: &wgpu::Device,
     shader: &wgpu::ShaderModule,
     camera_layout: &wgpu::BindGroupLayout,
+    alpha_test: bool,
     d: &MeshPipeline<'_>,
 ) -> wgpu::RenderPipeline {
     let mut layouts: Vec<Option<&wgpu::BindGroupLayout>> = vec![Some(camera_layout)];
@@ -560,23 +596,46 @@ fn mesh_pipeline(
     } else {
         vec![Some(vertex), Some(instance)]
     };
-    let targets = [Some(wgpu::ColorTargetState {
+    let mut targets = vec![Some(wgpu::ColorTargetState {
         format: COLOR_FORMAT,
         blend: d.blend,
         write_mask: wgpu::ColorWrites::ALL,
     })];
+    if let Some(format) = d.id_target {
+        targets.push(Some(wgpu::ColorTargetState {
+            format,
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        }));
+    }
+    let constants: &[(&str, f64)] = if alpha_test {
+        &[("ALPHA_TEST", 1.0)]
+    } else {
+        &[]
+    };
+    let compilation_options = wgpu::PipelineCompilationOptions {
+        constants,
+        ..Default::default()
+    };
+    // Depth-only passes need a fragment stage only to apply the alpha-test mask.
+    let (fragment, targets): (Option<&str>, &[Option<wgpu::ColorTargetState>]) =
+        match (d.fragment, alpha_test) {
+            (Some(f), _) => (Some(f), &targets),
+            (None, true) => (Some("fs_depth_masked"), &[]),
+            (None, false) => (None, &[]),
+        };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(d.label),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
             module: shader,
             entry_point: Some(if d.morph { "vs_morph" } else { "vs_main" }),
-            compilation_options: Default::default(),
+            compilation_options: compilation_options.clone(),
             buffers: &buffers,
         },
         primitive: wgpu::PrimitiveState {
             topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: None,
+            cull_mode: d.cull,
             ..Default::default()
         },
         depth_stencil: Some(wgpu::DepthStencilState {
@@ -587,11 +646,11 @@ fn mesh_pipeline(
             bias: Default::default(),
         }),
         multisample: wgpu::MultisampleState::default(),
-        fragment: d.fragment.map(|entry| wgpu::FragmentState {
+        fragment: fragment.map(|entry| wgpu::FragmentState {
             module: shader,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
-            targets: &targets,
+            compilation_options,
+            targets,
         }),
         multiview_mask: None,
         cache: None,
@@ -684,7 +743,7 @@ mod tests {
     use super::*;
 
     fn raw(id: f32) -> InstanceRaw {
-        InstanceRaw::new(&Mat4::IDENTITY, [1.0, 1.0, 1.0], [0.0, 0.0, 0.0, id])
+        InstanceRaw::new(&Mat4::IDENTITY, [1.0, 1.0, 1.0, 0.0], [0.0, 0.0, 0.0, id])
     }
 
     #[test]

@@ -24,35 +24,37 @@ pub struct GpuTimer {
 impl GpuTimer {
     /// None when the device has no timestamp queries (then frames are timed with the CPU clock only).
     pub fn new(ctx: &GpuContext, frames: u32) -> Option<GpuTimer> {
-        if !ctx
-            .device
-            .features()
-            .contains(wgpu::Features::TIMESTAMP_QUERY)
-        {
+        Self::on_device(&ctx.device, ctx.timestamp_period_ns, frames)
+    }
+
+    /// [`GpuTimer::new`] for code that holds only the device (methods timing one of their own passes);
+    /// `period_ns` is the queue's timestamp period.
+    pub fn on_device(device: &wgpu::Device, period_ns: f32, frames: u32) -> Option<GpuTimer> {
+        if !device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
             return None;
         }
         let frames = frames.max(1);
         let size = frames as u64 * SLOT;
         Some(GpuTimer {
-            query_set: ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
+            query_set: device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("frame timestamps"),
                 ty: wgpu::QueryType::Timestamp,
                 count: RING * 2,
             }),
-            resolve: ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            resolve: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("timestamp resolve"),
                 size,
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
-            readback: ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            readback: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("timestamp read-back"),
                 size,
                 usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             frames,
-            period_ns: ctx.timestamp_period_ns as f64,
+            period_ns: period_ns as f64,
         })
     }
 

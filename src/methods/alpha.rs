@@ -26,6 +26,8 @@ impl Alpha {
                 label: "alpha translucent",
                 morph: false,
                 fragment: Some("fs_translucent"),
+                id_target: None,
+                cull: None,
                 depth_compare: wgpu::CompareFunction::LessEqual,
                 depth_write: false,
                 blend: Some(OVER),

@@ -28,6 +28,8 @@ impl AlphaZWrite {
                 label,
                 morph: false,
                 fragment: Some("fs_translucent"),
+                id_target: None,
+                cull: None,
                 depth_compare,
                 depth_write: true,
                 blend: Some(OVER),

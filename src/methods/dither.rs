@@ -108,6 +108,8 @@ impl Dither {
                 label,
                 morph: false,
                 fragment: Some(fragment),
+                id_target: None,
+                cull: None,
                 depth_compare: wgpu::CompareFunction::Less,
                 depth_write: true,
                 blend: None,

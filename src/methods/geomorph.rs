@@ -37,12 +37,14 @@ impl Geomorph {
                         targets.extend(t.positions.iter().zip(&t.normals).map(|(p, n)| Vertex {
                             position: *p,
                             normal: *n,
+                            aux: [0.0; 4],
                         }));
                     }
                     None => targets.extend(lod.mesh.positions.iter().zip(&lod.mesh.normals).map(
                         |(p, n)| Vertex {
                             position: *p,
                             normal: *n,
+                            aux: [0.0; 4],
                         },
                     )),
                 }

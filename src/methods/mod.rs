@@ -6,6 +6,7 @@ mod alpha_2pass;
 mod alpha_zwrite;
 mod discrete;
 mod dither;
+pub mod fsi;
 mod geomorph;
 mod reference;
 
@@ -14,7 +15,7 @@ use crate::gpu::renderer::{
     DrawList, DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu,
 };
 use crate::morph::Correspondence;
-use crate::noise::NoisePattern;
+use crate::noise::{NoisePattern, VisTexture};
 use crate::scene::Scene;
 use crate::schedule::InstanceState;
 use glam::Mat4;
@@ -28,6 +29,9 @@ pub const METHODS: &[&str] = &[
     "alpha-zwrite",
     "dither",
     "geomorph",
+    "fsi",
+    "fsi-noreproject",
+    "fsi-sameframe",
 ];
 
 /// Settings some methods read (recorded in run.json with the rest of the config).
@@ -35,6 +39,7 @@ pub const METHODS: &[&str] = &[
 pub struct MethodOptions {
     pub noise: NoisePattern,
     pub correspondence: Correspondence,
+    pub vis_texture: VisTexture,
     pub seed: u64,
 }
 
@@ -43,6 +48,7 @@ impl Default for MethodOptions {
         MethodOptions {
             noise: NoisePattern::White16,
             correspondence: Correspondence::Nearest,
+            vis_texture: VisTexture::Noise,
             seed: 1,
         }
     }
@@ -58,6 +64,8 @@ pub struct FrameInput<'a> {
     pub matrices: &'a [Mat4],
     /// Camera-to-instance-centre distance per instance (what LOD selection used).
     pub distances: &'a [f32],
+    /// This frame belongs to the timing pass (methods that time a pass of their own do it only then).
+    pub timed: bool,
 }
 
 pub trait Method {
@@ -77,6 +85,17 @@ pub trait Method {
     fn extra_target_bytes(&self) -> u64 {
         0
     }
+
+    /// GPU milliseconds per frame of the method's own named stage over the last timing pass (FSI: its
+    /// combination pass), or None for methods without one.
+    fn stage_gpu_ms(&self, _ctx: &crate::gpu::GpuContext) -> Result<Option<Vec<Option<f64>>>> {
+        Ok(None)
+    }
+
+    /// Intermediate images worth seeing (`--dump-frames` writes them next to the frame): (name, target).
+    fn debug_targets(&self) -> Vec<(&'static str, &RenderTarget)> {
+        Vec::new()
+    }
 }
 
 /// Builds the method called `name` for `scene`; GPU objects are created here, once.
@@ -94,6 +113,24 @@ pub fn create(
         "alpha-zwrite" => Ok(Box::new(alpha_zwrite::AlphaZWrite::new(gpu, scene))),
         "dither" => Ok(Box::new(dither::Dither::new(gpu, scene, options))),
         "geomorph" => Ok(Box::new(geomorph::Geomorph::new(gpu, scene, options))),
+        "fsi" => Ok(Box::new(fsi::Fsi::new(
+            gpu,
+            scene,
+            options,
+            fsi::Variant::Sequential,
+        ))),
+        "fsi-noreproject" => Ok(Box::new(fsi::Fsi::new(
+            gpu,
+            scene,
+            options,
+            fsi::Variant::NoReproject,
+        ))),
+        "fsi-sameframe" => Ok(Box::new(fsi::Fsi::new(
+            gpu,
+            scene,
+            options,
+            fsi::Variant::SameFrame,
+        ))),
         _ => Err(Error::unknown("method", name, METHODS)),
     }
 }
@@ -208,9 +245,10 @@ pub(crate) fn instance_raw(
 ) -> InstanceRaw {
     let inst = &input.scene.instances[i];
     let model = &input.scene.models[inst.model as usize];
+    let [r, g, b] = model.color_of(lod);
     InstanceRaw::new(
         &input.matrices[i],
-        model.color,
+        [r, g, b, input.scene.animation_angle(i, input.frame)],
         [k, alpha, lod as f32, i as f32],
     )
 }

@@ -1,0 +1,98 @@
+// FSI combination pass (seed 000 sections 3.4-3.5), a compute pass over the pixels (a full-screen-triangle
+// render pass was recompiled by llvmpipe on every draw, costing milliseconds and ~1 MB of memory per frame). The newer LOD buffer is read at
+// the pixel; the older one through reprojection by eq. 2, p_old = P_old V_old V_new^-1 P_new^-1 p_new, using
+// the newer buffer's stored depth (or at the same pixel when `mode` = 1, the `fsi-noreproject` ablation).
+// A pixel that reprojects outside the older buffer takes the newer colour. Then per pixel:
+//   both ids 0 (two n-instances)              -> the newer colour;
+//   the same t-instance id in both            -> the average of the two colours (no depth test: coplanar LODs
+//                                                would z-fight), averaged in linear RGB;
+//   anything else (one t-instance)            -> the closer fragment, depths compared in the older frame's
+//                                                depth space (the newer depth reprojected by eq. 2).
+// Colours are read and written as the stored sRGB-encoded bytes (Rgba8Unorm views), so a pixel that takes one
+// buffer's colour is copied bit for bit; only averaged pixels are decoded, mixed and re-encoded.
+
+struct Combine {
+    // P_old * V_old * V_new^-1 * P_new^-1 (clip space of the newer frame to clip space of the older one).
+    reproject: mat4x4<f32>,
+    // Viewport size in pixels (x, y); z: mode, 0 = reproject, 1 = same pixel.
+    size_mode: vec4<f32>,
+};
+
+@group(0) @binding(0) var new_color: texture_2d<f32>;
+@group(0) @binding(1) var new_depth: texture_depth_2d;
+@group(0) @binding(2) var new_id: texture_2d<u32>;
+@group(0) @binding(3) var old_color: texture_2d<f32>;
+@group(0) @binding(4) var old_depth: texture_depth_2d;
+@group(0) @binding(5) var old_id: texture_2d<u32>;
+@group(0) @binding(6) var<uniform> combine: Combine;
+// The combined frame, as the sRGB-encoded bytes; copied into the frame's target afterwards.
+@group(0) @binding(7) var output: texture_storage_2d<rgba8unorm, write>;
+
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    let lo = c / 12.92;
+    let hi = pow((c + vec3<f32>(0.055)) / 1.055, vec3<f32>(2.4));
+    return select(hi, lo, c <= vec3<f32>(0.04045));
+}
+
+fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
+    let lo = c * 12.92;
+    let hi = 1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - vec3<f32>(0.055);
+    return select(hi, lo, c <= vec3<f32>(0.0031308));
+}
+
+// Where pixel centre `pos` of the newer frame, at depth `depth`, lies in the older frame: (x, y) in pixels,
+// z its depth there; w < 0 when it falls outside the older viewport or behind its camera.
+fn reproject(pos: vec2<f32>, depth: f32) -> vec4<f32> {
+    let size = combine.size_mode.xy;
+    let ndc = vec4<f32>(pos.x / size.x * 2.0 - 1.0, 1.0 - pos.y / size.y * 2.0, depth, 1.0);
+    let c = combine.reproject * ndc;
+    if (c.w <= 0.0) {
+        return vec4<f32>(0.0, 0.0, 0.0, -1.0);
+    }
+    let o = c.xyz / c.w;
+    let px = vec2<f32>((o.x + 1.0) * 0.5 * size.x, (1.0 - o.y) * 0.5 * size.y);
+    if (any(px < vec2<f32>(0.0)) || any(px >= size)) {
+        return vec4<f32>(0.0, 0.0, 0.0, -1.0);
+    }
+    return vec4<f32>(px, o.z, 1.0);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_combine(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(combine.size_mode.xy);
+    if (id.x >= size.x || id.y >= size.y) {
+        return;
+    }
+    let p = vec2<i32>(id.xy);
+    textureStore(output, p, combine_pixel(p, vec2<f32>(id.xy) + vec2<f32>(0.5)));
+}
+
+fn combine_pixel(p: vec2<i32>, pos: vec2<f32>) -> vec4<f32> {
+    let cn = textureLoad(new_color, p, 0);
+    let dn = textureLoad(new_depth, p, 0);
+    let idn = textureLoad(new_id, p, 0).r;
+    var q = p;
+    var dn_old = dn;
+    if (combine.size_mode.z < 0.5) {
+        let r = reproject(pos, dn);
+        if (r.w < 0.0) {
+            return cn;
+        }
+        q = vec2<i32>(floor(r.xy));
+        dn_old = r.z;
+    }
+    let co = textureLoad(old_color, q, 0);
+    let ido = textureLoad(old_id, q, 0).r;
+    if (idn == 0u && ido == 0u) {
+        return cn;
+    }
+    if (idn == ido) {
+        let mixed = 0.5 * (srgb_to_linear(cn.rgb) + srgb_to_linear(co.rgb));
+        return vec4<f32>(linear_to_srgb(mixed), 1.0);
+    }
+    let d_old = textureLoad(old_depth, q, 0);
+    if (d_old < dn_old) {
+        return co;
+    }
+    return cn;
+}

@@ -1,0 +1,830 @@
+//! `fsi`, `fsi-noreproject`, `fsi-sameframe`: Frame Sequential Interpolation (Scherzer and Wimmer 2008,
+//! seed 000 sections 3.2-3.5 and 4.1), the reference implementation of this harness, and its two ablations.
+//!
+//! Two LOD buffers (colour, depth, instance id) are used ping-pong: frame f renders the whole scene into buffer
+//! f mod 2; the other still holds frame f-1. n-instances are drawn normally with id 0. A t-instance gets id
+//! `instance index + 1` and alternates between `lod_from` and `lod_to` frame by frame (section 3.2, 4.1: a
+//! toggle counter per instance, started when its transition starts). The first frame of a transition shows
+//! the LOD that is complete at that moment (tau = 1: `lod_from` when the transition is entered at k < 0.5,
+//! `lod_to` when entered from the far end, k > 0.5), the one the previous frame showed as an n-instance;
+//! starting with the barely visible other LOD would lose the object for a frame, as the older buffer then
+//! holds it with id 0 (case 1 keeps the newer, empty pixel). Instances start transitions on different frames, so their toggles are out of
+//! phase and the triangle count stays even between frames. Each of its fragments is kept
+//! by eq. 1 where `visTex(p) <= tau`, p the object-space position before animation, the texture read at
+//! (p.x + p.z, p.y + p.z) (section 3.3) with one repeat per model radius (the paper leaves the scale open).
+//! tau follows Fig. 2 with the schedule's shared k: the incoming LOD has tau = min(1, 2k), the outgoing one
+//! tau = min(1, 2(1 - k)), so one of the two is always complete. A combination pass (shaders/fsi_combine.wgsl)
+//! then merges the two buffers into the frame (sections 3.4-3.5, eq. 2).
+//!
+//! Choices the paper leaves open, made here:
+//! - t-instances are drawn with back faces culled (n-instances are drawn like in every other method, two-sided).
+//!   Where eq. 1 discards a front fragment, a two-sided draw would show the object's own inside there with the
+//!   same id, and case 3 would average it with the other LOD's front: dark speckle all over the object. With
+//!   culling, what lies behind the object shows through, and case 2 picks the other LOD's front by depth.
+//! - Formats: colour Rgba8UnormSrgb (4 B), depth Depth32Float (4 B, the depth attachment itself, read as a
+//!   texture by the combination pass), id R16Uint (2 B; R32Uint when a scene has 65,535 instances or more):
+//!   10 bytes per pixel per buffer against the paper's 7 (24-bit colour, 16-bit float depth, 16-bit float id),
+//!   20 MiB for two 1024x1024 buffers against its 14 MB. wgpu has no 24-bit colour or 16-bit float depth
+//!   attachment; Depth16Unorm would lose precision the depth test of case 2 needs.
+//! - The average of case 3 is taken in linear RGB (the colour buffers are sRGB-encoded), like the blending of
+//!   the alpha methods.
+//! - When a frame does not follow the previous one (the first frame of a pass), no older buffer exists: the
+//!   other buffer is rendered in the same frame with the other LODs and the same camera (that frame costs
+//!   two scene renders, as `fsi-sameframe` always does).
+//! - `fsi-noreproject` reads the older buffer at the same pixel and compares the two stored depths as they are.
+//! - `fsi-sameframe` renders the whole scene into both buffers every frame (t-instances at `lod_from` in one and
+//!   `lod_to` in the other, same camera) and combines without reprojection: visibility textures without frame
+//!   sequencing.
+
+use super::{FrameInput, Method, MethodOptions};
+use crate::error::Result;
+use crate::gpu::renderer::{
+    DrawList, DrawStats, InstanceBuffer, InstanceRaw, MeshPipeline, RenderTarget, SceneGpu,
+};
+use crate::gpu::timing::GpuTimer;
+use crate::gpu::GpuContext;
+use crate::noise::{visibility_texture, VIS_TEXTURE_SIZE};
+use crate::scene::{Camera, Scene};
+use crate::schedule::InstanceState;
+use glam::{DMat4, Mat4};
+
+pub const COMBINE_WGSL: &str = include_str!("../../shaders/fsi_combine.wgsl");
+
+const N_PIPELINE: u8 = 0;
+const T_PIPELINE: u8 = 1;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Variant {
+    /// The paper's method: one LOD buffer per frame, the older one reprojected by eq. 2.
+    Sequential,
+    /// The older buffer read at the same pixel.
+    NoReproject,
+    /// Both LOD buffers rendered every frame, same camera.
+    SameFrame,
+}
+
+/// tau of eq. 1 for LOD `lod` of a t-instance in state `s` (Fig. 2): the incoming LOD fades in over the first
+/// half of the transition, the outgoing one fades out over the second.
+pub fn tau(s: &InstanceState, lod: u32) -> f32 {
+    let t = if lod == s.lod_to {
+        2.0 * s.k
+    } else {
+        2.0 * (1.0 - s.k)
+    };
+    // k comes from distances and carries rounding: at the midpoint both LODs must be complete.
+    if t >= 1.0 - 1e-5 {
+        1.0
+    } else {
+        t
+    }
+}
+
+/// The LOD a t-instance starts its toggle with: the one complete (tau = 1) when the transition is entered.
+pub fn first_lod(s: &InstanceState) -> u32 {
+    if s.k < 0.5 {
+        s.lod_from
+    } else {
+        s.lod_to
+    }
+}
+
+/// The LOD a t-instance shows `phase` frames after its transition started (its toggle counter), `first` being
+/// the LOD it started with: `first` on even phases, the other on odd ones.
+pub fn toggle_lod(s: &InstanceState, first: u32, phase: i64) -> u32 {
+    let other = if first == s.lod_from {
+        s.lod_to
+    } else {
+        s.lod_from
+    };
+    if phase.rem_euclid(2) == 0 {
+        first
+    } else {
+        other
+    }
+}
+
+/// Which LOD each t-instance shows in a buffer.
+#[derive(Debug, Clone, Copy)]
+enum Toggle {
+    /// The toggle counter at this frame (frame-sequential variants).
+    AtFrame(u32),
+    /// `lod_from` in buffer 0, `lod_to` in buffer 1 (`fsi-sameframe`).
+    Buffer(u32),
+}
+
+/// P_old V_old V_new^-1 P_new^-1 (eq. 2), computed in f64 so that a still camera gives the identity.
+pub fn reprojection(new: &Camera, old: &Camera) -> Mat4 {
+    let d = |m: Mat4| DMat4::from_cols_array(&m.to_cols_array().map(|x| x as f64));
+    let m = d(old.proj) * d(old.view) * d(new.view).inverse() * d(new.proj).inverse();
+    Mat4::from_cols_array(&m.to_cols_array().map(|x| x as f32))
+}
+
+/// The id format for `instances` instances (id 0 is reserved for n-instances).
+pub fn id_format(instances: usize) -> wgpu::TextureFormat {
+    if instances < u16::MAX as usize {
+        wgpu::TextureFormat::R16Uint
+    } else {
+        wgpu::TextureFormat::R32Uint
+    }
+}
+
+/// Bytes per pixel of one LOD buffer (colour + depth + id).
+pub fn lod_buffer_bytes_per_pixel(instances: usize) -> u64 {
+    let id = match id_format(instances) {
+        wgpu::TextureFormat::R16Uint => 2,
+        _ => 4,
+    };
+    4 + 4 + id
+}
+
+/// One LOD buffer: colour and depth (a [`RenderTarget`]) and the instance-id target.
+struct LodBuffer {
+    target: RenderTarget,
+    id: wgpu::Texture,
+    id_view: wgpu::TextureView,
+}
+
+/// A LOD buffer read back to the CPU (for tests and inspection): row-major, `width` x `height`.
+#[derive(Debug, Clone)]
+pub struct LodBufferImage {
+    pub width: u32,
+    pub height: u32,
+    /// RGBA8, sRGB-encoded.
+    pub color: Vec<u8>,
+    pub depth: Vec<f32>,
+    pub id: Vec<u32>,
+}
+
+impl LodBuffer {
+    fn new(gpu: &SceneGpu, label: &str, w: u32, h: u32, format: wgpu::TextureFormat) -> Self {
+        let target = RenderTarget::new(&gpu.device, label, w, h);
+        let id = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(&format!("{label} id")),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        LodBuffer {
+            id_view: id.create_view(&Default::default()),
+            id,
+            target,
+        }
+    }
+}
+
+/// A t-instance's toggle: the frame its transition started, its (lod_from, lod_to), the LOD it started with.
+type Started = (u32, (u32, u32), u32);
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct CombineRaw {
+    reproject: [[f32; 4]; 4],
+    size_mode: [f32; 4],
+}
+
+pub struct Fsi {
+    variant: Variant,
+    name: &'static str,
+    buffers: [LodBuffer; 2],
+    lists: [DrawList; 2],
+    instances: InstanceBuffer,
+    n_pipeline: wgpu::RenderPipeline,
+    t_pipeline: wgpu::RenderPipeline,
+    vis_group: wgpu::BindGroup,
+    combine_pipeline: wgpu::ComputePipeline,
+    /// The combination pass writes here (storage textures cannot be sRGB); copied into the frame's target.
+    combined: wgpu::Texture,
+    combined_view: wgpu::TextureView,
+    combine_layout: wgpu::BindGroupLayout,
+    combine_uniform: wgpu::Buffer,
+    /// Combine bind groups per (output target, newer buffer index).
+    combine_groups: Vec<(wgpu::Texture, [wgpu::BindGroup; 2])>,
+    /// The frame and camera the newer buffer of the last frame was rendered with.
+    previous: Option<(u32, Camera)>,
+    /// Per instance: the frame its current transition started, its (lod_from, lod_to) and its first LOD.
+    started: Vec<Option<Started>>,
+    combine_timer: Option<GpuTimer>,
+    /// Texture repeats per object-space unit, per model (1 / object-space radius).
+    repeats_per_unit: Vec<f32>,
+    id_bytes: u64,
+}
+
+impl Fsi {
+    pub fn new(gpu: &SceneGpu, scene: &Scene, options: &MethodOptions, variant: Variant) -> Self {
+        let device = &gpu.device;
+        let (w, h) = (scene.width, scene.height);
+        let format = id_format(scene.instances.len());
+        let buffers = [
+            LodBuffer::new(gpu, "fsi LOD buffer 0", w, h, format),
+            LodBuffer::new(gpu, "fsi LOD buffer 1", w, h, format),
+        ];
+        let vis_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("fsi visibility texture layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            }],
+        });
+        let side = VIS_TEXTURE_SIZE;
+        let vis = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("fsi visibility texture"),
+            size: wgpu::Extent3d {
+                width: side,
+                height: side,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        gpu.queue.write_texture(
+            vis.as_image_copy(),
+            bytemuck::cast_slice(&visibility_texture(options.vis_texture, options.seed)),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(side * 4),
+                rows_per_image: Some(side),
+            },
+            vis.size(),
+        );
+        let vis_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("fsi visibility texture"),
+            layout: &vis_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&vis.create_view(&Default::default())),
+            }],
+        });
+        let pipeline = |label, fragment, cull| {
+            gpu.mesh_pipeline(&MeshPipeline {
+                label,
+                morph: false,
+                fragment: Some(fragment),
+                id_target: Some(format),
+                cull,
+                depth_compare: wgpu::CompareFunction::Less,
+                depth_write: true,
+                blend: None,
+                extra_layouts: &[&vis_layout],
+            })
+        };
+        let n_pipeline = pipeline("fsi n-instances", "fs_fsi_n", None);
+        let t_pipeline = pipeline("fsi t-instances", "fs_fsi_t", Some(wgpu::Face::Back));
+
+        let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Texture {
+                sample_type,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let colour = wgpu::TextureSampleType::Float { filterable: false };
+        let combine_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("fsi combine layout"),
+            entries: &[
+                tex(0, colour),
+                tex(1, wgpu::TextureSampleType::Depth),
+                tex(2, wgpu::TextureSampleType::Uint),
+                tex(3, colour),
+                tex(4, wgpu::TextureSampleType::Depth),
+                tex(5, wgpu::TextureSampleType::Uint),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 7,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::Rgba8Unorm,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 6,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("fsi_combine.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(COMBINE_WGSL.into()),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("fsi combine"),
+            bind_group_layouts: &[Some(&combine_layout)],
+            immediate_size: 0,
+        });
+        let combine_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("fsi combine"),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some("cs_combine"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let combined = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("fsi combined frame"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8Unorm,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let combined_view = combined.create_view(&Default::default());
+        let combine_uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fsi combine uniform"),
+            size: std::mem::size_of::<CombineRaw>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let name = match variant {
+            Variant::Sequential => "fsi",
+            Variant::NoReproject => "fsi-noreproject",
+            Variant::SameFrame => "fsi-sameframe",
+        };
+        Fsi {
+            variant,
+            name,
+            buffers,
+            lists: [DrawList::default(), DrawList::default()],
+            instances: gpu
+                .create_instance_buffer("fsi instances", 2 * scene.instances.len() as u32),
+            n_pipeline,
+            t_pipeline,
+            vis_group,
+            combine_pipeline,
+            combined,
+            combined_view,
+            combine_layout,
+            combine_uniform,
+            combine_groups: Vec::new(),
+            previous: None,
+            started: vec![None; scene.instances.len()],
+            combine_timer: GpuTimer::on_device(
+                device,
+                gpu.queue.get_timestamp_period(),
+                scene.frames,
+            ),
+            repeats_per_unit: scene
+                .models
+                .iter()
+                .map(|m| m.scale / m.radius.max(f32::MIN_POSITIVE))
+                .collect(),
+            id_bytes: lod_buffer_bytes_per_pixel(scene.instances.len()) - 8,
+        }
+    }
+
+    /// Fills list `slot` with the scene as LOD buffer `parity` shows it and uploads it to its half of the
+    /// instance buffer.
+    fn prepare(&mut self, gpu: &SceneGpu, input: &FrameInput<'_>, slot: usize, toggle: Toggle) {
+        let list = &mut self.lists[slot];
+        list.clear();
+        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
+            let model = &input.scene.models[inst.model as usize];
+            let angle = input.scene.animation_angle(i, input.frame);
+            let matrix = &input.matrices[i];
+            if s.in_transition() {
+                let lod = match (toggle, self.started[i]) {
+                    (Toggle::Buffer(0), _) => s.lod_from,
+                    (Toggle::Buffer(_), _) => s.lod_to,
+                    (Toggle::AtFrame(f), Some((start, _, first))) => {
+                        toggle_lod(s, first, f as i64 - start as i64)
+                    }
+                    (Toggle::AtFrame(_), None) => first_lod(s),
+                };
+                let [r, g, b] = model.color_of(lod);
+                list.push(
+                    T_PIPELINE,
+                    inst.model,
+                    lod,
+                    InstanceRaw::new(
+                        matrix,
+                        [r, g, b, angle],
+                        [
+                            self.repeats_per_unit[inst.model as usize],
+                            tau(s, lod),
+                            lod as f32,
+                            (i + 1) as f32,
+                        ],
+                    ),
+                );
+            } else {
+                let lod = s.lod_from;
+                let [r, g, b] = model.color_of(lod);
+                list.push(
+                    N_PIPELINE,
+                    inst.model,
+                    lod,
+                    InstanceRaw::new(matrix, [r, g, b, angle], [0.0, 1.0, lod as f32, 0.0]),
+                );
+            }
+        }
+        list.build();
+        gpu.upload_at(
+            &self.instances,
+            slot as u32 * input.scene.instances.len() as u32,
+            list,
+        );
+    }
+
+    fn render(
+        &self,
+        gpu: &SceneGpu,
+        encoder: &mut wgpu::CommandEncoder,
+        slot: usize,
+        buffer: usize,
+        instances: u32,
+    ) -> DrawStats {
+        let b = &self.buffers[buffer];
+        let [r, g, bl] = crate::scene::BACKGROUND;
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("fsi LOD buffer pass"),
+            color_attachments: &[
+                Some(wgpu::RenderPassColorAttachment {
+                    view: &b.target.color_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color {
+                            r: r as f64,
+                            g: g as f64,
+                            b: bl as f64,
+                            a: 1.0,
+                        }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                }),
+                Some(wgpu::RenderPassColorAttachment {
+                    view: &b.id_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                }),
+            ],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &b.target.depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(1, &self.vis_group, &[]);
+        gpu.draw(
+            &mut pass,
+            &self.instances,
+            slot as u32 * instances,
+            &self.lists[slot],
+            &[&self.n_pipeline, &self.t_pipeline],
+        )
+    }
+
+    fn combine_group(&mut self, gpu: &SceneGpu, target: &RenderTarget) -> usize {
+        if let Some(i) = self
+            .combine_groups
+            .iter()
+            .position(|(t, _)| *t == target.color)
+        {
+            return i;
+        }
+        let make = |newer: usize| {
+            let (n, o) = (&self.buffers[newer], &self.buffers[1 - newer]);
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fsi combine inputs"),
+                layout: &self.combine_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&n.target.color_bytes_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&n.target.depth_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&n.id_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&o.target.color_bytes_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: wgpu::BindingResource::TextureView(&o.target.depth_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: wgpu::BindingResource::TextureView(&o.id_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: self.combine_uniform.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 7,
+                        resource: wgpu::BindingResource::TextureView(&self.combined_view),
+                    },
+                ],
+            })
+        };
+        let groups = [make(0), make(1)];
+        self.combine_groups.push((target.color.clone(), groups));
+        self.combine_groups.len() - 1
+    }
+}
+
+/// Copies one plane of `texture` (`bytes_per_texel` bytes per texel) into a tightly packed vector.
+fn read_plane(
+    ctx: &GpuContext,
+    texture: &wgpu::Texture,
+    aspect: wgpu::TextureAspect,
+    bytes_per_texel: u32,
+) -> Result<Vec<u8>> {
+    let (w, h) = (texture.width(), texture.height());
+    let row = (w * bytes_per_texel).div_ceil(256) * 256;
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("fsi LOD buffer read-back"),
+        size: row as u64 * h as u64,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(h),
+            },
+        },
+        texture.size(),
+    );
+    ctx.queue.submit([encoder.finish()]);
+    let tight = (w * bytes_per_texel) as usize;
+    ctx.read_buffer(&buffer, |bytes| {
+        let mut out = Vec::with_capacity(tight * h as usize);
+        for y in 0..h as usize {
+            out.extend_from_slice(&bytes[y * row as usize..y * row as usize + tight]);
+        }
+        out
+    })
+}
+
+impl Fsi {
+    /// Reads both LOD buffers back (colour, depth, id), after the frames that wrote them were submitted.
+    pub fn read_lod_buffers(&self, ctx: &GpuContext) -> Result<[LodBufferImage; 2]> {
+        let read = |b: &LodBuffer| -> Result<LodBufferImage> {
+            let color = read_plane(ctx, &b.target.color, wgpu::TextureAspect::All, 4)?;
+            let depth = read_plane(ctx, &b.target.depth, wgpu::TextureAspect::DepthOnly, 4)?;
+            let id_bytes = (self.id_bytes as u32).max(2);
+            let ids = read_plane(ctx, &b.id, wgpu::TextureAspect::All, id_bytes)?;
+            Ok(LodBufferImage {
+                width: b.target.width,
+                height: b.target.height,
+                color,
+                depth: bytemuck::pod_collect_to_vec(&depth),
+                id: if id_bytes == 2 {
+                    ids.chunks_exact(2)
+                        .map(|c| u16::from_le_bytes([c[0], c[1]]) as u32)
+                        .collect()
+                } else {
+                    bytemuck::pod_collect_to_vec(&ids)
+                },
+            })
+        };
+        Ok([read(&self.buffers[0])?, read(&self.buffers[1])?])
+    }
+}
+
+impl Method for Fsi {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn encode(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) -> DrawStats {
+        let f = input.frame;
+        let n = input.scene.instances.len() as u32;
+        let camera = input.scene.camera(f);
+        let newer = (f % 2) as usize;
+        let follows = matches!(self.previous, Some((p, _)) if p.wrapping_add(1) == f);
+        let mut stats = DrawStats::default();
+        if !follows {
+            self.started.fill(None);
+        }
+        for (i, s) in input.states.iter().enumerate() {
+            self.started[i] = match self.started[i] {
+                _ if !s.in_transition() => None,
+                Some((start, pair, first)) if pair == (s.lod_from, s.lod_to) => {
+                    Some((start, pair, first))
+                }
+                _ => Some((f, (s.lod_from, s.lod_to), first_lod(s))),
+            };
+        }
+        let (old_toggle, new_toggle) = match self.variant {
+            Variant::SameFrame => (
+                Toggle::Buffer(1 - newer as u32),
+                Toggle::Buffer(newer as u32),
+            ),
+            _ => (Toggle::AtFrame(f.wrapping_sub(1)), Toggle::AtFrame(f)),
+        };
+        let old_camera = match (self.variant, follows, self.previous) {
+            (Variant::SameFrame, _, _) | (_, false, _) | (_, true, None) => {
+                // Both buffers this frame, same camera (at a path's start: the previous frame as it would
+                // have been, the other LOD of each t-instance).
+                self.prepare(gpu, input, 1 - newer, old_toggle);
+                stats += self.render(gpu, encoder, 1 - newer, 1 - newer, n);
+                camera
+            }
+            (_, true, Some((_, c))) => c,
+        };
+        self.prepare(gpu, input, newer, new_toggle);
+        stats += self.render(gpu, encoder, newer, newer, n);
+        self.previous = Some((f, camera));
+
+        let same_pixel = self.variant != Variant::Sequential;
+        let raw = CombineRaw {
+            reproject: reprojection(&camera, &old_camera).to_cols_array_2d(),
+            size_mode: [
+                target.width as f32,
+                target.height as f32,
+                if same_pixel { 1.0 } else { 0.0 },
+                0.0,
+            ],
+        };
+        gpu.queue
+            .write_buffer(&self.combine_uniform, 0, bytemuck::bytes_of(&raw));
+        let g = self.combine_group(gpu, target);
+        let timer = self.combine_timer.as_ref().filter(|_| input.timed);
+        if let Some(t) = timer {
+            t.begin(encoder, f);
+        }
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("fsi combine pass"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.combine_pipeline);
+            pass.set_bind_group(0, &self.combine_groups[g].1[newer], &[]);
+            pass.dispatch_workgroups(target.width.div_ceil(8), target.height.div_ceil(8), 1);
+        }
+        // Same bytes, sRGB-tagged: copies between the two formats are plain copies.
+        encoder.copy_texture_to_texture(
+            self.combined.as_image_copy(),
+            target.color.as_image_copy(),
+            self.combined.size(),
+        );
+        if let Some(t) = timer {
+            t.end(encoder, f);
+        }
+        stats
+    }
+
+    fn extra_target_bytes(&self) -> u64 {
+        let px = self.buffers[0].target.width as u64 * self.buffers[0].target.height as u64;
+        2 * px * (8 + self.id_bytes)
+    }
+
+    fn stage_gpu_ms(&self, ctx: &GpuContext) -> Result<Option<Vec<Option<f64>>>> {
+        match &self.combine_timer {
+            Some(t) => Ok(Some(t.read(ctx)?)),
+            None => Ok(None),
+        }
+    }
+
+    fn debug_targets(&self) -> Vec<(&'static str, &RenderTarget)> {
+        vec![
+            ("lodbuffer0", &self.buffers[0].target),
+            ("lodbuffer1", &self.buffers[1].target),
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Vec3, Vec4};
+
+    fn st(from: u32, to: u32, k: f32) -> InstanceState {
+        InstanceState {
+            lod_from: from,
+            lod_to: to,
+            k,
+        }
+    }
+
+    #[test]
+    fn tau_follows_figure_2() {
+        // Incoming LOD fades in over the first half, outgoing fades out over the second.
+        let s = st(0, 1, 0.25);
+        assert_eq!(tau(&s, 1), 0.5);
+        assert_eq!(tau(&s, 0), 1.0);
+        let s = st(0, 1, 0.5);
+        assert_eq!((tau(&s, 0), tau(&s, 1)), (1.0, 1.0));
+        let s = st(0, 1, 0.75);
+        assert_eq!((tau(&s, 0), tau(&s, 1)), (0.5, 1.0));
+    }
+
+    #[test]
+    fn toggle_starts_with_the_outgoing_lod_and_alternates() {
+        let s = st(2, 3, 0.1);
+        assert_eq!(first_lod(&s), 2);
+        assert_eq!(toggle_lod(&s, 2, 0), 2);
+        assert_eq!(toggle_lod(&s, 2, 1), 3);
+        assert_eq!(toggle_lod(&s, 2, 2), 2);
+        assert_eq!(toggle_lod(&s, 2, -1), 3);
+        // Entered from the far end (k falling from 1): the complete LOD is lod_to.
+        let s = st(2, 3, 0.95);
+        assert_eq!(first_lod(&s), 3);
+        assert_eq!(toggle_lod(&s, 3, 0), 3);
+        assert_eq!(toggle_lod(&s, 3, 1), 2);
+    }
+
+    #[test]
+    fn reprojection_of_a_still_camera_is_the_identity() {
+        let c = Camera {
+            eye: Vec3::new(1.0, 2.0, 3.0),
+            view: Mat4::look_at_rh(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, Vec3::Y),
+            proj: Mat4::perspective_rh(0.8, 1.5, 0.1, 100.0),
+        };
+        let m = reprojection(&c, &c);
+        assert!(m.abs_diff_eq(Mat4::IDENTITY, 1e-6), "{m}");
+    }
+
+    #[test]
+    fn reprojection_maps_a_world_point_between_frames() {
+        let proj = Mat4::perspective_rh(0.8, 1.5, 0.1, 100.0);
+        let cam = |eye: Vec3| Camera {
+            eye,
+            view: Mat4::look_at_rh(eye, Vec3::new(0.0, 0.0, -10.0), Vec3::Y),
+            proj,
+        };
+        let (new, old) = (cam(Vec3::new(0.5, 0.0, 0.0)), cam(Vec3::ZERO));
+        let world = Vec4::new(0.7, -0.4, -8.0, 1.0);
+        let clip_new = new.proj * new.view * world;
+        let clip_old = old.proj * old.view * world;
+        let p_new = clip_new / clip_new.w;
+        let p = reprojection(&new, &old) * p_new;
+        let p_old = p / p.w;
+        assert!((p_old - clip_old / clip_old.w).abs().max_element() < 1e-5);
+    }
+
+    #[test]
+    fn buffer_bytes_against_the_paper() {
+        assert_eq!(lod_buffer_bytes_per_pixel(4000), 10);
+        assert_eq!(lod_buffer_bytes_per_pixel(70_000), 12);
+    }
+}
