@@ -13,6 +13,7 @@ pub mod methods;
 pub mod metrics;
 pub mod morph;
 pub mod noise;
+pub mod procgen;
 pub mod rng;
 pub mod runner;
 pub mod scene;
