@@ -17,7 +17,14 @@ use serde::Serialize;
 use std::sync::Arc;
 
 /// Every scene name `--scene` accepts.
-pub const SCENES: &[&str] = &["bunny-sweep", "bunny-grid"];
+pub const SCENES: &[&str] = &["bunny-sweep", "bunny-grid", "simple", "windmills", "trees"];
+
+/// Seed of the procedural scenes' models and layouts (tree shapes, instance jitter and yaw): fixed, so a
+/// scene is the same picture whatever `--seed` drives (the methods' noise).
+pub const SCENE_SEED: u64 = 2008;
+
+/// Rotation of the windmill blades per frame, radians (one turn in 5 s at 60 fps).
+pub const WINDMILL_SPIN_PER_FRAME: f32 = std::f32::consts::TAU / 300.0;
 
 /// The Stanford bunny, npm `bunny@1.0.1` (see scenes/README.md), compiled in so the binary needs no files.
 pub const BUNNY_OBJ: &[u8] = include_bytes!("../scenes/bunny.obj");
@@ -114,6 +121,9 @@ pub struct Scene {
     pub eye: Vec3,
     pub forward: Vec3,
     pub camera_mode: CameraMode,
+    /// Camera flight of the procedural scenes: the eye moves from `.0` to `.1` at constant speed over the
+    /// frames, looking along `forward`; None = the eye stays at `eye`.
+    pub flight: Option<(Vec3, Vec3)>,
     pub schedule: ScheduleParams,
 }
 
@@ -131,6 +141,8 @@ pub struct SceneDef {
     pub counts: Vec<u32>,
     pub camera_mode: CameraMode,
     pub mesh_source: String,
+    /// Milliseconds spent building the models' LOD chains (once per scene, never per instance).
+    pub lod_generation_ms: f64,
 }
 
 impl SceneDef {
@@ -140,6 +152,10 @@ impl SceneDef {
         }
         let pv = cfg.resolved(name);
         let fov_y = cfg.fov_deg.to_radians();
+        if !name.starts_with("bunny") {
+            return procedural_def(name, cfg, pv.frames, pv.width, pv.height, fov_y);
+        }
+        let started = std::time::Instant::now();
         let (mesh, mesh_source) = match &cfg.mesh {
             Some(p) => (Mesh::load_obj(p)?, p.display().to_string()),
             None => (
@@ -148,9 +164,12 @@ impl SceneDef {
             ),
         };
         let model = bunny_model(&mesh, cfg, pv.height, fov_y)?;
-        let counts = match name {
-            "bunny-grid" => cfg.counts(),
-            _ => vec![1],
+        let lod_generation_ms = started.elapsed().as_secs_f64() * 1e3;
+        // The sweep is one bunny whatever --count says.
+        let counts = if name == "bunny-sweep" {
+            vec![1]
+        } else {
+            cfg.counts(name)
         };
         Ok(SceneDef {
             name: name.to_string(),
@@ -163,10 +182,14 @@ impl SceneDef {
             counts,
             camera_mode: cfg.camera,
             mesh_source,
+            lod_generation_ms,
         })
     }
 
     pub fn instantiate(&self, count: u32) -> Scene {
+        if !self.name.starts_with("bunny") {
+            return self.instantiate_field(count);
+        }
         let m = &self.models[0];
         let b = self.schedule.band;
         let h = self.schedule.hysteresis;
@@ -226,9 +249,147 @@ impl SceneDef {
             eye: Vec3::ZERO,
             forward: Vec3::X,
             camera_mode: self.camera_mode,
+            flight: None,
             schedule: self.schedule,
         }
     }
+
+    /// The procedural scenes (seed 000 section 4): `count` instances on a jittered square grid on the ground
+    /// plane (spacing 2.5 model radii, jitter +-0.3 spacing, random yaw; SCENE_SEED), and a camera flight
+    /// along +z at a fixed height over the middle of the field, looking 12 degrees down: it starts back from
+    /// the field's near edge by 1.1 times the last switch distance (so the nearest instances start at the
+    /// coarsest LOD) and ends over the far edge, so instances keep entering and leaving transitions.
+    fn instantiate_field(&self, count: u32) -> Scene {
+        let m = &self.models[0];
+        let spacing = 2.5 * m.radius;
+        let side = (count as f32).sqrt().ceil().max(1.0) as u32;
+        let half = (side as f32 - 1.0) * spacing * 0.5;
+        let mut rng = crate::rng::SplitMix64::new(SCENE_SEED ^ count as u64);
+        let instances: Vec<Instance> = (0..count)
+            .map(|i| {
+                let (gx, gz) = ((i % side) as f32, (i / side) as f32);
+                let jx = (rng.next_f32() - 0.5) * 0.6 * spacing;
+                let jz = (rng.next_f32() - 0.5) * 0.6 * spacing;
+                Instance {
+                    model: 0,
+                    // The bounding-sphere centre's height above the ground (the model's base sits at y = 0).
+                    position: Vec3::new(
+                        gx * spacing - half + jx,
+                        m.center.y,
+                        gz * spacing - half + jz,
+                    ),
+                    yaw: rng.next_f32() * std::f32::consts::TAU,
+                }
+            })
+            .collect();
+        let last = m.switches.last().copied().unwrap_or(10.0 * m.radius);
+        let height = 2.0 * m.radius + m.center.y;
+        let rows = count.div_ceil(side) as f32;
+        let z_far = (rows - 1.0) * spacing - half;
+        let from = Vec3::new(0.0, height, -half - 1.1 * last);
+        let to = Vec3::new(0.0, height, z_far);
+        let pitch = 12f32.to_radians();
+        let forward = Vec3::new(0.0, -pitch.sin(), pitch.cos());
+        let extent = (to - from).length() + 2.0 * half + 4.0 * m.radius + last;
+        Scene {
+            name: self.name.clone(),
+            count,
+            models: self.models.clone(),
+            instances,
+            motion: Motion::Static,
+            frames: self.frames,
+            width: self.width,
+            height: self.height,
+            fov_y: self.fov_y,
+            near: m.radius * 0.02,
+            far: extent * 1.5,
+            eye: from,
+            forward,
+            camera_mode: self.camera_mode,
+            flight: Some((from, to)),
+            schedule: self.schedule,
+        }
+    }
+}
+
+/// The models of a procedural scene, built once: SIMPLE's sphere and box, the windmill, the tree
+/// (`crate::procgen`). Switch distances: from the measured LOD errors and `--pixel-error` like the bunny's,
+/// except SIMPLE, whose box is no approximation of the sphere at any distance: it switches at 12 sphere
+/// radii (at 320x240 and 60 degrees the sphere is then about 17 pixels across), or at `--switch-distances`.
+fn procedural_def(
+    name: &str,
+    cfg: &SceneConfig,
+    frames: u32,
+    width: u32,
+    height: u32,
+    fov_y: f32,
+) -> Result<SceneDef> {
+    let started = std::time::Instant::now();
+    let (chain, spin, source) = match name {
+        "simple" => (
+            crate::procgen::simple_chain()?,
+            0.0,
+            "procedural (src/procgen.rs: sphere and box)",
+        ),
+        "windmills" => (
+            crate::procgen::windmill_chain()?,
+            WINDMILL_SPIN_PER_FRAME,
+            "procedural (src/procgen.rs: windmill)",
+        ),
+        _ => (
+            crate::procgen::tree_chain(SCENE_SEED)?,
+            0.0,
+            "procedural (src/procgen.rs: tree, seed SCENE_SEED = 2008)",
+        ),
+    };
+    let lod_generation_ms = started.elapsed().as_secs_f64() * 1e3;
+    let lod_colors = chain.lod_colors.clone();
+    let chain = chain.chain;
+    let (center, radius) = chain.lods[0].mesh.bounding_sphere();
+    let scale = 1.0;
+    let (switches, switch_source) = match (&cfg.switch_distances, name) {
+        (Some(s), _) => {
+            if s.len() != chain.lods.len() - 1 {
+                return Err(Error::Config(format!(
+                    "--switch-distances has {} values but {name} has {} LODs after LOD0",
+                    s.len(),
+                    chain.lods.len() - 1
+                )));
+            }
+            (s.clone(), "override")
+        }
+        (None, "simple") => (vec![12.0 * radius], "scene"),
+        (None, _) => (
+            lod::switch_distances(&chain, scale, cfg.pixel_error, height, fov_y),
+            "pixel-error",
+        ),
+    };
+    cfg.schedule.check_switches(name, &switches)?;
+    let model = Model {
+        name: name.trim_end_matches('s').to_string(),
+        color: lod_colors.first().copied().unwrap_or([0.7; 3]),
+        lod_colors,
+        spin_per_frame: spin,
+        chain,
+        switches,
+        switch_source,
+        center,
+        radius: radius * scale,
+        scale,
+    };
+    Ok(SceneDef {
+        name: name.to_string(),
+        models: Arc::from(vec![model]),
+        frames,
+        width,
+        height,
+        fov_y,
+        schedule: cfg.schedule,
+        counts: cfg.counts(name),
+        camera_mode: cfg.camera,
+        mesh_source: source.to_string(),
+        lod_generation_ms,
+    })
 }
 
 /// Yaw of the bunny instances: the classic three-quarter view, face to the right.
@@ -327,12 +488,21 @@ impl Scene {
     }
 
     pub fn camera(&self, frame: u32) -> Camera {
-        let (eye, view) = match self.camera_mode {
-            CameraMode::Fixed => (
+        let (eye, view) = match (self.camera_mode, self.flight) {
+            (_, Some((from, to))) => {
+                let t = if self.frames > 1 {
+                    frame as f32 / (self.frames - 1) as f32
+                } else {
+                    0.0
+                };
+                let eye = from.lerp(to, t);
+                (eye, Mat4::look_at_rh(eye, eye + self.forward, Vec3::Y))
+            }
+            (CameraMode::Fixed, None) => (
                 self.eye,
                 Mat4::look_at_rh(self.eye, self.eye + self.forward, Vec3::Y),
             ),
-            CameraMode::Orbit => {
+            (CameraMode::Orbit, None) => {
                 let target = match self.instances.first() {
                     Some(_) => self.instance_position(0, frame),
                     None => self.eye + self.forward,
@@ -394,6 +564,10 @@ pub struct SceneDescription {
     pub models: Vec<ModelDescription>,
     pub motion: Motion,
     pub camera: CameraMode,
+    /// Milliseconds to build the models' LOD chains (once per scene).
+    pub lod_generation_ms: f64,
+    /// Milliseconds to place the instances of the first count (once per block).
+    pub instance_build_ms: f64,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -414,7 +588,9 @@ pub struct LodDescription {
 
 impl SceneDef {
     pub fn describe(&self, cfg: &SceneConfig) -> SceneDescription {
+        let started = std::time::Instant::now();
         let first = self.instantiate(self.counts[0]);
+        let instance_build_ms = started.elapsed().as_secs_f64() * 1e3;
         SceneDescription {
             scene: self.name.clone(),
             profile: format!("{:?}", cfg.profile).to_lowercase(),
@@ -446,6 +622,8 @@ impl SceneDef {
                 .collect(),
             motion: first.motion,
             camera: self.camera_mode,
+            lod_generation_ms: self.lod_generation_ms,
+            instance_build_ms,
         }
     }
 }

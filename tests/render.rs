@@ -394,3 +394,85 @@ fn experiment_sweep_runs_and_merges() {
     assert_eq!(read_csv(&out.join("frames.csv")).len(), 2 * 2 * 4);
     assert!(out.join("experiment.json").is_file());
 }
+
+/// Mean absolute difference (of 255, over R, G, B) and the fraction of pixels off by more than 16 in any
+/// channel, between two RGBA8 images of the same size.
+fn image_difference(a: &[u8], b: &[u8]) -> (f64, f64) {
+    let mut sum = 0u64;
+    let mut bad = 0usize;
+    for (p, q) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        let worst = (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap_or(0);
+        sum += (0..3).map(|c| p[c].abs_diff(q[c]) as u64).sum::<u64>();
+        bad += (worst > 16) as usize;
+    }
+    let pixels = a.len() / 4;
+    (sum as f64 / (pixels * 3) as f64, bad as f64 / pixels as f64)
+}
+
+/// One frame of every scene at 96x72 per method against a blessed PNG (tests/snapshots/scenes/), with the
+/// tolerance of `snapshot_reference_frame`: mean absolute difference at most 0.5 of 255 and at most 0.5 % of
+/// pixels off by more than 16. Frame 2 of a 4-frame run: the procedural scenes' camera is then two thirds of
+/// the way through its flight, inside the field. Re-bless with `LODBENCH_BLESS=1 cargo test --test render
+/// snapshot`.
+#[test]
+fn snapshot_scenes_every_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = run_config(&[
+        "--width",
+        "96",
+        "--height",
+        "72",
+        "--frames",
+        "4",
+        "--warmup",
+        "0",
+        "--count",
+        "4",
+        "--dump-frames",
+        "--dump-every",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    runner::run(&cfg).expect("every scene and method renders");
+    let snaps = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots/scenes");
+    let bless = std::env::var_os("LODBENCH_BLESS").is_some();
+    std::fs::create_dir_all(&snaps).unwrap();
+    let mut problems = Vec::new();
+    let mut checked = 0;
+    for scene in lodbench::scene::SCENES {
+        let count = if *scene == "bunny-sweep" { 1 } else { 4 };
+        for method in lodbench::methods::METHODS {
+            let stem = format!("{scene}_{method}_c{count}_f00002_method.png");
+            let frame = out.join("frames").join(&stem);
+            let actual = image::open(&frame)
+                .unwrap_or_else(|e| panic!("{}: {e}", frame.display()))
+                .to_rgba8();
+            let snap = snaps.join(format!("{scene}_{method}.png"));
+            if bless {
+                actual.save(&snap).unwrap();
+                continue;
+            }
+            let expected = image::open(&snap)
+                .unwrap_or_else(|e| panic!("{}: {e} (bless with LODBENCH_BLESS=1)", snap.display()))
+                .to_rgba8();
+            let uniform = actual.pixels().all(|p| p == actual.get_pixel(0, 0));
+            let (mean, bad) = image_difference(actual.as_raw(), expected.as_raw());
+            if uniform || mean > 0.5 || bad > 0.005 {
+                problems.push(format!(
+                    "{scene} {method}: mean {mean:.3}, {:.3} % off by > 16{}",
+                    bad * 100.0,
+                    if uniform { ", uniform frame" } else { "" }
+                ));
+            }
+            checked += 1;
+        }
+    }
+    assert!(
+        problems.is_empty(),
+        "scene snapshots differ:\n{}",
+        problems.join("\n")
+    );
+    assert!(bless || checked == lodbench::scene::SCENES.len() * lodbench::methods::METHODS.len());
+}

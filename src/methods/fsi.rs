@@ -13,7 +13,11 @@
 //! by eq. 1 where `visTex(p) <= tau`, p the object-space position before animation, the texture read at
 //! (p.x + p.z, p.y + p.z) (section 3.3) with one repeat per model radius (the paper leaves the scale open).
 //! tau follows Fig. 2 with the schedule's shared k: the incoming LOD has tau = min(1, 2k), the outgoing one
-//! tau = min(1, 2(1 - k)), so one of the two is always complete. A combination pass (shaders/fsi_combine.wgsl)
+//! tau = min(1, 2(1 - k)), so one of the two is always complete, with one addition the paper leaves open:
+//! the frame-sequential variants widen the midpoint plateau by the instance's change of k since the previous
+//! frame ([`tau_with_margin`]), because the older buffer holds the other LOD at the previous k. Without it, a
+//! frame whose k steps across 0.5 combines two buffers with coinciding holes (measured on bunny-sweep, ci
+//! profile: max pop 0.0224 without, against discrete's 0.0167). A combination pass (shaders/fsi_combine.wgsl)
 //! then merges the two buffers into the frame (sections 3.4-3.5, eq. 2).
 //!
 //! Choices the paper leaves open, made here:
@@ -66,10 +70,19 @@ pub enum Variant {
 /// tau of eq. 1 for LOD `lod` of a t-instance in state `s` (Fig. 2): the incoming LOD fades in over the first
 /// half of the transition, the outgoing one fades out over the second.
 pub fn tau(s: &InstanceState, lod: u32) -> f32 {
+    tau_with_margin(s, lod, 0.0)
+}
+
+/// [`tau`] with the midpoint plateau, where both LODs are complete, widened by `margin` on each side:
+/// tau_to = min(1, 2 (k + margin)), tau_from = min(1, 2 (1 - k + margin)). FSI passes the instance's change of
+/// k since the previous frame: the older buffer was rendered with the previous k, and without the margin a
+/// frame whose k steps across 0.5 combines two buffers that both have holes (the visibility texture is the
+/// same for both LODs, so the holes coincide and the background shows through for a frame).
+pub fn tau_with_margin(s: &InstanceState, lod: u32, margin: f32) -> f32 {
     let t = if lod == s.lod_to {
-        2.0 * s.k
+        2.0 * (s.k + margin)
     } else {
-        2.0 * (1.0 - s.k)
+        2.0 * (1.0 - s.k + margin)
     };
     // k comes from distances and carries rounding: at the midpoint both LODs must be complete.
     if t >= 1.0 - 1e-5 {
@@ -213,6 +226,9 @@ pub struct Fsi {
     previous: Option<(u32, Camera)>,
     /// Per instance: the frame its current transition started, its (lod_from, lod_to) and its first LOD.
     started: Vec<Option<Started>>,
+    /// Per instance: k of the previous frame, and this frame's |k - previous k| (the tau margin).
+    previous_k: Vec<Option<f32>>,
+    margin: Vec<f32>,
     combine_timer: Option<GpuTimer>,
     /// Texture repeats per object-space unit, per model (1 / object-space radius).
     repeats_per_unit: Vec<f32>,
@@ -393,6 +409,8 @@ impl Fsi {
             combine_groups: Vec::new(),
             previous: None,
             started: vec![None; scene.instances.len()],
+            previous_k: vec![None; scene.instances.len()],
+            margin: vec![0.0; scene.instances.len()],
             combine_timer: GpuTimer::on_device(
                 device,
                 gpu.queue.get_timestamp_period(),
@@ -435,7 +453,7 @@ impl Fsi {
                         [r, g, b, angle],
                         [
                             self.repeats_per_unit[inst.model as usize],
-                            tau(s, lod),
+                            tau_with_margin(s, lod, self.margin[i]),
                             lod as f32,
                             (i + 1) as f32,
                         ],
@@ -664,6 +682,16 @@ impl Method for Fsi {
         let mut stats = DrawStats::default();
         if !follows {
             self.started.fill(None);
+            self.previous_k.fill(None);
+        }
+        let sequential = self.variant != Variant::SameFrame;
+        for (i, s) in input.states.iter().enumerate() {
+            let k = s.in_transition().then_some(s.k);
+            self.margin[i] = match (k, self.previous_k[i]) {
+                (Some(k), Some(p)) if sequential => (k - p).abs(),
+                _ => 0.0,
+            };
+            self.previous_k[i] = k;
         }
         for (i, s) in input.states.iter().enumerate() {
             self.started[i] = match self.started[i] {
@@ -776,6 +804,15 @@ mod tests {
         assert_eq!((tau(&s, 0), tau(&s, 1)), (1.0, 1.0));
         let s = st(0, 1, 0.75);
         assert_eq!((tau(&s, 0), tau(&s, 1)), (0.5, 1.0));
+    }
+
+    #[test]
+    fn margin_keeps_one_buffer_complete_across_the_midpoint() {
+        // k steps 0.48 -> 0.52: the older buffer holds lod_to at k = 0.48, the newer lod_from at k = 0.52.
+        let (old, new) = (st(0, 1, 0.48), st(0, 1, 0.52));
+        assert!(tau(&old, 1) < 1.0 && tau(&new, 0) < 1.0);
+        let m = 0.04;
+        assert!(tau_with_margin(&old, 1, m) == 1.0 || tau_with_margin(&new, 0, m) == 1.0);
     }
 
     #[test]
