@@ -143,7 +143,8 @@ def contact(scene, frames_dir, by_method, path):
     in_transition = [int(r["frame"]) for r in first if int(r["t_instances"]) > 0]
     if not in_transition:
         return False
-    dumped = sorted({int(p.name.split("_f")[1][:5]) for p in frames_dir.glob(f"{scene}_*_method.png")})
+    # The frame number is the last `_fNNNNN` before `_method.png` (method names may contain `_f`, e.g. fsi).
+    dumped = sorted({int(p.name[: -len("_method.png")][-5:]) for p in frames_dir.glob(f"{scene}_*_method.png")})
     if not dumped:
         return False
     mid = in_transition[len(in_transition) // 2] if len(in_transition) < 3 else in_transition[0]
