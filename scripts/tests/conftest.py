@@ -28,9 +28,10 @@ def lodbench(*args: str) -> None:
 
 @pytest.fixture(scope="session")
 def dump(tmp_path_factory) -> Path:
-    """bunny-sweep, discrete and dither, 60 frames at 160x120, every 5th frame dumped."""
+    """bunny-sweep, discrete, dither and fsi (a method name containing `_f`), 60 frames at 160x120, every 5th frame
+    dumped."""
     out = tmp_path_factory.mktemp("dump") / "run"
-    lodbench("run", "--scene", "bunny-sweep", "--method", "discrete,dither", "--width", "160", "--height", "120",
+    lodbench("run", "--scene", "bunny-sweep", "--method", "discrete,dither,fsi", "--width", "160", "--height", "120",
              "--frames", "60", "--warmup", "0", "--switch-distances", "14,16,18", "--dump-frames",
              "--dump-every", "5", "--out", str(out))
     return out

@@ -31,6 +31,7 @@ def test_sweep_folder(dump, tmp_path):
         with Image.open(folder / "figures" / name) as im:
             assert im.width > 300 and im.height > 200
     assert "| bunny-sweep | dither |" in report
+    assert "| bunny-sweep | fsi |" in report
 
 
 def test_grid_folder_gets_fig5(grid, tmp_path):
