@@ -52,6 +52,12 @@ def switch_frames(rows):
     return [i for i in range(1, len(lod)) if lod[i] != lod[i - 1]]
 
 
+def save(fig, path):
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def sweep_figure(scene, by_method, path):
     fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
     first = next(iter(by_method.values()))
@@ -67,9 +73,7 @@ def sweep_figure(scene, by_method, path):
     axes[1].set_xlabel("frame (grey: discrete LOD switches)")
     axes[0].legend(ncol=4, fontsize=8)
     axes[0].set_title(f"{scene}: error along the path")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
 
 
 def fig6(scene, summary, path):
@@ -81,9 +85,7 @@ def fig6(scene, summary, path):
     ax.set_xticks(x, methods, rotation=20)
     ax.set_title(f"{scene}: popping per method (cf. seed 003 Fig. 6)")
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
 
 
 def fig5(scene, summary, path):
@@ -100,9 +102,7 @@ def fig5(scene, summary, path):
     ax.set_ylabel("median GPU frame time, ms")
     ax.set_title(f"{scene}: frame time against model count (cf. seed 003 Fig. 5)")
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
 
 
 def fig8(scene, summary, path):
@@ -117,9 +117,7 @@ def fig8(scene, summary, path):
     ax.set_ylabel("median GPU frame time, ms")
     ax.set_title(f"{scene}: frame time against viewport size (cf. seed 000 Fig. 8)")
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
 
 
 def cost(scene, summary, path):
@@ -133,9 +131,7 @@ def cost(scene, summary, path):
         ax.set_xlabel("median GPU frame time, ms")
         ax.set_ylabel(col)
     fig.suptitle(f"{scene}: error against cost")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
 
 
 def contact(scene, frames_dir, by_method, path):
