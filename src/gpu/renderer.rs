@@ -411,6 +411,37 @@ impl SceneGpu {
             .write_buffer(&self.camera_buffer, 0, bytemuck::bytes_of(&raw));
     }
 
+    /// A `side` x `side` R32Float texture holding `values` (row-major): the screen-space thresholds of
+    /// `dither`, the visibility texture of FSI. Read with `textureLoad` (no sampler).
+    pub fn create_value_texture(&self, label: &str, side: u32, values: &[f32]) -> wgpu::Texture {
+        debug_assert_eq!(values.len(), (side * side) as usize);
+        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: side,
+                height: side,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        self.queue.write_texture(
+            texture.as_image_copy(),
+            bytemuck::cast_slice(values),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(side * 4),
+                rows_per_image: Some(side),
+            },
+            texture.size(),
+        );
+        texture
+    }
+
     pub fn create_instance_buffer(&self, label: &str, capacity: u32) -> InstanceBuffer {
         let capacity = capacity.max(1);
         InstanceBuffer {

@@ -56,30 +56,7 @@ impl Dither {
         let (size, values) =
             threshold_texture(options.noise, options.seed).unwrap_or((0, vec![0.5]));
         let side = size.max(1);
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("dither thresholds"),
-            size: wgpu::Extent3d {
-                width: side,
-                height: side,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        gpu.queue.write_texture(
-            texture.as_image_copy(),
-            bytemuck::cast_slice(&values),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(side * 4),
-                rows_per_image: Some(side),
-            },
-            texture.size(),
-        );
+        let texture = gpu.create_value_texture("dither thresholds", side, &values);
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("dither params"),
             size: 16,

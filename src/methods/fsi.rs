@@ -40,10 +40,10 @@
 //!   `lod_to` in the other, same camera) and combines without reprojection: visibility textures without frame
 //!   sequencing.
 
-use super::{FrameInput, Method, MethodOptions};
+use super::{instance_raw_with, FrameInput, Method, MethodOptions};
 use crate::error::Result;
 use crate::gpu::renderer::{
-    DrawList, DrawStats, InstanceBuffer, InstanceRaw, MeshPipeline, RenderTarget, SceneGpu,
+    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu,
 };
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::GpuContext;
@@ -141,13 +141,17 @@ pub fn id_format(instances: usize) -> wgpu::TextureFormat {
     }
 }
 
-/// Bytes per pixel of one LOD buffer (colour + depth + id).
-pub fn lod_buffer_bytes_per_pixel(instances: usize) -> u64 {
-    let id = match id_format(instances) {
+/// Bytes per texel of an id format of [`id_format`].
+fn id_bytes(format: wgpu::TextureFormat) -> u32 {
+    match format {
         wgpu::TextureFormat::R16Uint => 2,
         _ => 4,
-    };
-    4 + 4 + id
+    }
+}
+
+/// Bytes per pixel of one LOD buffer (colour + depth + id).
+pub fn lod_buffer_bytes_per_pixel(instances: usize) -> u64 {
+    4 + 4 + id_bytes(id_format(instances)) as u64
 }
 
 /// One LOD buffer: colour and depth (a [`RenderTarget`]) and the instance-id target.
@@ -217,11 +221,9 @@ pub struct Fsi {
     combine_pipeline: wgpu::ComputePipeline,
     /// The combination pass writes here (storage textures cannot be sRGB); copied into the frame's target.
     combined: wgpu::Texture,
-    combined_view: wgpu::TextureView,
-    combine_layout: wgpu::BindGroupLayout,
     combine_uniform: wgpu::Buffer,
-    /// Combine bind groups per (output target, newer buffer index).
-    combine_groups: Vec<(wgpu::Texture, [wgpu::BindGroup; 2])>,
+    /// The combination pass's inputs, indexed by the newer buffer.
+    combine_groups: [wgpu::BindGroup; 2],
     /// The frame and camera the newer buffer of the last frame was rendered with.
     previous: Option<(u32, Camera)>,
     /// Per instance: the frame its current transition started, its (lod_from, lod_to) and its first LOD.
@@ -232,7 +234,7 @@ pub struct Fsi {
     combine_timer: Option<GpuTimer>,
     /// Texture repeats per object-space unit, per model (1 / object-space radius).
     repeats_per_unit: Vec<f32>,
-    id_bytes: u64,
+    id_format: wgpu::TextureFormat,
 }
 
 impl Fsi {
@@ -257,30 +259,10 @@ impl Fsi {
                 count: None,
             }],
         });
-        let side = VIS_TEXTURE_SIZE;
-        let vis = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("fsi visibility texture"),
-            size: wgpu::Extent3d {
-                width: side,
-                height: side,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        gpu.queue.write_texture(
-            vis.as_image_copy(),
-            bytemuck::cast_slice(&visibility_texture(options.vis_texture, options.seed)),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(side * 4),
-                rows_per_image: Some(side),
-            },
-            vis.size(),
+        let vis = gpu.create_value_texture(
+            "fsi visibility texture",
+            VIS_TEXTURE_SIZE,
+            &visibility_texture(options.vis_texture, options.seed),
         );
         let vis_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("fsi visibility texture"),
@@ -386,6 +368,39 @@ impl Fsi {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let combine_group = |newer: usize| {
+            let (n, o) = (&buffers[newer], &buffers[1 - newer]);
+            let views = [
+                &n.target.color_bytes_view,
+                &n.target.depth_view,
+                &n.id_view,
+                &o.target.color_bytes_view,
+                &o.target.depth_view,
+                &o.id_view,
+            ];
+            let mut entries: Vec<wgpu::BindGroupEntry> = views
+                .into_iter()
+                .enumerate()
+                .map(|(binding, view)| wgpu::BindGroupEntry {
+                    binding: binding as u32,
+                    resource: wgpu::BindingResource::TextureView(view),
+                })
+                .collect();
+            entries.push(wgpu::BindGroupEntry {
+                binding: 6,
+                resource: combine_uniform.as_entire_binding(),
+            });
+            entries.push(wgpu::BindGroupEntry {
+                binding: 7,
+                resource: wgpu::BindingResource::TextureView(&combined_view),
+            });
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("fsi combine inputs"),
+                layout: &combine_layout,
+                entries: &entries,
+            })
+        };
+        let combine_groups = [combine_group(0), combine_group(1)];
         let name = match variant {
             Variant::Sequential => "fsi",
             Variant::NoReproject => "fsi-noreproject",
@@ -403,10 +418,8 @@ impl Fsi {
             vis_group,
             combine_pipeline,
             combined,
-            combined_view,
-            combine_layout,
             combine_uniform,
-            combine_groups: Vec::new(),
+            combine_groups,
             previous: None,
             started: vec![None; scene.instances.len()],
             previous_k: vec![None; scene.instances.len()],
@@ -421,7 +434,7 @@ impl Fsi {
                 .iter()
                 .map(|m| m.scale / m.radius.max(f32::MIN_POSITIVE))
                 .collect(),
-            id_bytes: lod_buffer_bytes_per_pixel(scene.instances.len()) - 8,
+            id_format: format,
         }
     }
 
@@ -431,9 +444,6 @@ impl Fsi {
         let list = &mut self.lists[slot];
         list.clear();
         for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            let model = &input.scene.models[inst.model as usize];
-            let angle = input.scene.animation_angle(i, input.frame);
-            let matrix = &input.matrices[i];
             if s.in_transition() {
                 let lod = match (toggle, self.started[i]) {
                     (Toggle::Buffer(0), _) => s.lod_from,
@@ -443,30 +453,26 @@ impl Fsi {
                     }
                     (Toggle::AtFrame(_), None) => first_lod(s),
                 };
-                let [r, g, b] = model.color_of(lod);
+                let params = [
+                    self.repeats_per_unit[inst.model as usize],
+                    tau_with_margin(s, lod, self.margin[i]),
+                    lod as f32,
+                    (i + 1) as f32,
+                ];
                 list.push(
                     T_PIPELINE,
                     inst.model,
                     lod,
-                    InstanceRaw::new(
-                        matrix,
-                        [r, g, b, angle],
-                        [
-                            self.repeats_per_unit[inst.model as usize],
-                            tau_with_margin(s, lod, self.margin[i]),
-                            lod as f32,
-                            (i + 1) as f32,
-                        ],
-                    ),
+                    instance_raw_with(input, i, lod, params),
                 );
             } else {
                 let lod = s.lod_from;
-                let [r, g, b] = model.color_of(lod);
+                let params = [0.0, 1.0, lod as f32, 0.0];
                 list.push(
                     N_PIPELINE,
                     inst.model,
                     lod,
-                    InstanceRaw::new(matrix, [r, g, b, angle], [0.0, 1.0, lod as f32, 0.0]),
+                    instance_raw_with(input, i, lod, params),
                 );
             }
         }
@@ -536,60 +542,6 @@ impl Fsi {
             &[&self.n_pipeline, &self.t_pipeline],
         )
     }
-
-    fn combine_group(&mut self, gpu: &SceneGpu, target: &RenderTarget) -> usize {
-        if let Some(i) = self
-            .combine_groups
-            .iter()
-            .position(|(t, _)| *t == target.color)
-        {
-            return i;
-        }
-        let make = |newer: usize| {
-            let (n, o) = (&self.buffers[newer], &self.buffers[1 - newer]);
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fsi combine inputs"),
-                layout: &self.combine_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&n.target.color_bytes_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&n.target.depth_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&n.id_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::TextureView(&o.target.color_bytes_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: wgpu::BindingResource::TextureView(&o.target.depth_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 5,
-                        resource: wgpu::BindingResource::TextureView(&o.id_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 6,
-                        resource: self.combine_uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 7,
-                        resource: wgpu::BindingResource::TextureView(&self.combined_view),
-                    },
-                ],
-            })
-        };
-        let groups = [make(0), make(1)];
-        self.combine_groups.push((target.color.clone(), groups));
-        self.combine_groups.len() - 1
-    }
 }
 
 /// Copies one plane of `texture` (`bytes_per_texel` bytes per texel) into a tightly packed vector.
@@ -642,7 +594,7 @@ impl Fsi {
         let read = |b: &LodBuffer| -> Result<LodBufferImage> {
             let color = read_plane(ctx, &b.target.color, wgpu::TextureAspect::All, 4)?;
             let depth = read_plane(ctx, &b.target.depth, wgpu::TextureAspect::DepthOnly, 4)?;
-            let id_bytes = (self.id_bytes as u32).max(2);
+            let id_bytes = id_bytes(self.id_format);
             let ids = read_plane(ctx, &b.id, wgpu::TextureAspect::All, id_bytes)?;
             Ok(LodBufferImage {
                 width: b.target.width,
@@ -735,7 +687,6 @@ impl Method for Fsi {
         };
         gpu.queue
             .write_buffer(&self.combine_uniform, 0, bytemuck::bytes_of(&raw));
-        let g = self.combine_group(gpu, target);
         let timer = self.combine_timer.as_ref().filter(|_| input.timed);
         if let Some(t) = timer {
             t.begin(encoder, f);
@@ -746,7 +697,7 @@ impl Method for Fsi {
                 timestamp_writes: None,
             });
             pass.set_pipeline(&self.combine_pipeline);
-            pass.set_bind_group(0, &self.combine_groups[g].1[newer], &[]);
+            pass.set_bind_group(0, &self.combine_groups[newer], &[]);
             pass.dispatch_workgroups(target.width.div_ceil(8), target.height.div_ceil(8), 1);
         }
         // Same bytes, sRGB-tagged: copies between the two formats are plain copies.
@@ -763,7 +714,7 @@ impl Method for Fsi {
 
     fn extra_target_bytes(&self) -> u64 {
         let px = self.buffers[0].target.width as u64 * self.buffers[0].target.height as u64;
-        2 * px * (8 + self.id_bytes)
+        2 * px * (8 + id_bytes(self.id_format) as u64)
     }
 
     fn stage_gpu_ms(&self, ctx: &GpuContext) -> Result<Option<Vec<Option<f64>>>> {

@@ -243,13 +243,24 @@ pub(crate) fn instance_raw(
     alpha: f32,
     lod: u32,
 ) -> InstanceRaw {
+    instance_raw_with(input, i, lod, [k, alpha, lod as f32, i as f32])
+}
+
+/// Instance i drawn at `lod`: its matrix, the LOD's colour and its animation angle this frame, with the
+/// method's own `params` (shaders/mesh.wgsl reads them per method).
+pub(crate) fn instance_raw_with(
+    input: &FrameInput<'_>,
+    i: usize,
+    lod: u32,
+    params: [f32; 4],
+) -> InstanceRaw {
     let inst = &input.scene.instances[i];
     let model = &input.scene.models[inst.model as usize];
     let [r, g, b] = model.color_of(lod);
     InstanceRaw::new(
         &input.matrices[i],
         [r, g, b, input.scene.animation_angle(i, input.frame)],
-        [k, alpha, lod as f32, i as f32],
+        params,
     )
 }
 
