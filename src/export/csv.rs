@@ -173,9 +173,13 @@ impl SummaryRecord {
     }
 }
 
-/// max over consecutive frames of |t_f - t_(f-1)| / t_(f-1), triangles t (0 for fewer than two frames).
+/// max over consecutive frames of |t_f - t_(f-1)| / t_(f-1), triangles t, from the second frame of the block
+/// on (0 for fewer than three frames): the block's first frame has no previous one to read, and FSI renders
+/// both LOD buffers there, a start-up cost and not the alternation the paper measures (section 4.1).
 pub fn tri_alternation_max(rows: &[FrameRecord]) -> f64 {
-    rows.windows(2)
+    rows.get(1..)
+        .unwrap_or_default()
+        .windows(2)
         .map(|w| {
             let (a, b) = (w[0].triangles as f64, w[1].triangles as f64);
             if a > 0.0 {
@@ -265,6 +269,25 @@ mod tests {
             flip_mean: None,
             combine_gpu_ms: None,
         }
+    }
+
+    #[test]
+    fn tri_alternation_leaves_out_the_first_frame() {
+        let with = |tris: &[u64]| {
+            let rows: Vec<FrameRecord> = tris
+                .iter()
+                .enumerate()
+                .map(|(f, &t)| FrameRecord {
+                    triangles: t,
+                    ..row(f as u32, None, 0.0, 0.0)
+                })
+                .collect();
+            tri_alternation_max(&rows)
+        };
+        // FSI's first frame renders both LOD buffers: 200 -> 100 is left out; 100 -> 110 is 10 %.
+        assert!((with(&[200, 100, 110, 100]) - 0.1).abs() < 1e-12);
+        assert_eq!(with(&[200, 100]), 0.0);
+        assert_eq!(with(&[]), 0.0);
     }
 
     #[test]

@@ -9,7 +9,8 @@
 //! `lod_to` when entered from the far end, k > 0.5), the one the previous frame showed as an n-instance;
 //! starting with the barely visible other LOD would lose the object for a frame, as the older buffer then
 //! holds it with id 0 (case 1 keeps the newer, empty pixel). Instances start transitions on different frames, so their toggles are out of
-//! phase and the triangle count stays even between frames. Each of its fragments is kept
+//! phase and the triangle count stays even between frames; the instances already in transition at a pass's
+//! first frame (all of them in a static scene) get phases that balance it ([`Fsi::balance_phases`]). Each of its fragments is kept
 //! by eq. 1 where `visTex(p) <= tau`, p the object-space position before animation, the texture read at
 //! (p.x + p.z, p.y + p.z) (section 3.3) with one repeat per model radius (the paper leaves the scale open).
 //! tau follows Fig. 2 with the schedule's shared k: the incoming LOD has tau = min(1, 2k), the outgoing one
@@ -199,8 +200,9 @@ impl LodBuffer {
     }
 }
 
-/// A t-instance's toggle: the frame its transition started, its (lod_from, lod_to), the LOD it started with.
-type Started = (u32, (u32, u32), u32);
+/// A t-instance's toggle: the frame its transition started (its phase 0; may be before the pass's first frame,
+/// see [`Fsi::encode`]), its (lod_from, lod_to), the LOD it started with.
+type Started = (i64, (u32, u32), u32);
 
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -438,6 +440,47 @@ impl Fsi {
         }
     }
 
+    /// At a pass's first frame: sets the toggle phase of the instances already in transition so that the
+    /// triangle count stays even between frames (section 4.1). A transition that starts mid-pass starts at
+    /// phase 0, its first frame showing the LOD that is complete, the one the older buffer holds as an
+    /// n-instance. At a pass's first frame both buffers are rendered now, so either phase is right, and
+    /// starting them all at phase 0 would toggle them in step (every instance of a static scene). Greedy:
+    /// largest triangle difference first, each instance given the phase that brings the running difference
+    /// between this frame and the next closest to zero.
+    fn balance_phases(&mut self, scene: &Scene, f: u32) {
+        let tris = |model: u32, lod: u32| -> i64 {
+            scene.models[model as usize]
+                .chain
+                .lods
+                .get(lod as usize)
+                .map_or(0, |l| l.mesh.triangle_count() as i64)
+        };
+        let mut diffs: Vec<(usize, i64)> = self
+            .started
+            .iter()
+            .enumerate()
+            .filter_map(|(i, st)| {
+                let (_, (from, to), first) = (*st)?;
+                let other = if first == from { to } else { from };
+                let model = scene.instances[i].model;
+                Some((i, tris(model, first) - tris(model, other)))
+            })
+            .collect();
+        diffs.sort_by_key(|&(i, d)| (std::cmp::Reverse(d.abs()), i));
+        let mut balance = 0i64;
+        for (i, d) in diffs {
+            if let Some(st) = self.started[i].as_mut() {
+                if balance.signum() * d.signum() > 0 {
+                    // Phase 1: the other LOD now, the first one next frame.
+                    st.0 = f as i64 - 1;
+                    balance -= d;
+                } else {
+                    balance += d;
+                }
+            }
+        }
+    }
+
     /// Fills list `slot` with the scene as LOD buffer `parity` shows it and uploads it to its half of the
     /// instance buffer.
     fn prepare(&mut self, gpu: &SceneGpu, input: &FrameInput<'_>, slot: usize, toggle: Toggle) {
@@ -449,7 +492,7 @@ impl Fsi {
                     (Toggle::Buffer(0), _) => s.lod_from,
                     (Toggle::Buffer(_), _) => s.lod_to,
                     (Toggle::AtFrame(f), Some((start, _, first))) => {
-                        toggle_lod(s, first, f as i64 - start as i64)
+                        toggle_lod(s, first, f as i64 - start)
                     }
                     (Toggle::AtFrame(_), None) => first_lod(s),
                 };
@@ -651,8 +694,11 @@ impl Method for Fsi {
                 Some((start, pair, first)) if pair == (s.lod_from, s.lod_to) => {
                     Some((start, pair, first))
                 }
-                _ => Some((f, (s.lod_from, s.lod_to), first_lod(s))),
+                _ => Some((f as i64, (s.lod_from, s.lod_to), first_lod(s))),
             };
+        }
+        if !follows {
+            self.balance_phases(input.scene, f);
         }
         let (old_toggle, new_toggle) = match self.variant {
             Variant::SameFrame => (
