@@ -219,6 +219,7 @@ impl<'a> BlockRunner<'a> {
         // Timing pass.
         driver.reset();
         let mut rows = Vec::with_capacity(frames as usize);
+        let uploads_before = self.gpu.uploads.get();
         let pass_start = Instant::now();
         for f in 0..frames {
             check_interrupt()?;
@@ -260,6 +261,10 @@ impl<'a> BlockRunner<'a> {
             progress.inc(1);
         }
         let timing_ms = pass_start.elapsed().as_secs_f64() * 1e3 / frames as f64;
+        let uploads_after = self.gpu.uploads.get();
+        let per_frame = |after: u64, before: u64| (after - before) as f64 / frames as f64;
+        let instance_bytes_listed_per_frame = per_frame(uploads_after.0, uploads_before.0);
+        let instance_bytes_written_per_frame = per_frame(uploads_after.1, uploads_before.1);
         if let Some(t) = &self.timer {
             for (row, ms) in rows.iter_mut().zip(t.read(ctx)?) {
                 row.gpu_ms = ms;
@@ -379,6 +384,8 @@ impl<'a> BlockRunner<'a> {
                 quality_to_timing_ratio: quality_ms / timing_ms,
                 metric_gpu_ms_median,
                 extra_target_bytes: method.extra_target_bytes(),
+                instance_bytes_listed_per_frame,
+                instance_bytes_written_per_frame,
             },
         })
     }

@@ -38,6 +38,10 @@ pub struct BlockInfo {
     /// Median GPU time of the metric kernel alone per quality-pass frame (None without timestamps).
     pub metric_gpu_ms_median: Option<f64>,
     pub extra_target_bytes: u64,
+    /// Instance data per timing-pass frame: what the method's draw lists held, and what was written to the
+    /// GPU (only the entries that changed since the previous upload into the same buffer range).
+    pub instance_bytes_listed_per_frame: f64,
+    pub instance_bytes_written_per_frame: f64,
 }
 
 #[derive(Debug, Clone, Serialize)]

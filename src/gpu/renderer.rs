@@ -7,6 +7,8 @@ use crate::gpu::context::GpuContext;
 use crate::scene::{Camera, Scene, BACKGROUND};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 use wgpu::util::DeviceExt;
 
 pub const MESH_WGSL: &str = include_str!("../../shaders/mesh.wgsl");
@@ -215,6 +217,43 @@ impl RenderTarget {
 pub struct InstanceBuffer {
     pub buffer: wgpu::Buffer,
     pub capacity: u32,
+    /// What the buffer holds (zeros at creation, as wgpu initialises buffers), so that an upload writes only
+    /// the entries that differ.
+    shadow: Mutex<Vec<InstanceRaw>>,
+}
+
+/// Unchanged entries between two changed ones that are written anyway to make one write of them (each
+/// `write_buffer` has a fixed cost).
+const UPLOAD_MERGE_GAP: usize = 8;
+
+/// Instance data written per frame: what the draw lists held and what was actually written.
+#[derive(Debug, Default)]
+pub struct UploadCounters {
+    listed: AtomicU64,
+    written: AtomicU64,
+}
+
+impl UploadCounters {
+    /// (bytes the draw lists held, bytes written) since the SceneGpu was built.
+    pub fn get(&self) -> (u64, u64) {
+        (
+            self.listed.load(Ordering::Relaxed),
+            self.written.load(Ordering::Relaxed),
+        )
+    }
+}
+
+/// The runs `[start, end)` where `new` differs from `old` (same length), runs closer than `gap` merged.
+pub fn changed_runs<T: Pod>(old: &[T], new: &[T], gap: usize) -> Vec<(usize, usize)> {
+    let differs = |i: usize| bytemuck::bytes_of(&old[i]) != bytemuck::bytes_of(&new[i]);
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for i in (0..new.len().min(old.len())).filter(|&i| differs(i)) {
+        match runs.last_mut() {
+            Some((_, end)) if i - *end <= gap => *end = i + 1,
+            _ => runs.push((i, i + 1)),
+        }
+    }
+    runs
 }
 
 /// The scene on the GPU: geometry, camera uniform, shared pipelines. Built once per scene block.
@@ -232,6 +271,7 @@ pub struct SceneGpu {
     pub opaque_pipeline: wgpu::RenderPipeline,
     /// The scene has alpha-tested geometry: every mesh pipeline is built with `ALPHA_TEST` on.
     pub alpha_test: bool,
+    pub uploads: UploadCounters,
 }
 
 pub fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 2] {
@@ -397,6 +437,7 @@ impl SceneGpu {
             shader,
             opaque_pipeline,
             alpha_test,
+            uploads: UploadCounters::default(),
         })
     }
 
@@ -452,6 +493,7 @@ impl SceneGpu {
                 mapped_at_creation: false,
             }),
             capacity,
+            shadow: Mutex::new(vec![InstanceRaw::zeroed(); capacity as usize]),
         }
     }
 
@@ -462,15 +504,41 @@ impl SceneGpu {
 
     /// Uploads a built draw list into `buffer` from instance `first` on (several lists can share one buffer
     /// in one submission when they use disjoint ranges).
+    /// Only the entries that differ from what the buffer already holds are written (see [`changed_runs`]).
     pub fn upload_at(&self, buffer: &InstanceBuffer, first: u32, list: &DrawList) {
-        debug_assert!(first as usize + list.instances.len() <= buffer.capacity as usize);
-        if !list.instances.is_empty() {
+        let new = &list.instances;
+        let first = first as usize;
+        debug_assert!(first + new.len() <= buffer.capacity as usize);
+        let size = std::mem::size_of::<InstanceRaw>();
+        let mut shadow = buffer
+            .shadow
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let Some(old) = shadow.get_mut(first..first + new.len()) else {
+            // Past the buffer's capacity: a bug, which wgpu's validation reports (ctx.check_errors).
             self.queue.write_buffer(
                 &buffer.buffer,
-                first as u64 * std::mem::size_of::<InstanceRaw>() as u64,
-                bytemuck::cast_slice(&list.instances),
+                (first * size) as u64,
+                bytemuck::cast_slice(new),
             );
+            return;
+        };
+        let mut written = 0;
+        for (start, end) in changed_runs(old, new, UPLOAD_MERGE_GAP) {
+            self.queue.write_buffer(
+                &buffer.buffer,
+                ((first + start) * size) as u64,
+                bytemuck::cast_slice(&new[start..end]),
+            );
+            old[start..end].copy_from_slice(&new[start..end]);
+            written += (end - start) * size;
         }
+        self.uploads
+            .listed
+            .fetch_add((new.len() * size) as u64, Ordering::Relaxed);
+        self.uploads
+            .written
+            .fetch_add(written as u64, Ordering::Relaxed);
     }
 
     /// Begins a pass that clears `target` to the background and its depth to 1.
@@ -795,5 +863,20 @@ mod tests {
         l.clear();
         l.build();
         assert!(l.draws.is_empty());
+    }
+
+    #[test]
+    fn uploads_write_only_changed_runs() {
+        let old = [0u32, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15];
+        assert!(changed_runs(&old, &old, 8).is_empty());
+        let mut new = old;
+        new[3] = 99;
+        assert_eq!(changed_runs(&old, &new, 8), vec![(3, 4)]);
+        // Two changes 2 apart merge into one write with gap 2, stay apart with gap 1.
+        new[6] = 99;
+        assert_eq!(changed_runs(&old, &new, 2), vec![(3, 7)]);
+        assert_eq!(changed_runs(&old, &new, 1), vec![(3, 4), (6, 7)]);
+        new[15] = 0;
+        assert_eq!(changed_runs(&old, &new, 1), vec![(3, 4), (6, 7), (15, 16)]);
     }
 }
