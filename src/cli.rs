@@ -142,6 +142,10 @@ pub struct RunArgs {
     /// With --dump-frames: every k-th frame only.
     #[arg(long, default_value_t = 1)]
     pub dump_every: u32,
+    /// With --dump-frames: only frames with an instance in transition (of those, every k-th frame with
+    /// --dump-every), so a long run's dumps land where methods differ.
+    #[arg(long)]
+    pub dump_transitions: bool,
 }
 
 #[derive(Debug, Clone, Args)]

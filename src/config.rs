@@ -217,6 +217,8 @@ pub struct RunConfig {
     pub adapter: Option<String>,
     pub dump_frames: bool,
     pub dump_every: u32,
+    /// With `dump_frames`: only frames with an instance in transition.
+    pub dump_transitions: bool,
     pub msaa_samples: u32,
     pub color_format: String,
     pub depth_format: String,
@@ -228,6 +230,12 @@ impl RunConfig {
         let methods = resolve_names("method", &a.method, methods::METHODS)?;
         if a.dump_every == 0 {
             return Err(Error::Config("--dump-every must be at least 1".into()));
+        }
+        if a.dump_transitions && !a.dump_frames {
+            return Err(Error::Config(
+                "--dump-transitions selects which frames --dump-frames writes: add --dump-frames"
+                    .into(),
+            ));
         }
         Ok(RunConfig {
             scenes,
@@ -243,6 +251,7 @@ impl RunConfig {
             adapter: a.adapter.clone(),
             dump_frames: a.dump_frames,
             dump_every: a.dump_every,
+            dump_transitions: a.dump_transitions,
             msaa_samples: 1,
             color_format: format!("{COLOR_FORMAT:?}"),
             depth_format: format!("{DEPTH_FORMAT:?}"),

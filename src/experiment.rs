@@ -65,6 +65,7 @@ struct RunKeys {
     adapter: Option<String>,
     dump_frames: Option<bool>,
     dump_every: Option<u32>,
+    dump_transitions: Option<bool>,
 }
 
 #[allow(dead_code)]
@@ -296,17 +297,20 @@ mod tests {
 
     #[test]
     fn shipped_experiments_validate() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/experiments");
+        // The paper-scale files and their CPU-scale companions in cpu/.
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/experiments");
         let mut n = 0;
-        for entry in std::fs::read_dir(dir).unwrap() {
-            let p = entry.unwrap().path();
-            if p.extension().is_some_and(|e| e == "toml") {
-                let e = Experiment::load(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-                assert!(!e.runs.is_empty());
-                n += 1;
+        for dir in [root.clone(), root.join("cpu")] {
+            for entry in std::fs::read_dir(dir).unwrap() {
+                let p = entry.unwrap().path();
+                if p.extension().is_some_and(|e| e == "toml") {
+                    let e = Experiment::load(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+                    assert!(!e.runs.is_empty());
+                    n += 1;
+                }
             }
         }
-        assert!(n >= 2);
+        assert!(n >= 8, "{n} experiment files");
     }
 
     #[test]

@@ -129,6 +129,8 @@ pub struct BlockRunner<'a> {
     flip: bool,
     /// Hand every `dump_every`-th frame's images to the caller.
     dump: bool,
+    /// With `dump`: only frames with an instance in transition (`--dump-transitions`).
+    dump_transitions_only: bool,
 }
 
 /// Keep at most this many quality-pass frames queued on the GPU.
@@ -176,7 +178,13 @@ impl<'a> BlockRunner<'a> {
             readback,
             flip,
             dump,
+            dump_transitions_only: false,
         })
+    }
+
+    /// Dump only frames with an instance in transition (of those, still every `dump_every`-th frame).
+    pub fn dump_transitions_only(&mut self, on: bool) {
+        self.dump_transitions_only = on;
     }
 
     /// Timing pass then quality pass of `method_name`. `on_frames` is called with the quality-pass images of
@@ -282,7 +290,7 @@ impl<'a> BlockRunner<'a> {
         let mut in_flight = std::collections::VecDeque::new();
         for f in 0..frames {
             check_interrupt()?;
-            driver.advance(f);
+            let facts = driver.advance(f);
             self.gpu.write_camera(&scene.camera(f));
             let input = driver.input(f);
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -296,7 +304,9 @@ impl<'a> BlockRunner<'a> {
             if let Some(t) = &self.metric_timer {
                 t.end(&mut encoder, f);
             }
-            let dump = self.dump && f % dump_every == 0;
+            let dump = self.dump
+                && f % dump_every == 0
+                && (!self.dump_transitions_only || facts.t_instances > 0);
             let read = match &self.readback {
                 Some((m, r)) if dump || self.flip => {
                     m.encode_copy(&mut encoder, &self.method_target);
@@ -523,6 +533,7 @@ fn run_blocks(
             };
             let flip = cfg.metrics.contains(&crate::metrics::Metric::Flip);
             let mut block = BlockRunner::new(&ctx, &scene, options, dumper.is_some(), flip)?;
+            block.dump_transitions_only(cfg.dump_transitions);
             for method in &cfg.methods {
                 progress.set_message(format!("{} n={} {}", def.name, count, method));
                 let out =

@@ -191,3 +191,68 @@ fn list_and_describe_work() {
         .collect();
     assert!(s.windows(2).all(|w| w[1] > w[0]), "{s:?}");
 }
+
+#[test]
+fn dump_transitions_dumps_only_frames_in_transition() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let out = lodbench(
+        &[
+            "run",
+            "--scene",
+            "bunny-sweep",
+            "--method",
+            "discrete",
+            "--profile",
+            "quick",
+            "--frames",
+            "200",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--warmup",
+            "0",
+            "--dump-frames",
+            "--dump-transitions",
+            "--dump-every",
+            "2",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let frames = std::fs::read_to_string(out_dir.join("frames.csv")).unwrap();
+    let mut lines = frames.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (frame, t) = (col("frame"), col("t_instances"));
+    let expected: Vec<u32> = lines
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|r| r[t] != "0")
+        .map(|r| r[frame].parse::<u32>().unwrap())
+        .filter(|f| f % 2 == 0)
+        .collect();
+    let mut dumped: Vec<u32> = std::fs::read_dir(out_dir.join("frames"))
+        .unwrap()
+        .filter_map(|e| {
+            let name = e.unwrap().file_name().into_string().unwrap();
+            let stem = name.strip_suffix("_method.png")?;
+            stem[stem.len() - 5..].parse().ok()
+        })
+        .collect();
+    dumped.sort();
+    assert!(
+        expected.len() >= 4,
+        "too few frames in transition: {expected:?}"
+    );
+    assert_eq!(dumped, expected);
+    // Without --dump-frames the flag is refused, with one error line.
+    let out = lodbench(&["run", "--dump-transitions"], &[]);
+    fails_with(&out, &["--dump-frames"]);
+}
