@@ -85,6 +85,11 @@ pub enum CameraMode {
     /// `ORBIT_AMPLITUDE_DEG` * sin(2 pi f / `ORBIT_PERIOD_FRAMES`), at the distance the fixed camera would have,
     /// so LOD selection sees the same distances for that point.
     Orbit,
+    /// bunny-sweep: the bunny stays where the sweep starts and the camera moves instead, backwards and forwards
+    /// along its line of sight through the same distances, so every frame shows what `fixed` shows (the same
+    /// relative geometry under a directional light) while the motion is the camera's, the motion eq. 2 of FSI
+    /// reprojects. Elsewhere the same as `fixed`.
+    Dolly,
 }
 
 pub const ORBIT_AMPLITUDE_DEG: f32 = 30.0;
@@ -464,7 +469,10 @@ impl Scene {
         match self.motion {
             Motion::Static => inst.position,
             Motion::SweepX { near, far } => {
-                let d = sweep_distance(near, far, self.frames, frame);
+                let d = match self.camera_mode {
+                    CameraMode::Dolly => near,
+                    _ => sweep_distance(near, far, self.frames, frame),
+                };
                 Vec3::new(self.eye.x + d, inst.position.y, inst.position.z)
             }
         }
@@ -502,6 +510,16 @@ impl Scene {
                 self.eye,
                 Mat4::look_at_rh(self.eye, self.eye + self.forward, Vec3::Y),
             ),
+            (CameraMode::Dolly, None) => {
+                let eye = match self.motion {
+                    // Back from the bunny by as much as the fixed camera's bunny has moved away from it.
+                    Motion::SweepX { near, far } => {
+                        self.eye - Vec3::X * (sweep_distance(near, far, self.frames, frame) - near)
+                    }
+                    Motion::Static => self.eye,
+                };
+                (eye, Mat4::look_at_rh(eye, eye + self.forward, Vec3::Y))
+            }
             (CameraMode::Orbit, None) => {
                 let target = match self.instances.first() {
                     Some(_) => self.instance_position(0, frame),
@@ -691,6 +709,34 @@ mod tests {
             .iter()
             .all(|i| i.position.y == 0.0 && i.position.z == 0.0));
         assert_eq!(s.forward, Vec3::X);
+    }
+
+    #[test]
+    fn dolly_moves_the_camera_through_the_same_relative_geometry() {
+        let fixed = SceneDef::new("bunny-sweep", &cfg(&[]))
+            .unwrap()
+            .instantiate(1);
+        let dolly = SceneDef::new("bunny-sweep", &cfg(&["--camera", "dolly"]))
+            .unwrap()
+            .instantiate(1);
+        let mut eyes = Vec::new();
+        for f in [0, 1, fixed.frames / 4, fixed.frames / 2, fixed.frames - 1] {
+            // The bunny stays put; the eye moves.
+            assert_eq!(dolly.instance_position(0, f), dolly.instance_position(0, 0));
+            eyes.push(dolly.camera(f).eye);
+            let d = (fixed.instance_distance(0, f), dolly.instance_distance(0, f));
+            assert!((d.0 - d.1).abs() <= 1e-4 * d.0, "frame {f}: {d:?}");
+            // Object space to clip space is the same transform.
+            let (a, b) = (
+                fixed.camera(f).view_proj() * fixed.instance_matrix(0, f),
+                dolly.camera(f).view_proj() * dolly.instance_matrix(0, f),
+            );
+            let scale = a.to_cols_array().iter().fold(0f32, |m, x| m.max(x.abs()));
+            for (x, y) in a.to_cols_array().iter().zip(b.to_cols_array()) {
+                assert!((x - y).abs() <= 1e-4 * scale, "frame {f}: {a} vs {b}");
+            }
+        }
+        assert!(eyes[2].distance(eyes[0]) > 1.0, "{eyes:?}");
     }
 
     #[test]
