@@ -10,8 +10,9 @@ data allows):
   - fig5_<scene>.png        seed 003 Fig. 5: median frame time against instance count per method (scenes run with
                             several --count values, e.g. bunny-grid), with bootstrap 95 % intervals;
   - cost_<scene>.png        error against cost: mean rmse and max pop against median GPU time, per method;
-  - contact_<scene>.png     frames around the first transition per method with their error heat-maps (runs with
-                            --dump-frames).
+  - contact_<scene>.png     three dumped frames around one transition per method with their error heat-maps, cropped
+                            to where the scene is (runs with --dump-frames); `--transition worst` (default: the
+                            frame where the methods' rmse differ most), `first`, or N (the N-th along the path).
   - fig8_<scene>.png        seed 000 Fig. 8: median frame time against viewport size per method (experiment folders
                             sweeping `viewport`, e.g. `lodbench experiment` with [sweep] variable = "viewport").
 Experiment folders carry the swept variable as the first CSV column; the per-frame figures use its first value.
@@ -134,40 +135,115 @@ def cost(scene, summary, path):
     save(fig, path)
 
 
-def contact(scene, frames_dir, by_method, path):
+def transitions(rows):
+    """Episodes of the path with an instance in transition: lists of consecutive frame numbers."""
+    episodes = []
+    for r in rows:
+        if int(r["t_instances"]) == 0:
+            continue
+        f = int(r["frame"])
+        if episodes and f == episodes[-1][-1] + 1:
+            episodes[-1].append(f)
+        else:
+            episodes.append([f])
+    return episodes
+
+
+def pick_transition(by_method, dumped, which):
+    """The episode and the frame in it for the contact sheet. `which`: "worst" (the episode, among those with dumped
+    frames, holding the frame where the methods' rmse spreads most: max minus min over the methods), "first", or
+    a 1-based episode number. Returns (episode number, frame) or None when no episode has dumped frames."""
     first = next(iter(by_method.values()))
-    in_transition = [int(r["frame"]) for r in first if int(r["t_instances"]) > 0]
-    if not in_transition:
-        return False
+    episodes = transitions(first)
+    dumped = set(dumped)
+    shown = [(n, e) for n, e in enumerate(episodes, 1) if dumped.intersection(range(e[0] - 2, e[-1] + 3))]
+    if not shown:
+        return None
+    rmse = {m: {int(r["frame"]): num(r["rmse"]) for r in rs} for (m,), rs in by_method.items() if m != "reference"}
+    if which == "first":
+        n, e = shown[0]
+        return n, e[len(e) // 2]
+    if which != "worst":
+        n = int(which)
+        if not 1 <= n <= len(episodes):
+            raise ValueError(f"--transition {n}: the run has {len(episodes)} transitions")
+        e = episodes[n - 1]
+        if n not in dict(shown):
+            raise ValueError(f"--transition {n} (frames {e[0]}-{e[-1]}): no frames of it were dumped")
+        return n, e[len(e) // 2]
+
+    def spread(f):
+        vals = [v[f] for v in rmse.values() if f in v]
+        return max(vals) - min(vals) if vals else 0.0
+
+    return max(((n, f) for n, e in shown for f in e), key=lambda nf: spread(nf[1]))
+
+
+def crop_box(images, margin=8):
+    """The box holding everything that is not background (the reference's top-left colour) in any of the images,
+    with a margin; None when that is most of the frame anyway."""
+    arrays = [np.asarray(im.convert("RGB"), dtype=np.int16) for im in images]
+    h, w = arrays[0].shape[:2]
+    bg = arrays[0][0, 0]
+    mask = np.zeros((h, w), bool)
+    for a in arrays:
+        if a.shape[:2] == (h, w):
+            mask |= np.abs(a - bg).sum(axis=2) > 0
+    if not mask.any():
+        return None
+    ys, xs = np.nonzero(mask)
+    box = (max(0, xs.min() - margin), max(0, ys.min() - margin), min(w, xs.max() + 1 + margin),
+           min(h, ys.max() + 1 + margin))
+    if (box[2] - box[0]) * (box[3] - box[1]) > 0.6 * w * h:
+        return None
+    return box
+
+
+def contact(scene, frames_dir, by_method, path, which="worst"):
     # The frame number is the last `_fNNNNN` before `_method.png` (method names may contain `_f`, e.g. fsi).
     dumped = sorted({int(p.name[: -len("_method.png")][-5:]) for p in frames_dir.glob(f"{scene}_*_method.png")})
     if not dumped:
-        return False
-    mid = in_transition[len(in_transition) // 2] if len(in_transition) < 3 else in_transition[0]
+        return None
+    picked = pick_transition(by_method, dumped, which)
+    if picked is None:
+        return None
+    episode, mid = picked
     i = min(range(len(dumped)), key=lambda j: abs(dumped[j] - mid))
-    picks = dumped[max(0, i - 1): i + 2]
+    lo = min(max(0, i - 1), max(0, len(dumped) - 3))
+    picks = dumped[lo: lo + 3]
     methods = [m for (m,) in by_method]
+    stems = {(m, f): frames_dir / f"{scene}_{m}_c{by_method[(m,)][0]['count']}_f{f:05d}" for m in methods
+             for f in picks}
+    opened = {}
+    for (m, f), stem in stems.items():
+        for kind in ("reference", "method", "error"):
+            p = Path(f"{stem}_{kind}.png")
+            if p.is_file():
+                opened[(m, f, kind)] = Image.open(p)
+    box = crop_box([im for (m, f, kind), im in opened.items() if kind != "error"])
     fig, axes = plt.subplots(len(methods), 2 * len(picks), figsize=(2.2 * 2 * len(picks), 2.0 * len(methods)),
                              squeeze=False)
     for row, method in enumerate(methods):
-        count = by_method[(method,)][0]["count"]
         for col, f in enumerate(picks):
-            stem = frames_dir / f"{scene}_{method}_c{count}_f{f:05d}"
             for k, kind in enumerate(("method", "error")):
                 ax = axes[row][2 * col + k]
                 ax.axis("off")
-                p = Path(f"{stem}_{kind}.png")
-                if p.is_file():
-                    ax.imshow(Image.open(p))
+                im = opened.get((method, f, kind))
+                if im is not None:
+                    ax.imshow(im.crop(box) if box else im, interpolation="nearest")
                 if row == 0:
                     ax.set_title(f"frame {f} {kind}", fontsize=8)
             axes[row][0].text(-0.05, 0.5, method, transform=axes[row][0].transAxes, ha="right", va="center",
                               fontsize=8)
-    fig.suptitle(f"{scene}: around the first transition (error heat-map: black = equal, white >= 0.25)")
+    where = f", cropped to x {box[0]}-{box[2]}, y {box[1]}-{box[3]}" if box else ""
+    fig.suptitle(f"{scene}: transition {episode} of the path, frames {picks[0]}-{picks[-1]}{where}\n"
+                 "(error heat-map: black = equal, white >= 0.25)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
-    return True
+    for im in opened.values():
+        im.close()
+    return episode
 
 
 def markdown_table(rows, columns):
@@ -185,7 +261,7 @@ def markdown_table(rows, columns):
     return "\n".join(lines)
 
 
-def report(folder: Path) -> list:
+def report(folder: Path, transition: str = "worst") -> list:
     frames = read_csv(folder / "frames.csv")
     summary = read_csv(folder / "summary.csv")
     figs = folder / "figures"
@@ -212,9 +288,10 @@ def report(folder: Path) -> list:
             made.append((f"sweep_{scene}.png", f"{scene}: rmse and pop per frame"))
             fig6(scene, [r for r in scene_summary if r["count"] == first_count], figs / f"fig6_{scene}.png")
             made.append((f"fig6_{scene}.png", f"{scene}: popping per method"))
-            if (folder / "frames").is_dir() and contact(scene, folder / "frames", by_method,
-                                                        figs / f"contact_{scene}.png"):
-                made.append((f"contact_{scene}.png", f"{scene}: frames around the first transition"))
+            episode = contact(scene, folder / "frames", by_method, figs / f"contact_{scene}.png", transition) \
+                if (folder / "frames").is_dir() else None
+            if episode is not None:
+                made.append((f"contact_{scene}.png", f"{scene}: frames around transition {episode} of the path"))
         cost(scene, scene_summary, figs / f"cost_{scene}.png")
         made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
     columns = (["viewport"] if swept else []) + ["scene", "method", "count", "frames", "gpu_ms_median", "gpu_ms_median_ci95_lo",
@@ -230,12 +307,22 @@ def report(folder: Path) -> list:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("results", type=Path, nargs="+")
+    ap.add_argument("--transition", default="worst",
+                    help='which transition the contact sheet shows: "worst" (default: where the methods\' rmse '
+                         'differ most), "first", or a 1-based number along the path')
     args = ap.parse_args()
+    if args.transition not in ("worst", "first") and not args.transition.isdigit():
+        print(f"error: --transition {args.transition!r}: expected worst, first or a number", file=sys.stderr)
+        return 2
     for folder in args.results:
         if not (folder / "frames.csv").is_file() or not (folder / "summary.csv").is_file():
             print(f"error: {folder} has no frames.csv and summary.csv (a complete lodbench run?)", file=sys.stderr)
             return 2
-        made = report(folder)
+        try:
+            made = report(folder, args.transition)
+        except ValueError as e:
+            print(f"error: {folder}: {e}", file=sys.stderr)
+            return 2
         print(f"{folder}: report.md and {len(made)} figures in {folder / 'figures'}")
     return 0
 

@@ -34,6 +34,21 @@ def test_sweep_folder(dump, tmp_path):
     assert "| bunny-sweep | fsi |" in report
 
 
+def test_contact_sheet_transition_choice(dump, tmp_path):
+    folder = tmp_path / "sweep"
+    shutil.copytree(dump, folder)
+    r = subprocess.run([sys.executable, str(SCRIPT), "--transition", "first", str(folder)], capture_output=True,
+                       text=True)
+    assert r.returncode == 0, r.stderr
+    assert "frames around transition 1 of the path" in (folder / "report.md").read_text()
+    r = subprocess.run([sys.executable, str(SCRIPT), "--transition", "99", str(folder)], capture_output=True,
+                       text=True)
+    assert r.returncode == 2 and "--transition 99: the run has" in r.stderr
+    r = subprocess.run([sys.executable, str(SCRIPT), "--transition", "last", str(folder)], capture_output=True,
+                       text=True)
+    assert r.returncode == 2 and "expected worst, first or a number" in r.stderr
+
+
 def test_grid_folder_gets_fig5(grid, tmp_path):
     folder = tmp_path / "grid"
     shutil.copytree(grid, folder)
