@@ -13,6 +13,8 @@ data allows):
   - contact_<scene>.png     three dumped frames around one transition per method with their error heat-maps, cropped
                             to where the scene is (runs with --dump-frames); `--transition worst` (default: the
                             frame where the methods' rmse differ most), `first`, or N (the N-th along the path).
+  - fsi_buffers_<scene>.png FSI's two LOD buffers and the combined frame, at the dumped frame with the most instances
+                            in transition (an fsi method run with --dump-frames).
   - fig8_<scene>.png        seed 000 Fig. 8: median frame time against viewport size per method (experiment folders
                             sweeping `viewport`, e.g. `lodbench experiment` with [sweep] variable = "viewport").
 Experiment folders carry the swept variable as the first CSV column; the per-frame figures use its first value.
@@ -246,6 +248,36 @@ def contact(scene, frames_dir, by_method, path, which="worst"):
     return episode
 
 
+def fsi_buffers(scene, frames_dir, by_method, path):
+    """FSI's two LOD buffers and the combined frame side by side, for the dumped frame of an fsi-family method
+    with the most instances in transition (the `_lodbuffer0/1.png` dumps). Returns the frame or None."""
+    for (method,), rows in by_method.items():
+        if not method.startswith("fsi"):
+            continue
+        count = rows[0]["count"]
+        stem = f"{scene}_{method}_c{count}_f"
+        frames = [r for r in rows if int(r["t_instances"]) > 0
+                  and (frames_dir / f"{stem}{int(r['frame']):05d}_lodbuffer0.png").is_file()]
+        if not frames:
+            continue
+        best = max(frames, key=lambda r: (int(r["t_instances"]), -int(r["frame"])))
+        f = int(best["frame"])
+        panels = [("LOD buffer 0", "lodbuffer0"), ("LOD buffer 1", "lodbuffer1"), ("combined frame", "method")]
+        images = [Image.open(frames_dir / f"{stem}{f:05d}_{kind}.png") for _, kind in panels]
+        w, h = images[0].size
+        fig, axes = plt.subplots(1, 3, figsize=(3 * 4.0, 4.0 * h / w + 0.6), squeeze=False)
+        for ax, (title, _), im in zip(axes[0], panels, images):
+            ax.imshow(im, interpolation="nearest")
+            ax.set_title(title, fontsize=9)
+            ax.axis("off")
+            im.close()
+        fig.suptitle(f"{scene}, {method}, frame {f} ({best['t_instances']} instances in transition): the two LOD "
+                     "buffers hold this frame and the previous one; the combination pass merges them", fontsize=9)
+        save(fig, path)
+        return f
+    return None
+
+
 def markdown_table(rows, columns):
     lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
     for r in rows:
@@ -292,6 +324,10 @@ def report(folder: Path, transition: str = "worst") -> list:
                 if (folder / "frames").is_dir() else None
             if episode is not None:
                 made.append((f"contact_{scene}.png", f"{scene}: frames around transition {episode} of the path"))
+            fsi_frame = fsi_buffers(scene, folder / "frames", by_method, figs / f"fsi_buffers_{scene}.png") \
+                if (folder / "frames").is_dir() else None
+            if fsi_frame is not None:
+                made.append((f"fsi_buffers_{scene}.png", f"{scene}: FSI's two LOD buffers and the combined frame"))
         cost(scene, scene_summary, figs / f"cost_{scene}.png")
         made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
     columns = (["viewport"] if swept else []) + ["scene", "method", "count", "frames", "gpu_ms_median", "gpu_ms_median_ci95_lo",

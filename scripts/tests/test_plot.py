@@ -23,7 +23,8 @@ def test_sweep_folder(dump, tmp_path):
     r = plot(folder)
     assert r.returncode == 0, r.stderr
     assert figures(folder) == [
-        "contact_bunny-sweep.png", "cost_bunny-sweep.png", "fig6_bunny-sweep.png", "sweep_bunny-sweep.png",
+        "contact_bunny-sweep.png", "cost_bunny-sweep.png", "fig6_bunny-sweep.png", "fsi_buffers_bunny-sweep.png",
+        "sweep_bunny-sweep.png",
     ]
     report = (folder / "report.md").read_text()
     for name in figures(folder):
