@@ -29,6 +29,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 import numpy as np  # noqa: E402
 from PIL import Image  # noqa: E402
 
@@ -124,17 +125,34 @@ def fig8(scene, summary, path):
 
 
 def cost(scene, summary, path):
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    """Mean rmse and max pop against median GPU time: one colour per method, one marker per count, a legend
+    instead of labels at the points (methods of similar cost overlap)."""
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
+    methods = list(OrderedDict.fromkeys(r["method"] for r in summary))
+    counts = list(OrderedDict.fromkeys(r["count"] for r in summary))
+    markers = "osD^v<>px*"
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for r in summary:
         g = num(r["gpu_ms_median"])
+        mi, ci = methods.index(r["method"]), counts.index(r["count"])
         for ax, col in zip(axes, ("rmse_mean", "pop_max")):
-            ax.scatter(g, num(r[col]))
-            ax.annotate(f'{r["method"]} n={r["count"]}', (g, num(r[col])), fontsize=7)
+            ax.scatter(g, num(r[col]), color=colours[mi % len(colours)], marker=markers[ci % len(markers)],
+                       alpha=0.85)
     for ax, col in zip(axes, ("mean rmse", "max pop")):
         ax.set_xlabel("median GPU frame time, ms")
         ax.set_ylabel(col)
+        ax.grid(alpha=0.3)
+    # Two legends: colour = method, marker = count.
+    handles = [Line2D([], [], color=colours[i % len(colours)], marker="o", linestyle="", label=m)
+               for i, m in enumerate(methods)]
+    if len(counts) > 1:
+        handles += [Line2D([], [], color="grey", marker=markers[i % len(markers)], linestyle="", label=f"n={c}")
+                    for i, c in enumerate(counts)]
+    fig.legend(handles=handles, loc="center right", fontsize=7, frameon=False)
     fig.suptitle(f"{scene}: error against cost")
-    save(fig, path)
+    fig.tight_layout(rect=(0, 0, 0.84, 1))
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 def transitions(rows):
