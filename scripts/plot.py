@@ -14,7 +14,7 @@ data allows):
                             to where the scene is (runs with --dump-frames); `--transition worst` (default: the
                             frame where the methods' rmse differ most), `first`, or N (the N-th along the path).
   - fsi_buffers_<scene>.png FSI's two LOD buffers and the combined frame, at the dumped frame with the most instances
-                            in transition (an fsi method run with --dump-frames).
+                            in transition (ties: the largest rmse), cropped (an fsi method run with --dump-frames).
   - fig8_<scene>.png        seed 000 Fig. 8: median frame time against viewport size per method (experiment folders
                             sweeping `viewport`, e.g. `lodbench experiment` with [sweep] variable = "viewport").
 Experiment folders carry the swept variable as the first CSV column; the per-frame figures use its first value.
@@ -278,10 +278,14 @@ def fsi_buffers(scene, frames_dir, by_method, path):
                   and (frames_dir / f"{stem}{int(r['frame']):05d}_lodbuffer0.png").is_file()]
         if not frames:
             continue
-        best = max(frames, key=lambda r: (int(r["t_instances"]), -int(r["frame"])))
+        # Most instances in transition; among those, the largest rmse (where the objects are largest on screen).
+        best = max(frames, key=lambda r: (int(r["t_instances"]), num(r["rmse"]), -int(r["frame"])))
         f = int(best["frame"])
         panels = [("LOD buffer 0", "lodbuffer0"), ("LOD buffer 1", "lodbuffer1"), ("combined frame", "method")]
         images = [Image.open(frames_dir / f"{stem}{f:05d}_{kind}.png") for _, kind in panels]
+        box = crop_box(images)
+        if box:
+            images = [im.crop(box) for im in images]
         w, h = images[0].size
         fig, axes = plt.subplots(1, 3, figsize=(3 * 4.0, 4.0 * h / w + 0.6), squeeze=False)
         for ax, (title, _), im in zip(axes[0], panels, images):
@@ -289,8 +293,9 @@ def fsi_buffers(scene, frames_dir, by_method, path):
             ax.set_title(title, fontsize=9)
             ax.axis("off")
             im.close()
-        fig.suptitle(f"{scene}, {method}, frame {f} ({best['t_instances']} instances in transition): the two LOD "
-                     "buffers hold this frame and the previous one; the combination pass merges them", fontsize=9)
+        where = f", cropped to x {box[0]}-{box[2]}, y {box[1]}-{box[3]}" if box else ""
+        fig.suptitle(f"{scene}, {method}, frame {f} ({best['t_instances']} instances in transition{where}): the two "
+                     "LOD buffers hold this frame and the previous one; the combination pass merges them", fontsize=9)
         save(fig, path)
         return f
     return None
