@@ -7,6 +7,8 @@ Writes into each folder a `figures/` subfolder and `report.md` (the summary tabl
 data allows):
   - sweep_<scene>.png       rmse and pop along the path per method, discrete LOD switch frames marked;
   - fig6_<scene>.png        seed 003 Fig. 6: popping per method (mean rmse, max pop; bunny-sweep or any moving scene);
+  - transitions_<scene>.png the largest pop of each method within 5 frames of each transition of the path (up to 16
+                            transitions), also as a table in report.md;
   - fig5_<scene>.png        seed 003 Fig. 5: median frame time against instance count per method (scenes run with
                             several --count values, e.g. bunny-grid), with bootstrap 95 % intervals;
   - cost_<scene>.png        error against cost: mean rmse and max pop against median GPU time, per method;
@@ -89,6 +91,38 @@ def fig6(scene, summary, path):
     ax.set_xticks(x, methods, rotation=20)
     ax.set_title(f"{scene}: popping per method (cf. seed 003 Fig. 6)")
     ax.legend()
+    save(fig, path)
+
+
+def transition_pops(by_method, window=5):
+    """Per transition of the path (episodes with an instance in transition), the largest pop of each method within
+    `window` frames before its first and after its last frame: [(first, last, {method: max pop})]. A discrete
+    switch and the end of a smooth transition both fall inside that window."""
+    first = next(iter(by_method.values()))
+    out = []
+    for e in transitions(first):
+        lo, hi = e[0] - window, e[-1] + window
+        pops = {}
+        for (m,), rows in by_method.items():
+            if m == "reference":
+                continue
+            vals = [num(r["pop"]) for r in rows if lo <= int(r["frame"]) <= hi]
+            pops[m] = max(vals) if vals else float("nan")
+        out.append((e[0], e[-1], pops))
+    return out
+
+
+def transitions_figure(scene, per_transition, path):
+    methods = list(per_transition[0][2])
+    x = np.arange(len(per_transition))
+    width = 0.8 / len(methods)
+    fig, ax = plt.subplots(figsize=(max(8, 1.3 * len(per_transition) + 3), 4))
+    for i, m in enumerate(methods):
+        ax.bar(x - 0.4 + (i + 0.5) * width, [p[m] for _, _, p in per_transition], width, label=m)
+    ax.set_xticks(x, [f"frames {a}-{b}" for a, b, _ in per_transition], rotation=20, fontsize=8)
+    ax.set_ylabel("max pop within 5 frames")
+    ax.set_title(f"{scene}: popping per transition and method")
+    ax.legend(fontsize=7, ncol=2)
     save(fig, path)
 
 
@@ -322,6 +356,7 @@ def report(folder: Path, transition: str = "worst") -> list:
     figs = folder / "figures"
     figs.mkdir(exist_ok=True)
     made = []
+    tables = []
     swept = "viewport" in (summary[0] if summary else {})
     first_viewport = summary[0]["viewport"] if swept else None
     for (scene,), all_viewports in group(summary, "scene").items():
@@ -343,6 +378,11 @@ def report(folder: Path, transition: str = "worst") -> list:
             made.append((f"sweep_{scene}.png", f"{scene}: rmse and pop per frame"))
             fig6(scene, [r for r in scene_summary if r["count"] == first_count], figs / f"fig6_{scene}.png")
             made.append((f"fig6_{scene}.png", f"{scene}: popping per method"))
+            per_transition = transition_pops(by_method)
+            if 0 < len(per_transition) <= 16:
+                transitions_figure(scene, per_transition, figs / f"transitions_{scene}.png")
+                made.append((f"transitions_{scene}.png", f"{scene}: popping per transition"))
+                tables.append((scene, per_transition))
             episode = contact(scene, folder / "frames", by_method, figs / f"contact_{scene}.png", transition) \
                 if (folder / "frames").is_dir() else None
             if episode is not None:
@@ -357,6 +397,11 @@ def report(folder: Path, transition: str = "worst") -> list:
                "gpu_ms_median_ci95_hi", "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
                "de2000_mean"]
     text = [f"# lodbench report: {folder.name}", "", "## Summary", "", markdown_table(summary, columns), ""]
+    for scene, per_transition in tables:
+        methods = list(per_transition[0][2])
+        rows = [{"transition": f"frames {a}-{b}", **{m: f"{p[m]:.4f}" for m in methods}} for a, b, p in per_transition]
+        text += [f"## {scene}: max pop within 5 frames of each transition", "",
+                 markdown_table(rows, ["transition"] + methods), ""]
     for name, caption in made:
         text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
     (folder / "report.md").write_text("\n".join(text))

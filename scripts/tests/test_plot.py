@@ -24,7 +24,7 @@ def test_sweep_folder(dump, tmp_path):
     assert r.returncode == 0, r.stderr
     assert figures(folder) == [
         "contact_bunny-sweep.png", "cost_bunny-sweep.png", "fig6_bunny-sweep.png", "fsi_buffers_bunny-sweep.png",
-        "sweep_bunny-sweep.png",
+        "sweep_bunny-sweep.png", "transitions_bunny-sweep.png",
     ]
     report = (folder / "report.md").read_text()
     for name in figures(folder):
@@ -33,6 +33,7 @@ def test_sweep_folder(dump, tmp_path):
             assert im.width > 300 and im.height > 200
     assert "| bunny-sweep | dither |" in report
     assert "| bunny-sweep | fsi |" in report
+    assert "## bunny-sweep: max pop within 5 frames of each transition" in report
 
 
 def test_contact_sheet_transition_choice(dump, tmp_path):
