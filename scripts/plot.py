@@ -94,7 +94,11 @@ def fig6(scene, summary, path):
     save(fig, path)
 
 
-def transition_pops(by_method, window=5):
+# Frames either side of a transition that count as its own in the per-transition pop figure and table.
+TRANSITION_WINDOW = 5
+
+
+def transition_pops(by_method, window=TRANSITION_WINDOW):
     """Per transition of the path (episodes with an instance in transition), the largest pop of each method within
     `window` frames before its first and after its last frame: [(first, last, {method: max pop})]. A discrete
     switch and the end of a smooth transition both fall inside that window."""
@@ -120,7 +124,7 @@ def transitions_figure(scene, per_transition, path):
     for i, m in enumerate(methods):
         ax.bar(x - 0.4 + (i + 0.5) * width, [p[m] for _, _, p in per_transition], width, label=m)
     ax.set_xticks(x, [f"frames {a}-{b}" for a, b, _ in per_transition], rotation=20, fontsize=8)
-    ax.set_ylabel("max pop within 5 frames")
+    ax.set_ylabel(f"max pop within {TRANSITION_WINDOW} frames")
     ax.set_title(f"{scene}: popping per transition and method")
     ax.legend(fontsize=7, ncol=2)
     save(fig, path)
@@ -213,7 +217,6 @@ def pick_transition(by_method, dumped, which):
     shown = [(n, e) for n, e in enumerate(episodes, 1) if dumped.intersection(range(e[0] - 2, e[-1] + 3))]
     if not shown:
         return None
-    rmse = {m: {int(r["frame"]): num(r["rmse"]) for r in rs} for (m,), rs in by_method.items() if m != "reference"}
     if which == "first":
         n, e = shown[0]
         return n, e[len(e) // 2]
@@ -226,6 +229,8 @@ def pick_transition(by_method, dumped, which):
             raise ValueError(f"--transition {n} (frames {e[0]}-{e[-1]}): no frames of it were dumped")
         return n, e[len(e) // 2]
 
+    rmse = {m: {int(r["frame"]): num(r["rmse"]) for r in rs} for (m,), rs in by_method.items() if m != "reference"}
+
     def spread(f):
         vals = [v[f] for v in rmse.values() if f in v]
         return max(vals) - min(vals) if vals else 0.0
@@ -234,8 +239,8 @@ def pick_transition(by_method, dumped, which):
 
 
 def crop_box(images, margin=8):
-    """The box holding everything that is not background (the reference's top-left colour) in any of the images,
-    with a margin; None when that is most of the frame anyway."""
+    """The box holding everything that is not background (the first image's top-left colour) in any of the
+    images, with a margin; None when that is most of the frame anyway."""
     arrays = [np.asarray(im.convert("RGB"), dtype=np.int16) for im in images]
     h, w = arrays[0].shape[:2]
     bg = arrays[0][0, 0]
@@ -251,6 +256,10 @@ def crop_box(images, margin=8):
     if (box[2] - box[0]) * (box[3] - box[1]) > 0.6 * w * h:
         return None
     return box
+
+
+def crop_note(box):
+    return f", cropped to x {box[0]}-{box[2]}, y {box[1]}-{box[3]}" if box else ""
 
 
 def contact(scene, frames_dir, by_method, path, which="worst"):
@@ -289,8 +298,7 @@ def contact(scene, frames_dir, by_method, path, which="worst"):
                     ax.set_title(f"frame {f} {kind}", fontsize=8)
             axes[row][0].text(-0.05, 0.5, method, transform=axes[row][0].transAxes, ha="right", va="center",
                               fontsize=8)
-    where = f", cropped to x {box[0]}-{box[2]}, y {box[1]}-{box[3]}" if box else ""
-    fig.suptitle(f"{scene}: transition {episode} of the path, frames {picks[0]}-{picks[-1]}{where}\n"
+    fig.suptitle(f"{scene}: transition {episode} of the path, frames {picks[0]}-{picks[-1]}{crop_note(box)}\n"
                  "(error heat-map: black = equal, white >= 0.25)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
@@ -318,17 +326,15 @@ def fsi_buffers(scene, frames_dir, by_method, path):
         panels = [("LOD buffer 0", "lodbuffer0"), ("LOD buffer 1", "lodbuffer1"), ("combined frame", "method")]
         images = [Image.open(frames_dir / f"{stem}{f:05d}_{kind}.png") for _, kind in panels]
         box = crop_box(images)
-        if box:
-            images = [im.crop(box) for im in images]
-        w, h = images[0].size
+        w, h = (box[2] - box[0], box[3] - box[1]) if box else images[0].size
         fig, axes = plt.subplots(1, 3, figsize=(3 * 4.0, 4.0 * h / w + 0.6), squeeze=False)
         for ax, (title, _), im in zip(axes[0], panels, images):
-            ax.imshow(im, interpolation="nearest")
+            ax.imshow(im.crop(box) if box else im, interpolation="nearest")
             ax.set_title(title, fontsize=9)
             ax.axis("off")
             im.close()
-        where = f", cropped to x {box[0]}-{box[2]}, y {box[1]}-{box[3]}" if box else ""
-        fig.suptitle(f"{scene}, {method}, frame {f} ({best['t_instances']} instances in transition{where}): the two "
+        fig.suptitle(f"{scene}, {method}, frame {f} ({best['t_instances']} instances in transition"
+                     f"{crop_note(box)}): the two "
                      "LOD buffers hold this frame and the previous one; the combination pass merges them", fontsize=9)
         save(fig, path)
         return f
@@ -383,14 +389,12 @@ def report(folder: Path, transition: str = "worst") -> list:
                 transitions_figure(scene, per_transition, figs / f"transitions_{scene}.png")
                 made.append((f"transitions_{scene}.png", f"{scene}: popping per transition"))
                 tables.append((scene, per_transition))
-            episode = contact(scene, folder / "frames", by_method, figs / f"contact_{scene}.png", transition) \
-                if (folder / "frames").is_dir() else None
-            if episode is not None:
-                made.append((f"contact_{scene}.png", f"{scene}: frames around transition {episode} of the path"))
-            fsi_frame = fsi_buffers(scene, folder / "frames", by_method, figs / f"fsi_buffers_{scene}.png") \
-                if (folder / "frames").is_dir() else None
-            if fsi_frame is not None:
-                made.append((f"fsi_buffers_{scene}.png", f"{scene}: FSI's two LOD buffers and the combined frame"))
+            if (folder / "frames").is_dir():
+                episode = contact(scene, folder / "frames", by_method, figs / f"contact_{scene}.png", transition)
+                if episode is not None:
+                    made.append((f"contact_{scene}.png", f"{scene}: frames around transition {episode} of the path"))
+                if fsi_buffers(scene, folder / "frames", by_method, figs / f"fsi_buffers_{scene}.png") is not None:
+                    made.append((f"fsi_buffers_{scene}.png", f"{scene}: FSI's two LOD buffers and the combined frame"))
         cost(scene, scene_summary, figs / f"cost_{scene}.png")
         made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
     columns = (["viewport"] if swept else []) + ["scene", "method", "count", "frames", "gpu_ms_median", "gpu_ms_median_ci95_lo",
@@ -400,7 +404,7 @@ def report(folder: Path, transition: str = "worst") -> list:
     for scene, per_transition in tables:
         methods = list(per_transition[0][2])
         rows = [{"transition": f"frames {a}-{b}", **{m: f"{p[m]:.4f}" for m in methods}} for a, b, p in per_transition]
-        text += [f"## {scene}: max pop within 5 frames of each transition", "",
+        text += [f"## {scene}: max pop within {TRANSITION_WINDOW} frames of each transition", "",
                  markdown_table(rows, ["transition"] + methods), ""]
     for name, caption in made:
         text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
