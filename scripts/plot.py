@@ -19,7 +19,9 @@ data allows):
                             in transition (ties: the largest rmse), cropped (an fsi method run with --dump-frames).
   - fig8_<scene>.png        seed 000 Fig. 8: median frame time against viewport size per method (experiment folders
                             sweeping `viewport`, e.g. `lodbench experiment` with [sweep] variable = "viewport").
-Experiment folders carry the swept variable as the first CSV column; the per-frame figures use its first value.
+Experiment folders carry the swept variable as the first CSV column. A `viewport` sweep gets fig8 and its first value
+in the other figures; any other swept variable (`fsi-check`, `noise`, ...) makes each (method, value) pair its own
+series, labelled `method (variable value)`.
 """
 import argparse
 import csv
@@ -363,8 +365,14 @@ def report(folder: Path, transition: str = "worst") -> list:
     figs.mkdir(exist_ok=True)
     made = []
     tables = []
-    swept = "viewport" in (summary[0] if summary else {})
+    first_column = next(iter(summary[0]), None) if summary else None
+    variable = first_column if first_column not in (None, "scene") else None
+    swept = variable == "viewport"
     first_viewport = summary[0]["viewport"] if swept else None
+    if variable and not swept:
+        # Each value of the swept variable is its own series, in the figures and the tables.
+        for r in summary + frames:
+            r["method"] = f"{r['method']} ({variable} {r[variable]})"
     for (scene,), all_viewports in group(summary, "scene").items():
         if swept:
             fig8(scene, all_viewports, figs / f"fig8_{scene}.png")
@@ -397,7 +405,7 @@ def report(folder: Path, transition: str = "worst") -> list:
                     made.append((f"fsi_buffers_{scene}.png", f"{scene}: FSI's two LOD buffers and the combined frame"))
         cost(scene, scene_summary, figs / f"cost_{scene}.png")
         made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
-    columns = (["viewport"] if swept else []) + ["scene", "method", "count", "frames", "gpu_ms_median", "gpu_ms_median_ci95_lo",
+    columns = ([variable] if variable else []) + ["scene", "method", "count", "frames", "gpu_ms_median", "gpu_ms_median_ci95_lo",
                "gpu_ms_median_ci95_hi", "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
                "de2000_mean"]
     text = [f"# lodbench report: {folder.name}", "", "## Summary", "", markdown_table(summary, columns), ""]

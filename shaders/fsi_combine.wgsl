@@ -8,13 +8,19 @@
 //                                                would z-fight), averaged in linear RGB;
 //   anything else (one t-instance)            -> the closer fragment, depths compared in the older frame's
 //                                                depth space (the newer depth reprojected by eq. 2).
+// With `--fsi-check forward` (not in the paper; see `FsiCheck` in src/methods/fsi.rs) the older fragment used
+// is one that lands within a pixel of this pixel's centre when reprojected forward with its own depth
+// (`forward`, eq. 2 inverted): eq. 2's lookup if it does, else the texel found by moving the lookup by the
+// miss (`forward_match`); if none does, the pixel takes the newer colour, as if it reprojected outside.
 // Colours are read and written as the stored sRGB-encoded bytes (Rgba8Unorm views), so a pixel that takes one
 // buffer's colour is copied bit for bit; only averaged pixels are decoded, mixed and re-encoded.
 
 struct Combine {
     // P_old * V_old * V_new^-1 * P_new^-1 (clip space of the newer frame to clip space of the older one).
     reproject: mat4x4<f32>,
-    // Viewport size in pixels (x, y); z: mode, 0 = reproject, 1 = same pixel.
+    // P_new * V_new * V_old^-1 * P_old^-1 (clip space of the older frame to clip space of the newer one).
+    forward: mat4x4<f32>,
+    // Viewport size in pixels (x, y); z: mode, 0 = reproject, 1 = same pixel; w: 1 = forward check.
     size_mode: vec4<f32>,
 };
 
@@ -40,21 +46,58 @@ fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
     return select(hi, lo, c <= vec3<f32>(0.0031308));
 }
 
-// Where pixel centre `pos` of the newer frame, at depth `depth`, lies in the older frame: (x, y) in pixels,
-// z its depth there; w < 0 when it falls outside the older viewport or behind its camera.
-fn reproject(pos: vec2<f32>, depth: f32) -> vec4<f32> {
+// Where pixel position `pos` of one frame, at depth `depth`, lies in the other frame by the clip-to-clip matrix
+// `m`: (x, y) in pixels (possibly outside the viewport), z its depth there; w < 0 when behind the camera.
+fn map_pixel(m: mat4x4<f32>, pos: vec2<f32>, depth: f32) -> vec4<f32> {
     let size = combine.size_mode.xy;
     let ndc = vec4<f32>(pos.x / size.x * 2.0 - 1.0, 1.0 - pos.y / size.y * 2.0, depth, 1.0);
-    let c = combine.reproject * ndc;
+    let c = m * ndc;
     if (c.w <= 0.0) {
         return vec4<f32>(0.0, 0.0, 0.0, -1.0);
     }
     let o = c.xyz / c.w;
-    let px = vec2<f32>((o.x + 1.0) * 0.5 * size.x, (1.0 - o.y) * 0.5 * size.y);
-    if (any(px < vec2<f32>(0.0)) || any(px >= size)) {
+    return vec4<f32>((o.x + 1.0) * 0.5 * size.x, (1.0 - o.y) * 0.5 * size.y, o.z, 1.0);
+}
+
+// Where pixel centre `pos` of the newer frame, at depth `depth`, lies in the older frame (eq. 2); w < 0 when it
+// falls outside the older viewport or behind its camera.
+fn reproject(pos: vec2<f32>, depth: f32) -> vec4<f32> {
+    let r = map_pixel(combine.reproject, pos, depth);
+    if (any(r.xy < vec2<f32>(0.0)) || any(r.xy >= combine.size_mode.xy)) {
         return vec4<f32>(0.0, 0.0, 0.0, -1.0);
     }
-    return vec4<f32>(px, o.z, 1.0);
+    return r;
+}
+
+// How many texels `forward_match` tries, and how far (in pixels, in x and in y) from the pixel's centre the
+// older fragment may land: a pixel's own footprint (0.5) would leave gaps wherever the image magnifies between
+// frames (samples land further apart than a pixel), so it is one pixel.
+const FORWARD_STEPS: i32 = 4;
+const FORWARD_TOLERANCE: f32 = 1.0;
+
+// `--fsi-check forward`: the texel of the older buffer whose fragment, reprojected into the newer frame with
+// its own depth, lands within FORWARD_TOLERANCE of pixel `p`'s centre. The search starts at `q` (eq. 2's
+// lookup) and moves the lookup by how far the fragment missed, rounded, at most FORWARD_STEPS texels in all;
+// (-1, -1) when none lands near `p`.
+fn forward_match(p: vec2<i32>, q0: vec2<i32>) -> vec2<i32> {
+    let size = vec2<i32>(combine.size_mode.xy);
+    let centre = vec2<f32>(p) + vec2<f32>(0.5);
+    var q = q0;
+    for (var i = 0; i < FORWARD_STEPS; i++) {
+        let r = map_pixel(combine.forward, vec2<f32>(q) + vec2<f32>(0.5), textureLoad(old_depth, q, 0));
+        if (r.w < 0.0) {
+            break;
+        }
+        let miss = centre - r.xy;
+        if (all(abs(miss) <= vec2<f32>(FORWARD_TOLERANCE))) {
+            return q;
+        }
+        q += vec2<i32>(round(miss));
+        if (any(q < vec2<i32>(0)) || any(q >= size)) {
+            break;
+        }
+    }
+    return vec2<i32>(-1);
 }
 
 @compute @workgroup_size(8, 8)
@@ -80,6 +123,12 @@ fn combine_pixel(p: vec2<i32>, pos: vec2<f32>) -> vec4<f32> {
         }
         q = vec2<i32>(floor(r.xy));
         dn_old = r.z;
+        if (combine.size_mode.w > 0.5) {
+            q = forward_match(p, q);
+            if (q.x < 0) {
+                return cn;
+            }
+        }
     }
     let co = textureLoad(old_color, q, 0);
     let ido = textureLoad(old_id, q, 0).r;

@@ -211,6 +211,8 @@ pub struct RunConfig {
     pub correspondence: crate::morph::Correspondence,
     /// Visibility texture of `fsi*`.
     pub vis_texture: crate::noise::VisTexture,
+    /// Older-fragment test of `fsi`'s combination pass (not in the paper; `none` by default).
+    pub fsi_check: crate::methods::fsi::FsiCheck,
     /// `--metrics` (rmse, pop, de2000 always; flip when listed).
     pub metrics: Vec<crate::metrics::Metric>,
     pub out: Option<PathBuf>,
@@ -246,6 +248,7 @@ impl RunConfig {
             noise: a.noise,
             correspondence: a.correspondence,
             vis_texture: a.vis_texture,
+            fsi_check: a.fsi_check,
             metrics: a.metrics.clone(),
             out: a.out.clone(),
             adapter: a.adapter.clone(),

@@ -60,6 +60,7 @@ struct RunKeys {
     noise: Option<String>,
     correspondence: Option<String>,
     vis_texture: Option<String>,
+    fsi_check: Option<String>,
     camera: Option<String>,
     metrics: Option<Vec<String>>,
     adapter: Option<String>,

@@ -529,6 +529,7 @@ fn run_blocks(
                 noise: cfg.noise,
                 correspondence: cfg.correspondence,
                 vis_texture: cfg.vis_texture,
+                fsi_check: cfg.fsi_check,
                 seed: cfg.seed,
             };
             let flip = cfg.metrics.contains(&crate::metrics::Metric::Flip);

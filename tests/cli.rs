@@ -90,12 +90,19 @@ fn bad_numbers_are_rejected() {
 }
 
 #[test]
-fn unknown_metric_is_rejected() {
+fn unknown_metric_and_fsi_check_are_rejected() {
     let out = lodbench(&["run", "--metrics", "rmse,psnr"], &[]);
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.contains("psnr") && stderr.contains("flip") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+    let out = lodbench(&["run", "--method", "fsi", "--fsi-check", "backward"], &[]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("backward") && stderr.contains("forward") && !stderr.contains("panicked"),
         "{stderr}"
     );
 }
@@ -133,6 +140,8 @@ fn no_adapter_says_how_to_install_one() {
             "reference",
             "--frames",
             "2",
+            "--fsi-check",
+            "forward",
             "--out",
             out_dir.to_str().unwrap(),
         ],
@@ -145,6 +154,11 @@ fn no_adapter_says_how_to_install_one() {
     // The failed run is visibly incomplete.
     let manifest = std::fs::read_to_string(out_dir.join("run.json")).unwrap();
     assert!(manifest.contains("\"status\": \"failed\""), "{manifest}");
+    // Every resolved flag is recorded, the failed run's too.
+    assert!(
+        manifest.contains("\"fsi_check\": \"forward\""),
+        "{manifest}"
+    );
     assert!(!out_dir.join("frames.csv").exists());
     assert!(!out_dir.join("summary.csv").exists());
 }

@@ -9,7 +9,7 @@ use lodbench::cli::{Cli, Command};
 use lodbench::config::SceneConfig;
 use lodbench::gpu::renderer::{ColorReadback, RenderTarget, SceneGpu};
 use lodbench::gpu::GpuContext;
-use lodbench::methods::fsi::{reprojection, Fsi, LodBufferImage, Variant};
+use lodbench::methods::fsi::{reprojection, Fsi, FsiCheck, LodBufferImage, Variant};
 use lodbench::methods::{Method, MethodOptions};
 use lodbench::runner::{BlockRunner, FrameDriver};
 use lodbench::scene::{Motion, Scene, SceneDef};
@@ -78,12 +78,28 @@ struct Frame {
     newer: LodBufferImage,
     older: LodBufferImage,
     reproject: Mat4,
+    /// With `--fsi-check forward` on `fsi`: eq. 2 inverted (older clip space to newer).
+    forward: Option<Mat4>,
 }
 
 /// Renders frames 0..=last with `variant` and returns the last one with both LOD buffers.
 fn render_fsi(ctx: &GpuContext, scene: &Scene, variant: Variant, last: u32) -> Frame {
+    render_fsi_checked(ctx, scene, variant, FsiCheck::None, last)
+}
+
+fn render_fsi_checked(
+    ctx: &GpuContext,
+    scene: &Scene,
+    variant: Variant,
+    check: FsiCheck,
+    last: u32,
+) -> Frame {
     let gpu = SceneGpu::new(ctx, scene).unwrap();
-    let mut fsi = Fsi::new(&gpu, scene, &MethodOptions::default(), variant);
+    let options = MethodOptions {
+        fsi_check: check,
+        ..Default::default()
+    };
+    let mut fsi = Fsi::new(&gpu, scene, &options, variant);
     let target = RenderTarget::new(&ctx.device, "test target", scene.width, scene.height);
     let readback = ColorReadback::new(&ctx.device, "test read-back", scene.width, scene.height);
     let mut driver = FrameDriver::new(scene);
@@ -112,11 +128,14 @@ fn render_fsi(ctx: &GpuContext, scene: &Scene, variant: Variant, last: u32) -> F
         }
         _ => Mat4::IDENTITY,
     };
+    let forward = (variant == Variant::Sequential && check == FsiCheck::Forward && last > 0)
+        .then(|| reprojection(&scene.camera(last - 1), &scene.camera(last)));
     Frame {
         out,
         newer,
         older,
         reproject,
+        forward,
     }
 }
 
@@ -146,6 +165,67 @@ enum Case {
     Average,
     NewerCloser,
     OlderCloser,
+    /// `--fsi-check forward`: no older fragment found that reprojects into the pixel; the newer colour.
+    NoMatch,
+}
+
+/// Where pixel position (x, y) of one frame at `depth` lies in the other by the clip-to-clip matrix `m`, in
+/// pixels; None behind the camera.
+fn map_pixel(m: Mat4, x: f32, y: f32, depth: f32, w: u32, h: u32) -> Option<(f32, f32, f32)> {
+    let ndc = Vec4::new(
+        x / w as f32 * 2.0 - 1.0,
+        1.0 - y / h as f32 * 2.0,
+        depth,
+        1.0,
+    );
+    let c = m * ndc;
+    if c.w <= 0.0 {
+        return None;
+    }
+    let o = c.truncate() / c.w;
+    Some((
+        (o.x + 1.0) * 0.5 * w as f32,
+        (1.0 - o.y) * 0.5 * h as f32,
+        o.z,
+    ))
+}
+
+/// Within 1e-3 pixel of a pixel edge: floating-point rounding could put it on either side.
+fn near_edge(v: f32) -> bool {
+    (v - v.round()).abs() < 1e-3
+}
+
+/// `--fsi-check forward`: the older texel whose fragment, reprojected with its own depth by `m`, lands within a
+/// pixel (in x and in y) of pixel `p`'s centre, searched from `q` by moving the lookup by the rounded miss, at
+/// most 4 texels in all (the shader's FORWARD_STEPS and FORWARD_TOLERANCE). Outer None where rounding could go
+/// either way.
+fn forward_match(fr: &Frame, m: Mat4, p: (u32, u32), q: (u32, u32)) -> Option<Option<(u32, u32)>> {
+    let (w, h) = (fr.older.width, fr.older.height);
+    let centre = (p.0 as f32 + 0.5, p.1 as f32 + 0.5);
+    let mut q = (q.0 as i64, q.1 as i64);
+    for _ in 0..4 {
+        let d = fr.older.depth[(q.1 * w as i64 + q.0) as usize];
+        let Some((fx, fy, _)) = map_pixel(m, q.0 as f32 + 0.5, q.1 as f32 + 0.5, d, w, h) else {
+            return Some(None);
+        };
+        let miss = (centre.0 - fx, centre.1 - fy);
+        // Near the tolerance or a rounding boundary of the miss, the GPU may go either way.
+        let unsure = |v: f32| (v.abs() - 1.0).abs() < 1e-3 || (v - v.floor() - 0.5).abs() < 1e-3;
+        if unsure(miss.0) || unsure(miss.1) {
+            return None;
+        }
+        if miss.0.abs() <= 1.0 && miss.1.abs() <= 1.0 {
+            return Some(Some((q.0 as u32, q.1 as u32)));
+        }
+        q = (
+            q.0 + miss.0.round_ties_even() as i64,
+            q.1 + miss.1.round_ties_even() as i64,
+        );
+        if q.0 < 0 || q.1 < 0 || q.0 >= w as i64 || q.1 >= h as i64 {
+            return Some(None);
+        }
+    }
+    Some(None)
 }
 
 /// What the combination pass must write at pixel (x, y), by the paper: None where floating-point rounding
@@ -158,26 +238,24 @@ fn expected(fr: &Frame, x: u32, y: u32, reproject: bool) -> Option<(Case, [f32; 
     let newer = [cn[0] as f32, cn[1] as f32, cn[2] as f32];
     let dn = fr.newer.depth[p];
     let (q, dn_old) = if reproject {
-        let ndc = Vec4::new(
-            (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
-            1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
-            dn,
-            1.0,
-        );
-        let c = fr.reproject * ndc;
-        if c.w <= 0.0 {
+        let Some(px) = map_pixel(fr.reproject, x as f32 + 0.5, y as f32 + 0.5, dn, w, h) else {
             return Some((Case::Outside, newer, (x, y)));
-        }
-        let o = c.truncate() / c.w;
-        let px = ((o.x + 1.0) * 0.5 * w as f32, (1.0 - o.y) * 0.5 * h as f32);
-        let edge = |v: f32| (v - v.round()).abs() < 1e-3;
-        if edge(px.0) || edge(px.1) {
+        };
+        if near_edge(px.0) || near_edge(px.1) {
             return None;
         }
         if px.0 < 0.0 || px.1 < 0.0 || px.0 >= w as f32 || px.1 >= h as f32 {
             return Some((Case::Outside, newer, (x, y)));
         }
-        ((px.0.floor() as u32, px.1.floor() as u32), o.z)
+        let q = (px.0.floor() as u32, px.1.floor() as u32);
+        let q = match fr.forward {
+            Some(m) => match forward_match(fr, m, (x, y), q)? {
+                Some(q) => q,
+                None => return Some((Case::NoMatch, newer, (x, y))),
+            },
+            None => q,
+        };
+        (q, px.2)
     } else {
         ((x, y), dn)
     };
@@ -402,6 +480,52 @@ fn d_reprojection_follows_equation_2() {
     let same = render_fsi(&ctx, &scene, Variant::NoReproject, 31);
     let (_, moved) = check_combination(&same, false);
     assert_eq!(moved, 0);
+}
+
+/// `--fsi-check forward` (not in the paper): the older fragment used is one that reprojects, with its own depth,
+/// into the pixel, found from eq. 2's lookup by moving it by the miss. A near bunny in transition (k = 0.25) in
+/// front of a far one that the camera orbits: the near bunny moves a few pixels a frame across the view, so
+/// eq. 2 back-projects the background it uncovers onto where it stood a frame ago (section 4.2's
+/// disocclusion), and the background seen through eq. 1's holes onto another part of it. Every pixel matches
+/// the CPU model; the search moves lookups and finds no fragment for some pixels.
+#[test]
+fn f_forward_check_finds_the_fragment_that_moved_here() {
+    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let d = near_distance();
+    let s0 = d / (1.0 - 0.025);
+    // Instance 0 (the orbit's centre) far at LOD3, instance 1 near, in the band of the first switch.
+    let scene = static_scene(&[d * 3.0, d], [s0, s0 * 1.2, s0 * 1.4], 8, "orbit");
+    // Frame 3's newer buffer holds the stippled LOD1, frame 4's the complete LOD0.
+    for last in [3, 4] {
+        let checked =
+            render_fsi_checked(&ctx, &scene, Variant::Sequential, FsiCheck::Forward, last);
+        assert!(checked.forward.is_some());
+        let (with, moved_checked) = check_combination(&checked, true);
+        assert!(count(&with, Case::NoMatch) > 50, "frame {last}: {with:?}");
+        let plain = render_fsi(&ctx, &scene, Variant::Sequential, last);
+        let (without, moved_plain) = check_combination(&plain, true);
+        assert_eq!(count(&without, Case::NoMatch), 0);
+        // The search moved lookups away from eq. 2's.
+        assert!(
+            moved_checked != moved_plain,
+            "{moved_checked} {moved_plain}"
+        );
+        if last == 3 {
+            // Most holes of the stippled LOD1 still show the older LOD0, found by the search.
+            let (a, b) = (
+                count(&with, Case::OlderCloser),
+                count(&without, Case::OlderCloser),
+            );
+            assert!(b > 1000 && a > b * 3 / 4, "{with:?} against {without:?}");
+        }
+        // The buffers are the same; only the combination differs.
+        assert!(plain.newer.color == checked.newer.color && plain.older.id == checked.older.id);
+        assert!(plain.out != checked.out);
+    }
+    // The other variants do not reproject, and ignore the check.
+    let same = render_fsi_checked(&ctx, &scene, Variant::NoReproject, FsiCheck::Forward, 3);
+    let plain = render_fsi(&ctx, &scene, Variant::NoReproject, 3);
+    assert!(same.out == plain.out);
 }
 
 /// Section 4.1: the triangle count stays even between frames. Eight static bunnies in the transition bands of

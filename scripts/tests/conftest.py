@@ -56,3 +56,16 @@ def viewport_experiment(tmp_path_factory) -> Path:
     out = base / "run"
     lodbench("experiment", str(spec), "--out", str(out))
     return out
+
+
+@pytest.fixture(scope="session")
+def check_experiment(tmp_path_factory) -> Path:
+    """A sweep of a variable other than the viewport (`fsi-check`) written by `lodbench experiment`."""
+    base = tmp_path_factory.mktemp("experiment")
+    spec = base / "check.toml"
+    spec.write_text('name = "check"\n[run]\nscene = ["windmills"]\nmethod = ["fsi"]\nprofile = "ci"\n'
+                    'frames = 6\nwarmup = 0\nwidth = 64\nheight = 64\n'
+                    '[sweep]\nvariable = "fsi-check"\nvalues = ["none", "forward"]\n')
+    out = base / "run"
+    lodbench("experiment", str(spec), "--out", str(out))
+    return out

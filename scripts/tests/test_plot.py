@@ -72,3 +72,14 @@ def test_viewport_experiment_gets_fig8(viewport_experiment, tmp_path):
     assert r.returncode == 0, r.stderr
     assert "fig8_bunny-sweep.png" in figures(folder)
     assert "| 64,48 | bunny-sweep | discrete |" in (folder / "report.md").read_text()
+
+
+def test_other_sweep_variable_splits_the_series(check_experiment, tmp_path):
+    folder = tmp_path / "exp"
+    shutil.copytree(check_experiment, folder)
+    r = plot(folder)
+    assert r.returncode == 0, r.stderr
+    report = (folder / "report.md").read_text()
+    assert "| none | windmills | fsi (fsi-check none) |" in report
+    assert "| forward | windmills | fsi (fsi-check forward) |" in report
+    assert "fig8_windmills.png" not in figures(folder)

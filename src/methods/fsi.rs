@@ -68,6 +68,27 @@ pub enum Variant {
     SameFrame,
 }
 
+/// `--fsi-check`: an optional test on the older buffer's fragment before the combination pass uses it. Not in
+/// the paper; off by default, so `fsi` is the paper's method unless asked otherwise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum FsiCheck {
+    /// The paper's combination: the older fragment at eq. 2's lookup.
+    None,
+    /// Forward consistency (`fsi` only; the ablations do not reproject): the older fragment used is one that,
+    /// reprojected into the newer frame with its own depth (eq. 2 inverted), lands within a pixel of the
+    /// pixel's centre: eq. 2's lookup if it does, else the texel found by moving the lookup by the rounded
+    /// miss (at most 4 texels tried); if none does, the pixel takes the newer colour, as a pixel that
+    /// reprojects outside does. Eq. 2 back-projects with the newer depth, which is the background's wherever
+    /// the newer buffer shows background: where the camera's motion has uncovered it, the lookup lands where a
+    /// near object stood a frame ago and case 3 shows the object there again (section 4.2's disocclusion
+    /// artefact; no fragment of it lands near the pixel, so it is rejected); where eq. 1 discarded a
+    /// t-instance's fragment, the lookup lands on another part of the other LOD (the search finds the part
+    /// that moved here). The tolerance is a pixel, not a pixel's half-width, so that an image that magnifies
+    /// between frames leaves no pixel without a match.
+    Forward,
+}
+
 /// tau of eq. 1 for LOD `lod` of a t-instance in state `s` (Fig. 2): the incoming LOD fades in over the first
 /// half of the transition, the outgoing one fades out over the second.
 pub fn tau(s: &InstanceState, lod: u32) -> f32 {
@@ -208,11 +229,14 @@ type Started = (i64, (u32, u32), u32);
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct CombineRaw {
     reproject: [[f32; 4]; 4],
+    forward: [[f32; 4]; 4],
     size_mode: [f32; 4],
 }
 
 pub struct Fsi {
     variant: Variant,
+    /// `--fsi-check forward`, on `fsi` (the only variant that reprojects).
+    forward_check: bool,
     name: &'static str,
     buffers: [LodBuffer; 2],
     lists: [DrawList; 2],
@@ -410,6 +434,7 @@ impl Fsi {
         };
         Fsi {
             variant,
+            forward_check: variant == Variant::Sequential && options.fsi_check == FsiCheck::Forward,
             name,
             buffers,
             lists: [DrawList::default(), DrawList::default()],
@@ -724,11 +749,12 @@ impl Method for Fsi {
         let same_pixel = self.variant != Variant::Sequential;
         let raw = CombineRaw {
             reproject: reprojection(&camera, &old_camera).to_cols_array_2d(),
+            forward: reprojection(&old_camera, &camera).to_cols_array_2d(),
             size_mode: [
                 target.width as f32,
                 target.height as f32,
                 if same_pixel { 1.0 } else { 0.0 },
-                0.0,
+                if self.forward_check { 1.0 } else { 0.0 },
             ],
         };
         gpu.queue

@@ -40,6 +40,7 @@ pub struct MethodOptions {
     pub noise: NoisePattern,
     pub correspondence: Correspondence,
     pub vis_texture: VisTexture,
+    pub fsi_check: fsi::FsiCheck,
     pub seed: u64,
 }
 
@@ -49,6 +50,7 @@ impl Default for MethodOptions {
             noise: NoisePattern::White16,
             correspondence: Correspondence::Nearest,
             vis_texture: VisTexture::Noise,
+            fsi_check: fsi::FsiCheck::None,
             seed: 1,
         }
     }
