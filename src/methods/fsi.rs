@@ -85,7 +85,9 @@ pub enum FsiCheck {
     /// artefact; no fragment of it lands near the pixel, so it is rejected); where eq. 1 discarded a
     /// t-instance's fragment, the lookup lands on another part of the other LOD (the search finds the part
     /// that moved here). The tolerance is a pixel, not a pixel's half-width, so that an image that magnifies
-    /// between frames leaves no pixel without a match.
+    /// between frames leaves no pixel without a match. Like eq. 2 it assumes objects do not move: a moving
+    /// t-instance's older fragments can miss by more than a pixel, and then its holes show what is behind it
+    /// (measured in the README).
     Forward,
 }
 
