@@ -127,8 +127,8 @@ pub struct RunArgs {
     /// Visibility texture of Frame Sequential Interpolation (`fsi*`, seed 000 section 3.3).
     #[arg(long, value_enum, default_value_t = crate::noise::VisTexture::Noise)]
     pub vis_texture: crate::noise::VisTexture,
-    /// `fsi` only, not in the paper: `forward` shows an older fragment only if it reprojects into the pixel
-    /// with its own depth (rejects disocclusion ghosts, seed 000 section 4.2).
+    /// `fsi` only, not in the paper: `forward` uses an older fragment only if, reprojected with its own depth,
+    /// it lands within a pixel of the pixel (rejects the disocclusion ghosts of seed 000 section 4.2).
     #[arg(long, value_enum, default_value_t = crate::methods::fsi::FsiCheck::None)]
     pub fsi_check: crate::methods::fsi::FsiCheck,
     /// Image metrics per frame (rmse, pop and de2000 are always computed; flip adds NVIDIA FLIP, on the CPU).
