@@ -514,12 +514,10 @@ fn f_forward_check_finds_the_fragment_that_moved_here() {
     for last in [3, 4] {
         let checked =
             render_fsi_checked(&ctx, &scene, Variant::Sequential, FsiCheck::Forward, last);
-        assert!(checked.forward.is_some());
         let (with, checked_lookups) = check_combination(&checked, true);
         assert!(count(&with, Case::NoMatch) > 50, "frame {last}: {with:?}");
         let plain = render_fsi(&ctx, &scene, Variant::Sequential, last);
         let (without, plain_lookups) = check_combination(&plain, true);
-        assert_eq!(count(&without, Case::NoMatch), 0);
         // The search found another texel than eq. 2's lookup for many pixels (the buffers are the same, so the
         // plain run's lookup is eq. 2's).
         let searched = checked_lookups
