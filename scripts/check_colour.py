@@ -19,17 +19,12 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
+
+from dumps import load_rgb, parse_stem
 
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")  # colour-science warns about optional packages it does not need here
     import colour
-
-
-def load_rgb(path: Path) -> np.ndarray:
-    """The PNG's R, G, B as sRGB-encoded floats in [0, 1]."""
-    with Image.open(path) as im:
-        return np.asarray(im.convert("RGB"), dtype=np.float64) / 255.0
 
 
 def rmse(a: np.ndarray, b: np.ndarray) -> float:
@@ -43,14 +38,6 @@ def de2000_mean(a: np.ndarray, b: np.ndarray) -> float:
         lab_a = colour.XYZ_to_Lab(colour.sRGB_to_XYZ(a))
         lab_b = colour.XYZ_to_Lab(colour.sRGB_to_XYZ(b))
         return float(np.mean(colour.delta_E(lab_a, lab_b, method="CIE 2000")))
-
-
-def parse_stem(name: str):
-    """`{scene}_{method}_c{count}_f{frame:05}_method.png` -> (scene, method, count, frame)."""
-    parts = name[: -len("_method.png")].split("_")
-    if len(parts) != 4 or not parts[2].startswith("c") or not parts[3].startswith("f"):
-        return None
-    return parts[0], parts[1], parts[2][1:], str(int(parts[3][1:]))
 
 
 def main() -> int:

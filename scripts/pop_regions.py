@@ -18,19 +18,13 @@ reference's border (override with --background R,G,B as bytes). Exit 2 with a me
 """
 import argparse
 import csv
-import re
 import sys
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
 
-DUMP = re.compile(r"^(?P<scene>[^_]+)_(?P<method>[^_]+)_c(?P<count>\d+)_f(?P<frame>\d+)_method\.png$")
-
-
-def load(path: Path) -> np.ndarray:
-    return np.asarray(Image.open(path).convert("RGB"), dtype=np.int16)
+from dumps import load_rgb, parse_stem
 
 
 def dilate(mask: np.ndarray, steps: int) -> np.ndarray:
@@ -51,9 +45,10 @@ def border_colour(img: np.ndarray) -> tuple:
 
 
 def regions(method_prev, reference_prev, method, reference, band, background=None) -> dict:
-    """The numbers of one frame t from the method and reference images (H x W x 3 bytes) at t-1 and t."""
-    bg = np.array(background if background is not None else border_colour(reference), dtype=np.int16)
-    diff = ((method - reference) - (method_prev - reference_prev)) / 255.0
+    """The numbers of one frame t from the method and reference images (H x W x 3, values in [0, 1], as
+    `load_rgb` reads them) at t-1 and t; `background` in the same units."""
+    bg = np.array(background if background is not None else border_colour(reference))
+    diff = (method - reference) - (method_prev - reference_prev)
     energy = (diff ** 2).sum(axis=2)
     obj = np.any(reference != bg, axis=2)
     obj_prev = np.any(reference_prev != bg, axis=2)
@@ -73,11 +68,19 @@ def regions(method_prev, reference_prev, method, reference, band, background=Non
 def parse_frames(text):
     frames = set()
     for part in text.split(","):
-        lo, _, hi = part.partition("-")
-        if not lo.strip().isdigit() or (hi and not hi.strip().isdigit()):
+        lo, sep, hi = part.partition("-")
+        if not lo.strip().isdigit() or (sep and not hi.strip().isdigit()):
             raise ValueError(f"--frames {text!r}: expected numbers and ranges like 40-50,60")
         frames.update(range(int(lo), int(hi or lo) + 1))
     return frames
+
+
+def parse_background(text):
+    """`R,G,B` bytes -> the colour in [0, 1]."""
+    parts = text.split(",")
+    if len(parts) != 3 or not all(p.strip().isdigit() and int(p) <= 255 for p in parts):
+        raise ValueError(f"--background {text!r}: expected three bytes R,G,B")
+    return [int(p) / 255.0 for p in parts]
 
 
 def main() -> int:
@@ -93,42 +96,38 @@ def main() -> int:
     frames_dir = args.run / "frames"
     try:
         wanted = parse_frames(args.frames) if args.frames else None
-        background = None
-        if args.background:
-            background = [int(v) for v in args.background.split(",")]
-            if len(background) != 3 or not all(0 <= v <= 255 for v in background):
-                raise ValueError
+        background = parse_background(args.background) if args.background else None
     except ValueError as e:
-        msg = str(e) or f"--background {args.background!r}: expected three bytes R,G,B"
-        print(f"error: {msg}", file=sys.stderr)
+        print(f"error: {e}", file=sys.stderr)
         return 2
     if args.band < 1:
         print(f"error: --band {args.band}: expected 1 or more", file=sys.stderr)
         return 2
     dumps = sorted(frames_dir.glob("*_method.png")) if frames_dir.is_dir() else []
-    keys = [m.groupdict() for m in (DUMP.match(p.name) for p in dumps) if m]
+    keys = [k for k in (parse_stem(p.name) for p in dumps) if k]
     if not keys:
         print(f"error: {frames_dir} holds no dumped frames (run lodbench with --dump-frames)", file=sys.stderr)
         return 2
-    methods = args.method.split(",") if args.method else sorted({k["method"] for k in keys})
+    methods = args.method.split(",") if args.method else sorted({method for _, method, _, _ in keys})
     csv_pop = {}
     if (args.run / "frames.csv").is_file():
         with open(args.run / "frames.csv", newline="") as f:
             for r in csv.DictReader(f):
-                csv_pop[(r["scene"], r["method"], r["count"], int(r["frame"]))] = r["pop"]
+                csv_pop[(r["scene"], r["method"], r["count"], r["frame"])] = r["pop"]
     print("scene,method,count,frame,pop,pop_csv,silhouette,interior,extra,missing")
     reported = 0
-    for k in keys:
-        t = int(k["frame"])
-        if k["method"] not in methods or (wanted is not None and t not in wanted):
+    for key in keys:
+        scene, method, count, frame = key
+        t = int(frame)
+        if method not in methods or (wanted is not None and t not in wanted):
             continue
-        stem = frames_dir / f"{k['scene']}_{k['method']}_c{k['count']}_f"
+        stem = frames_dir / f"{scene}_{method}_c{count}_f"
         paths = [Path(f"{stem}{f:05d}_{kind}.png") for f in (t - 1, t) for kind in ("method", "reference")]
         if not all(p.is_file() for p in paths):
             continue
-        r = regions(*(load(p) for p in paths), band=args.band, background=background)
-        pop_csv = csv_pop.get((k["scene"], k["method"], k["count"], t), "")
-        print(f"{k['scene']},{k['method']},{k['count']},{t},{r['pop']:.6f},{pop_csv and f'{float(pop_csv):.6f}'},"
+        r = regions(*(load_rgb(p) for p in paths), band=args.band, background=background)
+        pop_csv = csv_pop.get(key, "")
+        print(f"{scene},{method},{count},{t},{r['pop']:.6f},{pop_csv and f'{float(pop_csv):.6f}'},"
               f"{r['silhouette']:.4f},{r['interior']:.4f},{r['extra']},{r['missing']}")
         reported += 1
     if reported == 0:

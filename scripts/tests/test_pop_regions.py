@@ -89,5 +89,8 @@ def test_bad_input_is_named(tmp_path):
     assert r.returncode == 2 and "--frames" in r.stderr
     r = run(folder, "--method", "alpha")
     assert r.returncode == 2 and "no dumped frame matched" in r.stderr
-    r = run(folder, "--background", "1,2")
-    assert r.returncode == 2 and "--background" in r.stderr
+    for bad in ("1,2", "a,b,c", "1,2,256"):
+        r = run(folder, "--background", bad)
+        assert r.returncode == 2 and "--background" in r.stderr, (bad, r.stderr)
+    r = run(folder, "--frames", "40-")
+    assert r.returncode == 2 and "--frames" in r.stderr
