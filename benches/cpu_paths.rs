@@ -1,12 +1,19 @@
 //! Criterion benches of the CPU paths: LOD generation, the schedule, the metrics oracle, CSV export.
 //! `cargo bench --bench cpu_paths`
 
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "a test or bench fails by panicking"
+)]
+
 use criterion::{criterion_group, criterion_main, Criterion};
-use lodbench::export::csv::{FrameRecord, FramesWriter};
+use lodbench::export::csv::FramesWriter;
 use lodbench::lod::{LodChain, DEFAULT_TARGETS};
 use lodbench::mesh::Mesh;
 use lodbench::metrics::SequenceMetrics;
 use lodbench::morph;
+use lodbench::records::FrameRecord;
 use lodbench::rng::SplitMix64;
 use lodbench::scene::BUNNY_OBJ;
 use lodbench::schedule::{LodSchedule, ScheduleParams};

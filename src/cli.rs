@@ -1,8 +1,15 @@
 //! The command-line contract (clap derive). Scripts, CI and later issues rely on these exact names.
+//!
+//! `RunArgs` and `SceneArgs` are also what an experiment file's `[run]` table deserialises into (kebab-case
+//! keys, the flags' names without dashes); a key it leaves out takes the flag's default
+//! (`crate::defaults::clap_defaults`), so a file and a command line with the same settings are the same run.
 
+use crate::methods::MethodOptions;
+use crate::metrics::Metric;
+use crate::scene::{CameraMode, Profile};
 use crate::schedule::FadeMode;
-use clap::{Args, Parser, Subcommand, ValueEnum};
-use serde::Serialize;
+use clap::{Args, Parser, Subcommand};
+use serde::Deserialize;
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -41,20 +48,9 @@ pub struct ExperimentArgs {
     pub check: bool,
 }
 
-/// Size and length presets; explicit flags override them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum Profile {
-    /// A minute's look at everything: small viewport, few frames.
-    Quick,
-    /// What CI runs on a software adapter.
-    Ci,
-    /// The papers' sizes: 800x600, 3,600 timed frames, the full instance counts.
-    Paper,
-}
-
 /// Flags that change what a scene is (shared by `run` and `describe`).
-#[derive(Debug, Clone, Args)]
+#[derive(Debug, Clone, Args, Deserialize)]
+#[serde(default, rename_all = "kebab-case")]
 pub struct SceneArgs {
     /// Size preset; explicit flags override it.
     #[arg(long, value_enum, default_value_t = Profile::Quick)]
@@ -79,6 +75,7 @@ pub struct SceneArgs {
     pub switch_distances: Option<Vec<f32>>,
     /// bunny-grid instance counts; each count is its own block of rows.
     #[arg(long, value_delimiter = ',')]
+    #[serde(deserialize_with = "one_or_many")]
     pub count: Vec<u32>,
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = 60.0)]
@@ -98,19 +95,29 @@ pub struct SceneArgs {
     /// Camera motion: `fixed` (the scene's own path) or `orbit` (the camera swings around what it looks at,
     /// +-30 degrees over 240 frames, keeping its distance: every pixel moves, which exercises FSI's
     /// reprojection).
-    #[arg(long, value_enum, default_value_t = crate::scene::CameraMode::Fixed)]
-    pub camera: crate::scene::CameraMode,
+    #[arg(long, value_enum, default_value_t = CameraMode::Fixed)]
+    pub camera: CameraMode,
 }
 
-#[derive(Debug, Clone, Args)]
+impl Default for SceneArgs {
+    fn default() -> Self {
+        crate::defaults::clap_defaults()
+    }
+}
+
+#[derive(Debug, Clone, Args, Deserialize)]
+#[serde(default, rename_all = "kebab-case")]
 pub struct RunArgs {
     /// Scenes to run (comma-separated or repeated); all when absent.
     #[arg(long, value_delimiter = ',')]
+    #[serde(deserialize_with = "one_or_many")]
     pub scene: Vec<String>,
     /// Methods to run (comma-separated or repeated); all when absent.
     #[arg(long, value_delimiter = ',')]
+    #[serde(deserialize_with = "one_or_many")]
     pub method: Vec<String>,
     #[command(flatten)]
+    #[serde(flatten)]
     pub scene_args: SceneArgs,
     /// Untimed frames rendered before the timed ones.
     #[arg(long)]
@@ -118,22 +125,13 @@ pub struct RunArgs {
     /// Seed of every random choice (recorded in run.json).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Threshold pattern of noise blending (`dither`).
-    #[arg(long, value_enum, default_value_t = crate::noise::NoisePattern::White16)]
-    pub noise: crate::noise::NoisePattern,
-    /// Vertex correspondence of geomorphing (`geomorph`).
-    #[arg(long, value_enum, default_value_t = crate::morph::Correspondence::Nearest)]
-    pub correspondence: crate::morph::Correspondence,
-    /// Visibility texture of Frame Sequential Interpolation (`fsi*`, seed 000 section 3.3).
-    #[arg(long, value_enum, default_value_t = crate::noise::VisTexture::Noise)]
-    pub vis_texture: crate::noise::VisTexture,
-    /// `fsi` only, not in the paper: `forward` uses an older fragment only if, reprojected with its own depth,
-    /// it lands within a pixel of the pixel (rejects the disocclusion ghosts of seed 000 section 4.2).
-    #[arg(long, value_enum, default_value_t = crate::methods::fsi::FsiCheck::None)]
-    pub fsi_check: crate::methods::fsi::FsiCheck,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub method_options: MethodOptions,
     /// Image metrics per frame (rmse, pop and de2000 are always computed; flip adds NVIDIA FLIP, on the CPU).
-    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [crate::metrics::Metric::Rmse, crate::metrics::Metric::Pop, crate::metrics::Metric::De2000])]
-    pub metrics: Vec<crate::metrics::Metric>,
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Metric::Rmse, Metric::Pop, Metric::De2000])]
+    #[serde(deserialize_with = "one_or_many")]
+    pub metrics: Vec<Metric>,
     /// Output folder (default results/<scene>-<time>/).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -150,6 +148,31 @@ pub struct RunArgs {
     /// --dump-every), so a long run's dumps land where methods differ.
     #[arg(long)]
     pub dump_transitions: bool,
+}
+
+impl Default for RunArgs {
+    fn default() -> Self {
+        crate::defaults::clap_defaults()
+    }
+}
+
+/// A list flag in a file: a single value or an array (`count = 50` or `count = [50, 250]`), as on the command
+/// line, where `--count 50` and `--count 50,250` both work.
+fn one_or_many<'de, D, T>(d: D) -> Result<Vec<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum OneOrMany<T> {
+        Many(Vec<T>),
+        One(T),
+    }
+    Ok(match OneOrMany::deserialize(d)? {
+        OneOrMany::Many(v) => v,
+        OneOrMany::One(x) => vec![x],
+    })
 }
 
 #[derive(Debug, Clone, Args)]
@@ -172,6 +195,30 @@ mod tests {
     #[test]
     fn cli_is_consistent() {
         Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn file_defaults_are_the_flag_defaults() {
+        let from_flags = match Cli::try_parse_from(["lodbench", "run"]).unwrap().command {
+            Command::Run(r) => r,
+            _ => unreachable!(),
+        };
+        let from_file: RunArgs = toml::from_str("").unwrap();
+        assert_eq!(format!("{from_flags:?}"), format!("{from_file:?}"));
+        let set: RunArgs = toml::from_str(
+            "count = 50\npixel-error = 2\nnoise = \"bayer4\"\nfsi-check = \"forward\"",
+        )
+        .unwrap();
+        assert_eq!(set.scene_args.count, vec![50]);
+        assert_eq!(set.scene_args.pixel_error, 2.0);
+        assert_eq!(
+            set.method_options.dither.noise,
+            crate::noise::NoisePattern::Bayer4
+        );
+        assert_eq!(
+            set.method_options.fsi.fsi_check,
+            crate::methods::fsi::FsiCheck::Forward
+        );
     }
 
     #[test]

@@ -11,70 +11,75 @@
 //! variable = "viewport"     # a [run] key, or "viewport" for [width, height] pairs
 //! values = [[256, 256], [512, 512]]
 //! ```
-//! The `[run]` table is turned into `lodbench run` arguments and validated exactly as on the command line.
-//! Unknown keys are errors naming the key and the line.
+//! The `[run]` table deserialises straight into `RunArgs` (the same struct clap fills from the command line,
+//! so a key takes exactly the values its flag takes, and a key left out takes the flag's default), and is then
+//! validated by `RunConfig::from_args` as on the command line. An unknown key, or a value of the wrong type, is
+//! an error naming the key and its line.
 
-use crate::cli::{Cli, Command};
+use crate::cli::RunArgs;
 use crate::config::RunConfig;
 use crate::error::{Error, Result};
-use clap::Parser;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// The file's schema (checked first, so a typo is reported with its line).
+/// The file's shape (checked first, so a typo outside `[run]` is reported with its line).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct ExperimentSchema {
-    #[allow(dead_code)]
+struct ExperimentFile {
     name: String,
-    #[allow(dead_code)]
     #[serde(default)]
     description: String,
-    #[allow(dead_code)]
-    run: RunKeys,
-    #[allow(dead_code)]
+    run: toml::Table,
     sweep: Option<SweepKeys>,
 }
 
-#[allow(dead_code)]
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, rename_all = "kebab-case")]
-struct RunKeys {
-    scene: Option<Vec<String>>,
-    method: Option<Vec<String>>,
-    profile: Option<String>,
-    width: Option<u32>,
-    height: Option<u32>,
-    frames: Option<u32>,
-    warmup: Option<u32>,
-    seed: Option<u64>,
-    count: Option<Vec<u32>>,
-    mesh: Option<String>,
-    pixel_error: Option<f64>,
-    switch_distances: Option<Vec<f64>>,
-    fov: Option<f64>,
-    fade: Option<String>,
-    band: Option<f64>,
-    fade_frames: Option<u32>,
-    hysteresis: Option<f64>,
-    noise: Option<String>,
-    correspondence: Option<String>,
-    vis_texture: Option<String>,
-    fsi_check: Option<String>,
-    camera: Option<String>,
-    metrics: Option<Vec<String>>,
-    adapter: Option<String>,
-    dump_frames: Option<bool>,
-    dump_every: Option<u32>,
-    dump_transitions: Option<bool>,
-}
-
-#[allow(dead_code)]
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SweepKeys {
     variable: String,
     values: Vec<toml::Value>,
+}
+
+/// The keys `[run]` takes: every `lodbench run` flag without its dashes, except `out` (the experiment decides
+/// where each run writes).
+pub fn run_keys() -> Vec<String> {
+    use clap::Args;
+    RunArgs::augment_args(clap::Command::new("run"))
+        .get_arguments()
+        .filter_map(|a| a.get_long().map(str::to_string))
+        .filter(|k| k != "out")
+        .collect()
+}
+
+/// Line number (1-based) and text of `key = ...` inside the `[run]` table of `text`, if it is there.
+fn key_line<'t>(text: &'t str, key: &str) -> Option<(usize, &'t str)> {
+    let mut in_run = false;
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim();
+        if t.starts_with('[') {
+            in_run = t.trim_start_matches('[').trim_end_matches(']').trim() == "run";
+        } else if in_run {
+            let k = t.split('=').next().unwrap_or("").trim().trim_matches('"');
+            if k == key {
+                return Some((i + 1, t));
+            }
+        }
+    }
+    None
+}
+
+/// `table` as `RunArgs`. On a bad value, the key at fault is found by reading each key alone (serde's message
+/// for a flattened struct does not name it).
+fn run_args(table: &toml::Table) -> std::result::Result<RunArgs, (String, String)> {
+    RunArgs::deserialize(toml::Value::Table(table.clone())).map_err(|whole| {
+        for (k, v) in table {
+            let alone = toml::Table::from_iter([(k.clone(), v.clone())]);
+            if let Err(e) = RunArgs::deserialize(toml::Value::Table(alone)) {
+                return (k.clone(), e.message().trim().to_string());
+            }
+        }
+        (String::new(), whole.message().trim().to_string())
+    })
 }
 
 /// One run of the experiment: the swept value (as written in the column) and its validated configuration.
@@ -102,23 +107,8 @@ fn value_text(v: &toml::Value) -> String {
     }
 }
 
-fn args_of(run: &toml::Table) -> Vec<String> {
-    let mut argv = vec!["lodbench".to_string(), "run".to_string()];
-    for (k, v) in run {
-        match v {
-            toml::Value::Boolean(true) => argv.push(format!("--{k}")),
-            toml::Value::Boolean(false) => {}
-            _ => {
-                argv.push(format!("--{k}"));
-                argv.push(value_text(v));
-            }
-        }
-    }
-    argv
-}
-
 impl Experiment {
-    /// Reads and validates an experiment file: schema, then every run's flags as `lodbench run` would.
+    /// Reads and validates an experiment file: its shape, then every run's flags as `lodbench run` would.
     pub fn load(path: &Path) -> Result<Experiment> {
         let name = path.display().to_string();
         let bad = |problem: String| Error::Config(format!("experiment {name}: {problem}"));
@@ -132,42 +122,41 @@ impl Experiment {
             }
             None => e.message().to_string(),
         };
-        toml::from_str::<ExperimentSchema>(&text).map_err(|e| bad(at(&e)))?;
-        let doc: toml::Table = toml::from_str(&text).map_err(|e| bad(at(&e)))?;
-        let get_str = |k: &str| {
-            doc.get(k)
-                .and_then(|v| v.as_str())
-                .unwrap_or("")
-                .to_string()
+        let file: ExperimentFile = toml::from_str(&text).map_err(|e| bad(at(&e)))?;
+        let keys = run_keys();
+        let where_is = |key: &str| match key_line(&text, key) {
+            Some((line, source)) => format!("line {line} (`{source}`): "),
+            None => String::new(),
         };
-        let run = doc
-            .get("run")
-            .and_then(|v| v.as_table())
-            .cloned()
-            .unwrap_or_default();
-        let sweep = doc.get("sweep").and_then(|v| v.as_table());
+        for key in file.run.keys() {
+            if !keys.contains(key) {
+                return Err(bad(format!(
+                    "{}[run] has no key '{key}' (the keys are `lodbench run`'s flags without dashes, \
+                     except out: {})",
+                    where_is(key),
+                    keys.join(", ")
+                )));
+            }
+        }
         let mut variants: Vec<(Option<String>, toml::Table)> = Vec::new();
-        let variable = match sweep {
+        let variable = match &file.sweep {
             None => {
-                variants.push((None, run.clone()));
+                variants.push((None, file.run.clone()));
                 None
             }
-            Some(s) => {
-                let var = s
-                    .get("variable")
-                    .and_then(|v| v.as_str())
-                    .unwrap_or("")
-                    .to_string();
-                let values = s
-                    .get("values")
-                    .and_then(|v| v.as_array())
-                    .cloned()
-                    .unwrap_or_default();
-                if values.is_empty() {
+            Some(sweep) => {
+                let var = sweep.variable.as_str();
+                if var != "viewport" && !keys.iter().any(|k| k == var) {
+                    return Err(bad(format!(
+                        "[sweep] variable '{var}' is not a [run] key or viewport (the keys: {})",
+                        keys.join(", ")
+                    )));
+                }
+                if sweep.values.is_empty() {
                     return Err(bad("[sweep] values is empty".into()));
                 }
-                for v in &values {
-                    let mut t = run.clone();
+                for v in &sweep.values {
+                    let mut t = file.run.clone();
                     if var == "viewport" {
                         let pair = v.as_array().filter(|a| a.len() == 2);
                         let Some(pair) = pair else {
@@ -178,50 +167,27 @@ impl Experiment {
                         t.insert("width".into(), pair[0].clone());
                         t.insert("height".into(), pair[1].clone());
                     } else {
-                        // Reuse the schema to check the variable is a [run] key.
-                        let probe = format!("[run]\n{var} = {v}\n");
-                        #[derive(Deserialize)]
-                        #[serde(deny_unknown_fields)]
-                        struct Probe {
-                            #[allow(dead_code)]
-                            run: RunKeys,
-                        }
-                        toml::from_str::<Probe>(&probe).map_err(|e| {
-                            bad(format!(
-                                "[sweep] variable '{var}' with value {v}: {}",
-                                e.message()
-                            ))
-                        })?;
-                        t.insert(var.clone(), v.clone());
+                        t.insert(var.to_string(), v.clone());
                     }
                     variants.push((Some(value_text(v)), t));
                 }
-                Some(var)
+                Some(var.to_string())
             }
         };
         let mut runs = Vec::new();
         for (value, table) in variants {
-            let args = match Cli::try_parse_from(args_of(&table)) {
-                Ok(Cli {
-                    command: Command::Run(r),
-                }) => r,
-                Ok(_) => unreachable!("args_of always builds a run command"),
-                Err(e) => {
-                    let msg = e.to_string();
-                    let first = msg
-                        .lines()
-                        .next()
-                        .unwrap_or("")
-                        .trim_start_matches("error: ");
-                    return Err(bad(format!("[run] {first}")));
-                }
-            };
+            let args = run_args(&table).map_err(|(key, message)| match &value {
+                Some(v) if Some(key.as_str()) == variable.as_deref() || key.is_empty() => bad(
+                    format!("[sweep] variable '{key}' with value {v}: {message}"),
+                ),
+                _ => bad(format!("{}[run] {key}: {message}", where_is(&key))),
+            })?;
             let config = RunConfig::from_args(&args).map_err(|e| bad(e.to_string()))?;
             runs.push(PlannedRun { value, config });
         }
         Ok(Experiment {
-            name: get_str("name"),
-            description: get_str("description"),
+            name: file.name,
+            description: file.description,
             file: path.to_path_buf(),
             variable,
             runs,
@@ -289,6 +255,7 @@ fn merge(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use clap::Parser;
 
     fn write(dir: &Path, text: &str) -> PathBuf {
         let p = dir.join("e.toml");
@@ -346,6 +313,52 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("line 2"));
+    }
+
+    #[test]
+    fn every_run_key_is_read() {
+        // A key clap knows but serde named differently would be ignored silently: each key with a value of no
+        // flag's type (a table) must fail, naming that key.
+        for key in run_keys() {
+            let t = toml::Table::from_iter([(key.clone(), toml::Value::Table(toml::Table::new()))]);
+            let (k, _) = run_args(&t).expect_err(&key);
+            assert_eq!(k, key);
+        }
+        // And a key set in a file equals the flag on the command line.
+        let t: toml::Table = toml::from_str(
+            "scene = [\"bunny-grid\"]\ncount = [5, 7]\nfov = 50\ncamera = \"orbit\"\nvis-texture = \"radial\"\n\
+             correspondence = \"surface\"\ndump-frames = true\nmetrics = [\"rmse\", \"flip\"]\nseed = 9",
+        )
+        .unwrap();
+        let from_file = run_args(&t).unwrap();
+        let from_flags = match crate::cli::Cli::try_parse_from([
+            "lodbench",
+            "run",
+            "--scene",
+            "bunny-grid",
+            "--count",
+            "5,7",
+            "--fov",
+            "50",
+            "--camera",
+            "orbit",
+            "--vis-texture",
+            "radial",
+            "--correspondence",
+            "surface",
+            "--dump-frames",
+            "--metrics",
+            "rmse,flip",
+            "--seed",
+            "9",
+        ])
+        .unwrap()
+        .command
+        {
+            crate::cli::Command::Run(r) => r,
+            _ => unreachable!(),
+        };
+        assert_eq!(format!("{from_file:?}"), format!("{from_flags:?}"));
     }
 
     #[test]

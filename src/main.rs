@@ -2,8 +2,8 @@
 
 use clap::Parser;
 use lodbench::cli::{Cli, Command, DescribeArgs};
-use lodbench::config::{RunConfig, SceneConfig};
-use lodbench::scene::{SceneDef, SCENES};
+use lodbench::config::RunConfig;
+use lodbench::scene::{SceneConfig, SceneDef, SceneKind};
 use lodbench::{gpu, methods, runner, Error};
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
@@ -70,7 +70,7 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
             println!(
                 "  {} scenes {:?} methods {:?}",
                 r.value.as_deref().unwrap_or("-"),
-                r.config.scenes,
+                r.config.scenes.iter().map(|s| s.name()).collect::<Vec<_>>(),
                 r.config.methods
             );
         }
@@ -84,15 +84,18 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
     let out = args
         .out
         .clone()
-        .unwrap_or_else(|| runner::default_out_dir(std::slice::from_ref(&e.name)));
+        .unwrap_or_else(|| runner::default_out_dir(&[e.name.as_str()]));
     let folders = e.run(&out)?;
     println!("{} run(s) in {}", folders.len(), out.display());
     Ok(())
 }
 
 fn list() -> lodbench::Result<()> {
-    println!("scenes:  {}", SCENES.join(", "));
-    println!("methods: {}", methods::METHODS.join(", "));
+    println!("scenes:  {}", SceneKind::names().join(", "));
+    println!("methods:");
+    for m in methods::BUILTIN {
+        println!("  {:<16} {}", m.name, m.about);
+    }
     let adapters = gpu::context::enumerate_adapters();
     if adapters.is_empty() {
         println!("adapters: none found");
@@ -118,7 +121,7 @@ fn list() -> lodbench::Result<()> {
 
 fn describe(args: &DescribeArgs) -> lodbench::Result<()> {
     let cfg = SceneConfig::from_args(&args.scene_args)?;
-    let def = SceneDef::new(&args.scene, &cfg)?;
+    let def = SceneDef::new(SceneKind::from_name(&args.scene)?, &cfg)?;
     let d = def.describe(&cfg);
     if args.json {
         println!("{}", serde_json::to_string_pretty(&d)?);

@@ -170,7 +170,9 @@ pub fn de2000_mean(method: &[u8], reference: &[u8]) -> f64 {
 
 /// `--metrics`: the per-frame image metrics. rmse, pop and de2000 are always computed (on the GPU, at little
 /// cost); `flip` adds NVIDIA FLIP, computed on the CPU from read-back frames.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Metric {
     Rmse,

@@ -5,7 +5,7 @@ use crate::rng::SplitMix64;
 use serde::Serialize;
 
 /// `--noise`: which threshold pattern noise blending uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum NoisePattern {
     /// 16x16 white noise from the run's seed, as the paper's texture.
@@ -40,7 +40,7 @@ pub fn threshold_texture(pattern: NoisePattern, seed: u64) -> Option<(u32, Vec<f
 /// `--vis-texture`: the visibility texture of FSI (seed 000 section 3.3, eq. 1). A t-instance's fragment is kept
 /// where the texture's value at its object-space position is <= tau, so low values appear first while a LOD
 /// fades in and disappear last while it fades out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum VisTexture {
     /// 64x64 uniform white noise from the run's seed: the paper's choice for all its images.

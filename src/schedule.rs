@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use serde::Serialize;
 
 /// How k advances during a transition.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum FadeMode {
     /// k is the instance's position inside the band `[s(1-band), s(1+band)]` around switch distance s.

@@ -5,6 +5,12 @@
 //! Re-bless the baseline after an intended change with
 //! `LODBENCH_BLESS=1 cargo test --release --test ci_profile`.
 
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "a test or bench fails by panicking"
+)]
+
 use clap::Parser;
 use lodbench::cli::{Cli, Command};
 use lodbench::config::RunConfig;
@@ -142,7 +148,7 @@ fn column(rows: &[Row], method: &str, name: &str) -> Vec<f64> {
 #[test]
 fn smooth_methods_match_discrete_outside_transitions_and_pop_less() {
     let rows = read_csv(&ci_run().join("frames.csv"));
-    let methods: Vec<String> = lodbench::methods::METHODS
+    let methods: Vec<String> = lodbench::methods::names()
         .iter()
         .map(|m| m.to_string())
         .collect();

@@ -1,5 +1,11 @@
 //! Bad input ends in one clear `error:` line and a non-zero exit, never a panic.
 
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "a test or bench fails by panicking"
+)]
+
 use std::path::Path;
 use std::process::{Command, Output};
 

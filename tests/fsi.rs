@@ -2,17 +2,22 @@
 //! checked pixel by pixel against a CPU implementation of seed 000 sections 3.4-3.5 and eq. 2 that reads the
 //! same two LOD buffers (colour, depth, id) back from the GPU.
 
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "a test or bench fails by panicking"
+)]
+
 use clap::Parser;
 use glam::{Mat4, Vec3, Vec4};
 use indicatif::ProgressBar;
 use lodbench::cli::{Cli, Command};
-use lodbench::config::SceneConfig;
-use lodbench::gpu::renderer::{ColorReadback, RenderTarget, SceneGpu};
 use lodbench::gpu::GpuContext;
+use lodbench::gpu::{RenderTarget, SceneGpu, TextureReadback};
+use lodbench::measure::{BlockRunner, FrameDriver};
 use lodbench::methods::fsi::{reprojection, Fsi, FsiCheck, LodBufferImage, Variant};
 use lodbench::methods::{Method, MethodOptions};
-use lodbench::runner::{BlockRunner, FrameDriver};
-use lodbench::scene::{Motion, Scene, SceneDef};
+use lodbench::scene::{Motion, Scene, SceneConfig, SceneDef, SceneKind};
 use std::sync::Arc;
 
 const W: u32 = 160;
@@ -53,7 +58,7 @@ fn static_scene(distances: &[f32], switches: [f32; 3], frames: u32, camera: &str
             camera,
         ],
     );
-    let def = SceneDef::new("bunny-grid", &cfg).unwrap();
+    let def = SceneDef::new(SceneKind::BunnyGrid, &cfg).unwrap();
     let mut scene = def.instantiate(distances.len() as u32);
     for (inst, &d) in scene.instances.iter_mut().zip(distances) {
         inst.position = Vec3::new(d, 0.0, 0.0);
@@ -69,7 +74,9 @@ fn static_scene(distances: &[f32], switches: [f32; 3], frames: u32, camera: &str
 /// A distance that fits the whole bunny in view (the grid's first position with default switches).
 fn near_distance() -> f32 {
     let cfg = scene_cfg("bunny-grid", &["--count", "1"]);
-    let d = SceneDef::new("bunny-grid", &cfg).unwrap().instantiate(1);
+    let d = SceneDef::new(SceneKind::BunnyGrid, &cfg)
+        .unwrap()
+        .instantiate(1);
     d.instances[0].position.x
 }
 
@@ -95,13 +102,11 @@ fn render_fsi_checked(
     last: u32,
 ) -> Frame {
     let gpu = SceneGpu::new(ctx, scene).unwrap();
-    let options = MethodOptions {
-        fsi_check: check,
-        ..Default::default()
-    };
-    let mut fsi = Fsi::new(&gpu, scene, &options, variant);
+    let mut options = MethodOptions::default();
+    options.fsi.fsi_check = check;
+    let mut fsi = Fsi::new(&gpu, scene, &options.fsi, 1, variant);
     let target = RenderTarget::new(&ctx.device, "test target", scene.width, scene.height);
-    let readback = ColorReadback::new(&ctx.device, "test read-back", scene.width, scene.height);
+    let readback = TextureReadback::color(&ctx.device, "test read-back", scene.width, scene.height);
     let mut driver = FrameDriver::new(scene);
     for f in 0..=last {
         driver.advance(f);
@@ -362,12 +367,14 @@ fn a_no_transition_frames_match_discrete_bit_for_bit() {
                 camera,
             ],
         );
-        let scene = SceneDef::new("bunny-sweep", &cfg).unwrap().instantiate(1);
+        let scene = SceneDef::new(SceneKind::BunnySweep, &cfg)
+            .unwrap()
+            .instantiate(1);
         let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true, false).unwrap();
         let mut frames = std::collections::HashMap::new();
         for method in ["discrete", "fsi"] {
             let out = block
-                .run_method(method, 0, 1, &ProgressBar::hidden(), |f, m, _, _| {
+                .run_method(method, 0, 1, &ProgressBar::hidden(), |f, (m, _, _)| {
                     frames.insert((method, f), m.to_vec());
                     Ok(())
                 })
@@ -563,7 +570,7 @@ fn e_static_transitions_toggle_out_of_phase() {
     let scene = static_scene(&distances, [10.0, 20.0, 40.0], 6, "fixed");
     let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true, false).unwrap();
     let out = block
-        .run_method("fsi", 0, 1, &ProgressBar::hidden(), |_, _, _, _| Ok(()))
+        .run_method("fsi", 0, 1, &ProgressBar::hidden(), |_, _| Ok(()))
         .unwrap();
     let tris: Vec<u64> = out.rows.iter().map(|r| r.triangles).collect();
     assert!(
@@ -573,6 +580,6 @@ fn e_static_transitions_toggle_out_of_phase() {
     );
     // The first frame draws the scene twice.
     assert!(tris[0] > tris[1] * 3 / 2, "{tris:?}");
-    let alternation = lodbench::export::csv::tri_alternation_max(&out.rows);
+    let alternation = lodbench::records::tri_alternation_max(&out.rows);
     assert!(alternation < 0.02, "{alternation} {tris:?}");
 }

@@ -1,13 +1,20 @@
 //! Integration tests that render on a real adapter (Mesa lavapipe in CI) at small sizes.
 
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "a test or bench fails by panicking"
+)]
+
 use clap::Parser;
 use indicatif::ProgressBar;
 use lodbench::cli::{Cli, Command};
-use lodbench::config::{RunConfig, SceneConfig};
+use lodbench::config::RunConfig;
 use lodbench::gpu::GpuContext;
+use lodbench::measure::BlockRunner;
 use lodbench::metrics::SequenceMetrics;
-use lodbench::runner::{self, BlockRunner};
-use lodbench::scene::SceneDef;
+use lodbench::runner;
+use lodbench::scene::{SceneConfig, SceneDef, SceneKind};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -29,7 +36,9 @@ fn scene_from(args: &[&str]) -> lodbench::scene::Scene {
         _ => unreachable!(),
     };
     let cfg = SceneConfig::from_args(&d.scene_args).unwrap();
-    SceneDef::new("bunny-sweep", &cfg).unwrap().instantiate(1)
+    SceneDef::new(SceneKind::BunnySweep, &cfg)
+        .unwrap()
+        .instantiate(1)
 }
 
 type Rows = Vec<HashMap<String, String>>;
@@ -208,7 +217,7 @@ fn gpu_metrics_match_cpu_oracle() {
     let mut oracle = SequenceMetrics::new();
     let mut cpu = Vec::new();
     let out = block
-        .run_method("discrete", 0, 1, &ProgressBar::hidden(), |_, m, r, _| {
+        .run_method("discrete", 0, 1, &ProgressBar::hidden(), |_, (m, r, _)| {
             cpu.push(oracle.frame(m, r));
             Ok(())
         })
@@ -256,7 +265,7 @@ fn snapshot_reference_frame() {
     let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true, false).unwrap();
     let mut frame0 = None;
     block
-        .run_method("reference", 0, 1, &ProgressBar::hidden(), |f, m, _, _| {
+        .run_method("reference", 0, 1, &ProgressBar::hidden(), |f, (m, _, _)| {
             if f == 0 {
                 frame0 = Some(m.to_vec());
             }
@@ -441,9 +450,9 @@ fn snapshot_scenes_every_method() {
     std::fs::create_dir_all(&snaps).unwrap();
     let mut problems = Vec::new();
     let mut checked = 0;
-    for scene in lodbench::scene::SCENES {
-        let count = if *scene == "bunny-sweep" { 1 } else { 4 };
-        for method in lodbench::methods::METHODS {
+    for scene in SceneKind::names() {
+        let count = if scene == "bunny-sweep" { 1 } else { 4 };
+        for method in lodbench::methods::names() {
             let stem = format!("{scene}_{method}_c{count}_f00002_method.png");
             let frame = out.join("frames").join(&stem);
             let actual = image::open(&frame)
@@ -474,5 +483,5 @@ fn snapshot_scenes_every_method() {
         "scene snapshots differ:\n{}",
         problems.join("\n")
     );
-    assert!(bless || checked == lodbench::scene::SCENES.len() * lodbench::methods::METHODS.len());
+    assert!(bless || checked == SceneKind::ALL.len() * lodbench::methods::BUILTIN.len());
 }

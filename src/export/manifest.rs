@@ -3,6 +3,7 @@
 use crate::config::RunConfig;
 use crate::error::{Error, Result};
 use crate::gpu::{AdapterSummary, TimingSource};
+use crate::records::BlockInfo;
 use crate::scene::SceneDescription;
 use serde::Serialize;
 use std::path::Path;
@@ -19,31 +20,6 @@ pub enum RunStatus {
     Failed,
 }
 
-/// Per (scene, count, method) block: sizes and the cost of the two passes.
-#[derive(Debug, Clone, Serialize)]
-pub struct BlockInfo {
-    pub scene: String,
-    pub method: String,
-    pub count: u32,
-    pub width: u32,
-    pub height: u32,
-    pub frames: u32,
-    pub warmup: u32,
-    /// Wall time per frame of the timing pass (render + wait), milliseconds.
-    pub timing_pass_ms_per_frame: f64,
-    /// Wall time per frame of the quality pass (reference + method + metric kernel), milliseconds.
-    pub quality_pass_ms_per_frame: f64,
-    /// quality_pass_ms_per_frame / timing_pass_ms_per_frame (2.0 is the floor: the reference doubles the work).
-    pub quality_to_timing_ratio: f64,
-    /// Median GPU time of the metric kernel alone per quality-pass frame (None without timestamps).
-    pub metric_gpu_ms_median: Option<f64>,
-    pub extra_target_bytes: u64,
-    /// Instance data per timing-pass frame: what the method's draw lists held, and what was written to the
-    /// GPU (only the entries that changed since the previous upload into the same buffer range).
-    pub instance_bytes_listed_per_frame: f64,
-    pub instance_bytes_written_per_frame: f64,
-}
-
 #[derive(Debug, Clone, Serialize)]
 pub struct RunManifest {
     pub status: RunStatus,
@@ -56,7 +32,7 @@ pub struct RunManifest {
     pub adapter: Option<AdapterSummary>,
     pub timing_source: Option<TimingSource>,
     pub timestamp_period_ns: Option<f32>,
-    /// Frames the timing pass keeps in flight (see README, "Timing").
+    /// Frames the timing pass keeps in flight (docs/measurement.md, "Timing pass").
     pub frames_in_flight_timing: u32,
     pub config: RunConfig,
     pub scenes: Vec<SceneDescription>,

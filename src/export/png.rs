@@ -24,7 +24,10 @@ impl FrameDumper {
         format!("{scene}_{method}_c{count}_f{frame:05}")
     }
 
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "a frame's images and their identity: grouping them would only add a struct used once"
+    )]
     pub fn write(
         &self,
         scene: &str,

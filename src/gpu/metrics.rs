@@ -3,7 +3,7 @@
 
 use crate::error::Result;
 use crate::gpu::context::GpuContext;
-use crate::gpu::renderer::RenderTarget;
+use crate::gpu::targets::RenderTarget;
 use crate::metrics::FrameMetrics;
 
 pub const METRICS_WGSL: &str = include_str!("../../shaders/metrics.wgsl");

@@ -1,9 +1,21 @@
-//! Everything that talks to wgpu.
+//! The GPU layer: device and adapter, the scene's geometry on the GPU, render targets, instance buffers,
+//! pipelines, draw lists, read-back, timestamps and the metric kernel. It imports nothing above it except
+//! the scene's data (`crate::scene`), never the methods, the configuration or the runner.
 
 pub mod context;
+pub mod draw_list;
+pub mod instances;
 pub mod metrics;
-pub mod renderer;
+pub mod pipelines;
+pub mod readback;
+pub mod scene_gpu;
+pub mod targets;
 pub mod timing;
 
 pub use context::{AdapterSummary, GpuContext, TimingSource};
-pub use renderer::{DrawList, DrawStats, InstanceRaw, RenderTarget, SceneGpu};
+pub use draw_list::{Draw, DrawList, DrawStats, InstanceRaw, PipelineIndex};
+pub use instances::{changed_runs, InstanceBuffer, UploadCounters};
+pub use pipelines::{vertex_layouts, MeshPipeline, Vertex, MESH_WGSL};
+pub use readback::{read_texture, TextureReadback};
+pub use scene_gpu::{LodRange, SceneGpu, AMBIENT, LIGHT_DIR};
+pub use targets::RenderTarget;

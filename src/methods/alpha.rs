@@ -4,8 +4,8 @@
 //! by instance distance, depth test on (less-equal, so a translucent surface coinciding with the opaque one
 //! still blends), depth writes off.
 
-use super::{FrameInput, Method, UnpopLists};
-use crate::gpu::renderer::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
+use super::common::{FrameInput, Method, UnpopLists};
+use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
 /// Standard "over" blending of a translucent surface.
@@ -38,10 +38,6 @@ impl Alpha {
 }
 
 impl Method for Alpha {
-    fn name(&self) -> &'static str {
-        "alpha"
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,

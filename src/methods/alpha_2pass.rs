@@ -10,9 +10,9 @@
 //! render passes per t-instance.
 
 use super::alpha::OVER;
-use super::{FrameInput, Method, UnpopLists};
-use crate::config::DEPTH_FORMAT;
-use crate::gpu::renderer::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
+use super::common::{FrameInput, Method, UnpopLists};
+use crate::formats::DEPTH_FORMAT;
+use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
 pub struct AlphaTwoPass {
@@ -113,10 +113,6 @@ impl AlphaTwoPass {
 }
 
 impl Method for AlphaTwoPass {
-    fn name(&self) -> &'static str {
-        "alpha-2pass"
-    }
-
     fn extra_target_bytes(&self) -> u64 {
         let s = self.object_depth.size();
         s.width as u64 * s.height as u64 * 4

@@ -6,8 +6,8 @@
 //! draws first, translucent ones back to front.
 
 use super::alpha::OVER;
-use super::{FrameInput, Method, UnpopLists};
-use crate::gpu::renderer::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
+use super::common::{FrameInput, Method, UnpopLists};
+use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
 /// Pipeline indices of the translucent draws.
@@ -50,10 +50,6 @@ impl AlphaZWrite {
 }
 
 impl Method for AlphaZWrite {
-    fn name(&self) -> &'static str {
-        "alpha-zwrite"
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,

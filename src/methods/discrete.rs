@@ -2,8 +2,8 @@
 //! Each instance shows one LOD; the switch is hard, at the centre of the schedule's band (k = 0.5, i.e. at the
 //! switch distance itself).
 
-use super::{FrameInput, Method, OpaqueInstances};
-use crate::gpu::renderer::{DrawStats, RenderTarget, SceneGpu};
+use super::common::{FrameInput, Method, OpaqueInstances};
+use crate::gpu::{DrawStats, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
 pub struct Discrete {
@@ -19,10 +19,6 @@ impl Discrete {
 }
 
 impl Method for Discrete {
-    fn name(&self) -> &'static str {
-        "discrete"
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,

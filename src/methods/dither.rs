@@ -4,12 +4,26 @@
 //! them, and depth writes stay on: no sorting, no translucency. The threshold pattern is `--noise`
 //! (`src/noise.rs`), tiled in screen space.
 
-use super::{instance_raw, FrameInput, Method, MethodOptions};
-use crate::gpu::renderer::{
-    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu,
-};
+use super::common::{instance_raw, FrameInput, Method};
+use crate::gpu::{DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::noise::threshold_texture;
+use crate::noise::NoisePattern;
 use crate::scene::Scene;
+
+/// `dither`'s flags.
+#[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
+#[serde(default, rename_all(deserialize = "kebab-case"))]
+pub struct DitherOptions {
+    /// Threshold pattern of noise blending (`dither`).
+    #[arg(long, value_enum, default_value_t = NoisePattern::White16)]
+    pub noise: NoisePattern,
+}
+
+impl Default for DitherOptions {
+    fn default() -> Self {
+        crate::defaults::clap_defaults()
+    }
+}
 
 const STEADY: u8 = 0;
 const DITHERED: u8 = 1;
@@ -25,7 +39,7 @@ pub struct Dither {
 }
 
 impl Dither {
-    pub fn new(gpu: &SceneGpu, scene: &Scene, options: &MethodOptions) -> Self {
+    pub fn new(gpu: &SceneGpu, scene: &Scene, options: &DitherOptions, seed: u64) -> Self {
         let device = &gpu.device;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dither noise layout"),
@@ -53,8 +67,7 @@ impl Dither {
             ],
         });
         // Interleaved gradient noise needs no texture: a 1x1 placeholder keeps the layout the same.
-        let (size, values) =
-            threshold_texture(options.noise, options.seed).unwrap_or((0, vec![0.5]));
+        let (size, values) = threshold_texture(options.noise, seed).unwrap_or((0, vec![0.5]));
         let side = size.max(1);
         let texture = gpu.create_value_texture("dither thresholds", side, &values);
         let params = device.create_buffer(&wgpu::BufferDescriptor {
@@ -105,10 +118,6 @@ impl Dither {
 }
 
 impl Method for Dither {
-    fn name(&self) -> &'static str {
-        "dither"
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,

@@ -41,13 +41,14 @@
 //!   `lod_to` in the other, same camera) and combines without reprojection: visibility textures without frame
 //!   sequencing.
 
-use super::{instance_raw_with, FrameInput, Method, MethodOptions};
+use super::common::{instance_raw_with, FrameInput, Method};
 use crate::error::Result;
-use crate::gpu::renderer::{
-    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu,
-};
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::GpuContext;
+use crate::gpu::{
+    read_texture, DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu,
+};
+use crate::noise::VisTexture;
 use crate::noise::{visibility_texture, VIS_TEXTURE_SIZE};
 use crate::scene::{Camera, Scene};
 use crate::schedule::InstanceState;
@@ -70,7 +71,9 @@ pub enum Variant {
 
 /// `--fsi-check`: an optional test on the older buffer's fragment before the combination pass uses it. Not in
 /// the paper; off by default, so `fsi` is the paper's method unless asked otherwise.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum FsiCheck {
     /// The paper's combination: the older fragment at eq. 2's lookup.
@@ -89,6 +92,25 @@ pub enum FsiCheck {
     /// t-instance's older fragments can miss by more than a pixel, and then its holes show what is behind it
     /// (measured in the README).
     Forward,
+}
+
+/// `fsi*`'s flags.
+#[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
+#[serde(default, rename_all(deserialize = "kebab-case"))]
+pub struct FsiOptions {
+    /// Visibility texture of Frame Sequential Interpolation (`fsi*`, seed 000 section 3.3).
+    #[arg(long, value_enum, default_value_t = VisTexture::Noise)]
+    pub vis_texture: VisTexture,
+    /// `fsi` only, not in the paper: `forward` uses an older fragment only if, reprojected with its own depth,
+    /// it lands within a pixel of the pixel (rejects the disocclusion ghosts of seed 000 section 4.2).
+    #[arg(long, value_enum, default_value_t = FsiCheck::None)]
+    pub fsi_check: FsiCheck,
+}
+
+impl Default for FsiOptions {
+    fn default() -> Self {
+        crate::defaults::clap_defaults()
+    }
 }
 
 /// tau of eq. 1 for LOD `lod` of a t-instance in state `s` (Fig. 2): the incoming LOD fades in over the first
@@ -239,7 +261,6 @@ pub struct Fsi {
     variant: Variant,
     /// `--fsi-check forward`, on `fsi` (the only variant that reprojects).
     forward_check: bool,
-    name: &'static str,
     buffers: [LodBuffer; 2],
     lists: [DrawList; 2],
     instances: InstanceBuffer,
@@ -266,7 +287,13 @@ pub struct Fsi {
 }
 
 impl Fsi {
-    pub fn new(gpu: &SceneGpu, scene: &Scene, options: &MethodOptions, variant: Variant) -> Self {
+    pub fn new(
+        gpu: &SceneGpu,
+        scene: &Scene,
+        options: &FsiOptions,
+        seed: u64,
+        variant: Variant,
+    ) -> Self {
         let device = &gpu.device;
         let (w, h) = (scene.width, scene.height);
         let format = id_format(scene.instances.len());
@@ -290,7 +317,7 @@ impl Fsi {
         let vis = gpu.create_value_texture(
             "fsi visibility texture",
             VIS_TEXTURE_SIZE,
-            &visibility_texture(options.vis_texture, options.seed),
+            &visibility_texture(options.vis_texture, seed),
         );
         let vis_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("fsi visibility texture"),
@@ -429,15 +456,9 @@ impl Fsi {
             })
         };
         let combine_groups = [combine_group(0), combine_group(1)];
-        let name = match variant {
-            Variant::Sequential => "fsi",
-            Variant::NoReproject => "fsi-noreproject",
-            Variant::SameFrame => "fsi-sameframe",
-        };
         Fsi {
             variant,
             forward_check: variant == Variant::Sequential && options.fsi_check == FsiCheck::Forward,
-            name,
             buffers,
             lists: [DrawList::default(), DrawList::default()],
             instances: gpu
@@ -614,58 +635,14 @@ impl Fsi {
     }
 }
 
-/// Copies one plane of `texture` (`bytes_per_texel` bytes per texel) into a tightly packed vector.
-fn read_plane(
-    ctx: &GpuContext,
-    texture: &wgpu::Texture,
-    aspect: wgpu::TextureAspect,
-    bytes_per_texel: u32,
-) -> Result<Vec<u8>> {
-    let (w, h) = (texture.width(), texture.height());
-    let row = (w * bytes_per_texel).div_ceil(256) * 256;
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("fsi LOD buffer read-back"),
-        size: row as u64 * h as u64,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(row),
-                rows_per_image: Some(h),
-            },
-        },
-        texture.size(),
-    );
-    ctx.queue.submit([encoder.finish()]);
-    let tight = (w * bytes_per_texel) as usize;
-    ctx.read_buffer(&buffer, |bytes| {
-        let mut out = Vec::with_capacity(tight * h as usize);
-        for y in 0..h as usize {
-            out.extend_from_slice(&bytes[y * row as usize..y * row as usize + tight]);
-        }
-        out
-    })
-}
-
 impl Fsi {
     /// Reads both LOD buffers back (colour, depth, id), after the frames that wrote them were submitted.
     pub fn read_lod_buffers(&self, ctx: &GpuContext) -> Result<[LodBufferImage; 2]> {
         let read = |b: &LodBuffer| -> Result<LodBufferImage> {
-            let color = read_plane(ctx, &b.target.color, wgpu::TextureAspect::All, 4)?;
-            let depth = read_plane(ctx, &b.target.depth, wgpu::TextureAspect::DepthOnly, 4)?;
+            let color = read_texture(ctx, &b.target.color, wgpu::TextureAspect::All, 4)?;
+            let depth = read_texture(ctx, &b.target.depth, wgpu::TextureAspect::DepthOnly, 4)?;
             let id_bytes = id_bytes(self.id_format);
-            let ids = read_plane(ctx, &b.id, wgpu::TextureAspect::All, id_bytes)?;
+            let ids = read_texture(ctx, &b.id, wgpu::TextureAspect::All, id_bytes)?;
             Ok(LodBufferImage {
                 width: b.target.width,
                 height: b.target.height,
@@ -685,10 +662,6 @@ impl Fsi {
 }
 
 impl Method for Fsi {
-    fn name(&self) -> &'static str {
-        self.name
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,

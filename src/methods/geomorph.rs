@@ -5,16 +5,32 @@
 //! measured by the `pop` column on those frames. Targets come from `--correspondence` (`src/morph.rs`), computed
 //! once per LOD pair and cached.
 
-use super::{instance_raw, FrameInput, Method, MethodOptions};
-use crate::gpu::renderer::{
+use super::common::{instance_raw, FrameInput, Method};
+use crate::gpu::{
     DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu, Vertex,
 };
 use crate::morph::morph_targets;
+use crate::morph::Correspondence;
 use crate::scene::Scene;
 use wgpu::util::DeviceExt;
 
 const STEADY: u8 = 0;
 const MORPHING: u8 = 1;
+
+/// `geomorph`'s flags.
+#[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
+#[serde(default, rename_all(deserialize = "kebab-case"))]
+pub struct GeomorphOptions {
+    /// Vertex correspondence of geomorphing (`geomorph`).
+    #[arg(long, value_enum, default_value_t = Correspondence::Nearest)]
+    pub correspondence: Correspondence,
+}
+
+impl Default for GeomorphOptions {
+    fn default() -> Self {
+        crate::defaults::clap_defaults()
+    }
+}
 
 pub struct Geomorph {
     list: DrawList,
@@ -26,7 +42,7 @@ pub struct Geomorph {
 }
 
 impl Geomorph {
-    pub fn new(gpu: &SceneGpu, scene: &Scene, options: &MethodOptions) -> Self {
+    pub fn new(gpu: &SceneGpu, scene: &Scene, options: &GeomorphOptions) -> Self {
         let mut targets: Vec<Vertex> = Vec::new();
         for model in scene.models.iter() {
             let lods = &model.chain.lods;
@@ -69,10 +85,6 @@ impl Geomorph {
 }
 
 impl Method for Geomorph {
-    fn name(&self) -> &'static str {
-        "geomorph"
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,

@@ -1,353 +1,147 @@
-//! Transition methods behind one trait and a registry. A method only decides how to draw the shared schedule's
-//! `(lod_from, lod_to, k)` per instance; it never selects LODs itself.
+//! Transition methods behind one trait and one registry. A method only decides how to draw the shared
+//! schedule's `(lod_from, lod_to, k)` per instance; it never selects LODs itself.
+//!
+//! Adding a method: a new file with a type implementing [`Method`] (and, if it has flags, an options struct
+//! flattened into [`MethodOptions`]), plus its line in [`BUILTIN`]. docs/ARCHITECTURE.md walks through it;
+//! `tests/registry.rs` does it with a throwaway method. The methods' files import `common`, never this file, so
+//! the registry can name them without an import circle.
 
-mod alpha;
-mod alpha_2pass;
-mod alpha_zwrite;
-mod discrete;
-mod dither;
+pub mod alpha;
+pub mod alpha_2pass;
+pub mod alpha_zwrite;
+pub mod common;
+pub mod discrete;
+pub mod dither;
 pub mod fsi;
-mod geomorph;
-mod reference;
+pub mod geomorph;
+pub mod reference;
+
+pub use common::{instance_raw, instance_raw_with, FrameInput, Method, OpaqueInstances};
 
 use crate::error::{Error, Result};
-use crate::gpu::renderer::{
-    DrawList, DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu,
-};
-use crate::morph::Correspondence;
-use crate::noise::{NoisePattern, VisTexture};
+use crate::gpu::SceneGpu;
 use crate::scene::Scene;
-use crate::schedule::InstanceState;
-use glam::Mat4;
 
-/// Every method name `--method` accepts, in the order runs use when none is given.
-pub const METHODS: &[&str] = &[
-    "reference",
-    "discrete",
-    "alpha",
-    "alpha-2pass",
-    "alpha-zwrite",
-    "dither",
-    "geomorph",
-    "fsi",
-    "fsi-noreproject",
-    "fsi-sameframe",
-];
-
-/// Settings some methods read (recorded in run.json with the rest of the config).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+/// The flags of every method, each method's declared once in its own file and flattened here: `lodbench run`
+/// takes them as flags, experiment files as `[run]` keys, and run.json records them (its `config`, and each
+/// block's `method_options`, the ones its method reads).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Default, clap::Args, serde::Serialize, serde::Deserialize,
+)]
+#[serde(default)]
 pub struct MethodOptions {
-    pub noise: NoisePattern,
-    pub correspondence: Correspondence,
-    pub vis_texture: VisTexture,
-    pub fsi_check: fsi::FsiCheck,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub dither: dither::DitherOptions,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub geomorph: geomorph::GeomorphOptions,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub fsi: fsi::FsiOptions,
+}
+
+/// What a method's constructor gets; GPU objects are created there, once per scene block.
+pub struct Build<'a> {
+    pub gpu: &'a SceneGpu,
+    pub scene: &'a Scene,
+    pub options: &'a MethodOptions,
+    /// `--seed` (noise patterns, visibility textures).
     pub seed: u64,
 }
 
-impl Default for MethodOptions {
+/// One method of the registry.
+#[derive(Clone, Copy)]
+pub struct MethodEntry {
+    /// The name `--method` takes and the CSVs' `method` column holds.
+    pub name: &'static str,
+    /// One line for `lodbench list`.
+    pub about: &'static str,
+    pub create: fn(&Build<'_>) -> Result<Box<dyn Method>>,
+    /// The options this method reads, as run.json records them per block (None: it reads none).
+    pub options: fn(&MethodOptions) -> Option<serde_json::Value>,
+}
+
+fn no_options(_: &MethodOptions) -> Option<serde_json::Value> {
+    None
+}
+
+fn json(v: impl serde::Serialize) -> Option<serde_json::Value> {
+    serde_json::to_value(v).ok()
+}
+
+/// Every built-in method, in the order runs use when `--method` is absent. One line a method (rustfmt would
+/// spread each over eight).
+#[rustfmt::skip]
+pub const BUILTIN: &[MethodEntry] = &[
+    MethodEntry { name: "reference", about: "LOD0 everywhere: the high-poly reference", create: |b| Ok(Box::new(reference::Reference::new(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "discrete", about: "discrete LOD switching: a hard switch at k = 0.5", create: |b| Ok(Box::new(discrete::Discrete::new(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "alpha", about: "Giegl's unpopping: one LOD opaque, the other blended over it", create: |b| Ok(Box::new(alpha::Alpha::new(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "alpha-2pass", about: "unpopping, double pass: each translucent LOD shows only its nearest surface", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "alpha-zwrite", about: "Blow's unpopping: translucent with Z-writes, the compare switch", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "dither", about: "noise blending: complementary screen-space discard", create: |b| Ok(Box::new(dither::Dither::new(b.gpu, b.scene, &b.options.dither, b.seed))), options: |o| json(o.dither) },
+    MethodEntry { name: "geomorph", about: "geomorphing: the finer LOD's vertices move to their targets on the coarser", create: |b| Ok(Box::new(geomorph::Geomorph::new(b.gpu, b.scene, &b.options.geomorph))), options: |o| json(o.geomorph) },
+    MethodEntry { name: "fsi", about: "Frame Sequential Interpolation (seed 000)", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::Sequential))), options: |o| json(o.fsi) },
+    MethodEntry { name: "fsi-noreproject", about: "FSI ablation: the older buffer read at the same pixel", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::NoReproject))), options: |o| json(o.fsi.vis_texture) },
+    MethodEntry { name: "fsi-sameframe", about: "FSI ablation: both LOD buffers rendered every frame", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::SameFrame))), options: |o| json(o.fsi.vis_texture) },
+];
+
+/// The methods a run can name: the built-in ones, plus any a caller (a test, a downstream crate) adds.
+#[derive(Clone)]
+pub struct Registry {
+    entries: Vec<MethodEntry>,
+}
+
+impl Default for Registry {
     fn default() -> Self {
-        MethodOptions {
-            noise: NoisePattern::White16,
-            correspondence: Correspondence::Nearest,
-            vis_texture: VisTexture::Noise,
-            fsi_check: fsi::FsiCheck::None,
-            seed: 1,
+        Registry {
+            entries: BUILTIN.to_vec(),
         }
     }
 }
 
-/// What a method gets for one frame.
-pub struct FrameInput<'a> {
-    pub frame: u32,
-    pub scene: &'a Scene,
-    /// One state per instance, from the shared schedule.
-    pub states: &'a [InstanceState],
-    /// One object-to-world matrix per instance.
-    pub matrices: &'a [Mat4],
-    /// Camera-to-instance-centre distance per instance (what LOD selection used).
-    pub distances: &'a [f32],
-    /// This frame belongs to the timing pass (methods that time a pass of their own do it only then).
-    pub timed: bool,
-}
-
-pub trait Method {
-    fn name(&self) -> &'static str;
-
-    /// Writes the frame's per-instance data (through the queue, before the submission) and records its passes
-    /// into `encoder`, leaving the final image in `target`. Returns what it really submitted.
-    fn encode(
-        &mut self,
-        gpu: &SceneGpu,
-        input: &FrameInput<'_>,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &RenderTarget,
-    ) -> DrawStats;
-
-    /// Render-target memory the method holds beyond the frame's own colour and depth target, in bytes.
-    fn extra_target_bytes(&self) -> u64 {
-        0
+impl Registry {
+    /// The built-in methods.
+    pub fn builtin() -> Registry {
+        Registry::default()
     }
 
-    /// GPU milliseconds per frame of the method's own named stage over the last timing pass (FSI: its
-    /// combination pass), or None for methods without one.
-    fn stage_gpu_ms(&self, _ctx: &crate::gpu::GpuContext) -> Result<Option<Vec<Option<f64>>>> {
-        Ok(None)
-    }
-
-    /// Intermediate images worth seeing (`--dump-frames` writes them next to the frame): (name, target).
-    fn debug_targets(&self) -> Vec<(&'static str, &RenderTarget)> {
-        Vec::new()
-    }
-}
-
-/// Builds the method called `name` for `scene`; GPU objects are created here, once.
-pub fn create(
-    name: &str,
-    gpu: &SceneGpu,
-    scene: &Scene,
-    options: &MethodOptions,
-) -> Result<Box<dyn Method>> {
-    match name {
-        "reference" => Ok(Box::new(reference::Reference::new(gpu, scene))),
-        "discrete" => Ok(Box::new(discrete::Discrete::new(gpu, scene))),
-        "alpha" => Ok(Box::new(alpha::Alpha::new(gpu, scene))),
-        "alpha-2pass" => Ok(Box::new(alpha_2pass::AlphaTwoPass::new(gpu, scene))),
-        "alpha-zwrite" => Ok(Box::new(alpha_zwrite::AlphaZWrite::new(gpu, scene))),
-        "dither" => Ok(Box::new(dither::Dither::new(gpu, scene, options))),
-        "geomorph" => Ok(Box::new(geomorph::Geomorph::new(gpu, scene, options))),
-        "fsi" => Ok(Box::new(fsi::Fsi::new(
-            gpu,
-            scene,
-            options,
-            fsi::Variant::Sequential,
-        ))),
-        "fsi-noreproject" => Ok(Box::new(fsi::Fsi::new(
-            gpu,
-            scene,
-            options,
-            fsi::Variant::NoReproject,
-        ))),
-        "fsi-sameframe" => Ok(Box::new(fsi::Fsi::new(
-            gpu,
-            scene,
-            options,
-            fsi::Variant::SameFrame,
-        ))),
-        _ => Err(Error::unknown("method", name, METHODS)),
-    }
-}
-
-/// The Giegl-Wimmer "unpopping" schedule (seed 000 Fig. 2, seed 001 Fig. 1b): one LOD is always opaque. For
-/// k < 0.5 the incoming LOD (`lod_to`) is translucent with alpha 2k over the opaque outgoing one; from k = 0.5
-/// the incoming one is opaque and the outgoing one translucent with alpha 2(1 - k).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Unpop {
-    pub opaque: u32,
-    /// (LOD, alpha) of the translucent draw of a t-instance.
-    pub translucent: Option<(u32, f32)>,
-    /// True from k = 0.5 on: the roles have swapped.
-    pub swapped: bool,
-}
-
-pub(crate) fn unpop(s: &InstanceState) -> Unpop {
-    if !s.in_transition() {
-        return Unpop {
-            opaque: s.lod_from,
-            translucent: None,
-            swapped: false,
-        };
-    }
-    if s.k < 0.5 {
-        Unpop {
-            opaque: s.lod_from,
-            translucent: Some((s.lod_to, 2.0 * s.k)),
-            swapped: false,
+    /// This registry plus `entry`; a name already taken is an error.
+    pub fn with(mut self, entry: MethodEntry) -> Result<Registry> {
+        if self.entries.iter().any(|e| e.name == entry.name) {
+            return Err(Error::Config(format!(
+                "method {} is registered twice",
+                entry.name
+            )));
         }
-    } else {
-        Unpop {
-            opaque: s.lod_to,
-            translucent: Some((s.lod_from, 2.0 * (1.0 - s.k))),
-            swapped: true,
-        }
+        self.entries.push(entry);
+        Ok(self)
+    }
+
+    pub fn entries(&self) -> &[MethodEntry] {
+        &self.entries
+    }
+
+    /// Every name, in registry order.
+    pub fn names(&self) -> Vec<&'static str> {
+        self.entries.iter().map(|e| e.name).collect()
+    }
+
+    /// The method called `name`, or an error listing the valid names.
+    pub fn get(&self, name: &str) -> Result<&MethodEntry> {
+        self.entries
+            .iter()
+            .find(|e| e.name == name)
+            .ok_or_else(|| Error::unknown("method", name, &self.names()))
+    }
+
+    /// Builds the method called `name`.
+    pub fn create(&self, name: &str, build: &Build<'_>) -> Result<Box<dyn Method>> {
+        (self.get(name)?.create)(build)
     }
 }
 
-/// Indices of the instances `select` keeps, farthest first (ties by index, so the order is deterministic).
-pub(crate) fn back_to_front(
-    distances: &[f32],
-    out: &mut Vec<usize>,
-    select: impl Fn(usize) -> bool,
-) {
-    out.clear();
-    out.extend((0..distances.len()).filter(|&i| select(i)));
-    out.sort_by(|&a, &b| distances[b].total_cmp(&distances[a]).then(a.cmp(&b)));
-}
-
-/// The draw lists of the unpopping methods: every instance's opaque LOD, then the translucent LODs of the
-/// t-instances back to front. Kept between frames.
-#[derive(Default)]
-pub(crate) struct UnpopLists {
-    pub opaque: DrawList,
-    pub translucent: DrawList,
-    order: Vec<usize>,
-}
-
-impl UnpopLists {
-    /// Fills and builds both lists and uploads them to `buffer`, opaque first; `pipeline_of` picks the
-    /// translucent draw's pipeline index. Returns the first instance of the translucent list in `buffer`.
-    pub fn prepare(
-        &mut self,
-        gpu: &SceneGpu,
-        input: &FrameInput<'_>,
-        buffer: &InstanceBuffer,
-        pipeline_of: impl Fn(&Unpop) -> u8,
-    ) -> u32 {
-        self.opaque.clear();
-        self.translucent.clear();
-        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            let u = unpop(s);
-            self.opaque.push(
-                0,
-                inst.model,
-                u.opaque,
-                instance_raw(input, i, s.k, 1.0, u.opaque),
-            );
-        }
-        back_to_front(input.distances, &mut self.order, |i| {
-            input.states[i].in_transition()
-        });
-        for &i in &self.order {
-            let s = &input.states[i];
-            let u = unpop(s);
-            if let Some((lod, alpha)) = u.translucent {
-                let model = input.scene.instances[i].model;
-                self.translucent.push(
-                    pipeline_of(&u),
-                    model,
-                    lod,
-                    instance_raw(input, i, s.k, alpha, lod),
-                );
-            }
-        }
-        self.opaque.build();
-        self.translucent.build_in_order();
-        let n_opaque = self.opaque.instances.len() as u32;
-        gpu.upload_at(buffer, 0, &self.opaque);
-        gpu.upload_at(buffer, n_opaque, &self.translucent);
-        n_opaque
-    }
-}
-
-pub(crate) fn instance_raw(
-    input: &FrameInput<'_>,
-    i: usize,
-    k: f32,
-    alpha: f32,
-    lod: u32,
-) -> InstanceRaw {
-    instance_raw_with(input, i, lod, [k, alpha, lod as f32, i as f32])
-}
-
-/// Instance i drawn at `lod`: its matrix, the LOD's colour and its animation angle this frame, with the
-/// method's own `params` (shaders/mesh.wgsl reads them per method).
-pub(crate) fn instance_raw_with(
-    input: &FrameInput<'_>,
-    i: usize,
-    lod: u32,
-    params: [f32; 4],
-) -> InstanceRaw {
-    let inst = &input.scene.instances[i];
-    let model = &input.scene.models[inst.model as usize];
-    let [r, g, b] = model.color_of(lod);
-    InstanceRaw::new(
-        &input.matrices[i],
-        [r, g, b, input.scene.animation_angle(i, input.frame)],
-        params,
-    )
-}
-
-/// Shared by methods that draw every instance once, opaque, at one LOD each.
-pub(crate) struct OpaqueInstances {
-    list: DrawList,
-    buffer: InstanceBuffer,
-}
-
-impl OpaqueInstances {
-    pub fn new(gpu: &SceneGpu, scene: &Scene, label: &str) -> Self {
-        OpaqueInstances {
-            list: DrawList::default(),
-            buffer: gpu.create_instance_buffer(label, scene.instances.len() as u32),
-        }
-    }
-
-    /// Draws instance i at `lod_of(state_i)` into a cleared `target`.
-    pub fn encode(
-        &mut self,
-        gpu: &SceneGpu,
-        input: &FrameInput<'_>,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &RenderTarget,
-        label: &str,
-        lod_of: impl Fn(&InstanceState) -> u32,
-    ) -> DrawStats {
-        self.list.clear();
-        for (i, (inst, state)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            let lod = lod_of(state);
-            self.list.push(
-                0,
-                inst.model,
-                lod,
-                instance_raw(input, i, state.k, 1.0, lod),
-            );
-        }
-        self.list.build();
-        gpu.upload(&self.buffer, &self.list);
-        let mut pass = gpu.begin_clear_pass(encoder, target, label);
-        gpu.draw(
-            &mut pass,
-            &self.buffer,
-            0,
-            &self.list,
-            &[&gpu.opaque_pipeline],
-        )
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn st(from: u32, to: u32, k: f32) -> InstanceState {
-        InstanceState {
-            lod_from: from,
-            lod_to: to,
-            k,
-        }
-    }
-
-    #[test]
-    fn unpopping_keeps_one_lod_opaque() {
-        assert_eq!(unpop(&st(1, 1, 0.0)).translucent, None);
-        let a = unpop(&st(0, 1, 0.2));
-        assert_eq!((a.opaque, a.swapped), (0, false));
-        assert_eq!(a.translucent, Some((1, 0.4)));
-        let b = unpop(&st(0, 1, 0.5));
-        assert_eq!((b.opaque, b.swapped), (1, true));
-        assert_eq!(b.translucent, Some((0, 1.0)));
-        let c = unpop(&st(0, 1, 0.9));
-        assert_eq!(c.opaque, 1);
-        let (lod, alpha) = c.translucent.unwrap();
-        assert_eq!(lod, 0);
-        assert!((alpha - 0.2).abs() < 1e-6);
-        // Alpha is continuous through the swap: 2k -> 1 from below, 2(1-k) = 1 at k = 0.5.
-        let below = unpop(&st(0, 1, 0.4999)).translucent.unwrap().1;
-        assert!((below - 1.0).abs() < 1e-3);
-    }
-
-    #[test]
-    fn back_to_front_sorts_farthest_first() {
-        let mut order = Vec::new();
-        back_to_front(&[3.0, 9.0, 1.0, 9.0], &mut order, |i| i != 2);
-        assert_eq!(order, vec![1, 3, 0]);
-    }
+/// Every built-in method name, in [`BUILTIN`]'s order.
+pub fn names() -> Vec<&'static str> {
+    BUILTIN.iter().map(|e| e.name).collect()
 }

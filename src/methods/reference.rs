@@ -1,8 +1,8 @@
 //! `reference`: the high-poly baseline of seed 003 section 6: every instance at LOD0, always. The quality pass
 //! compares every method against this.
 
-use super::{FrameInput, Method, OpaqueInstances};
-use crate::gpu::renderer::{DrawStats, RenderTarget, SceneGpu};
+use super::common::{FrameInput, Method, OpaqueInstances};
+use crate::gpu::{DrawStats, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
 pub struct Reference {
@@ -18,10 +18,6 @@ impl Reference {
 }
 
 impl Method for Reference {
-    fn name(&self) -> &'static str {
-        "reference"
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,

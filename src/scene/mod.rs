@@ -7,7 +7,6 @@
 //!   spaced by dx = (w - camera_x) / n, the camera looking along +x; nothing is culled, so bunnies behind
 //!   others are still drawn (the paper turns occlusion culling off).
 
-use crate::config::SceneConfig;
 use crate::error::{Error, Result};
 use crate::lod::{self, LodChain, LodInfo, DEFAULT_TARGETS};
 use crate::mesh::Mesh;
@@ -16,8 +15,47 @@ use glam::{Mat4, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
-/// Every scene name `--scene` accepts.
-pub const SCENES: &[&str] = &["bunny-sweep", "bunny-grid", "simple", "windmills", "trees"];
+pub mod kind;
+
+pub use kind::{CameraMode, Profile, ProfileValues, SceneKind, PAPER_COUNTS};
+
+/// Scene-defining settings after the profile is applied (built from the flags by `crate::config`).
+#[derive(Debug, Clone, Serialize)]
+pub struct SceneConfig {
+    pub profile: Profile,
+    pub camera: CameraMode,
+    /// Explicit overrides; None = the profile's value for each scene.
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub frames: Option<u32>,
+    pub mesh: Option<std::path::PathBuf>,
+    pub pixel_error: f32,
+    pub switch_distances: Option<Vec<f32>>,
+    pub counts: Option<Vec<u32>>,
+    pub fov_deg: f32,
+    pub schedule: ScheduleParams,
+}
+
+impl SceneConfig {
+    /// The profile's values for `kind` with the explicit flags applied.
+    pub fn resolved(&self, kind: SceneKind) -> ProfileValues {
+        let p = kind.profile(self.profile);
+        ProfileValues {
+            width: self.width.unwrap_or(p.width),
+            height: self.height.unwrap_or(p.height),
+            frames: self.frames.unwrap_or(p.frames),
+            warmup: p.warmup,
+        }
+    }
+
+    /// The instance counts of `kind`: `--count`, or the profile's (bunny-sweep is always one bunny).
+    pub fn counts(&self, kind: SceneKind) -> Vec<u32> {
+        match (kind, &self.counts) {
+            (SceneKind::BunnySweep, _) | (_, None) => kind.profile_counts(self.profile),
+            (_, Some(c)) => c.clone(),
+        }
+    }
+}
 
 /// Seed of the procedural scenes' models and layouts (tree shapes, instance jitter and yaw): fixed, so a
 /// scene is the same picture whatever `--seed` drives (the methods' noise).
@@ -27,7 +65,7 @@ pub const SCENE_SEED: u64 = 2008;
 pub const WINDMILL_SPIN_PER_FRAME: f32 = std::f32::consts::TAU / 300.0;
 
 /// The Stanford bunny, npm `bunny@1.0.1` (see scenes/README.md), compiled in so the binary needs no files.
-pub const BUNNY_OBJ: &[u8] = include_bytes!("../scenes/bunny.obj");
+pub const BUNNY_OBJ: &[u8] = include_bytes!("../../scenes/bunny.obj");
 
 /// Background colour (linear RGB) behind every scene.
 pub const BACKGROUND: [f32; 3] = [0.045, 0.05, 0.06];
@@ -75,23 +113,6 @@ pub enum Motion {
     },
 }
 
-/// `--camera`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum CameraMode {
-    /// The scene's own camera (fixed for the bunny scenes).
-    Fixed,
-    /// The eye swings around the point it looks at (the swept bunny, or the first grid bunny) by
-    /// `ORBIT_AMPLITUDE_DEG` * sin(2 pi f / `ORBIT_PERIOD_FRAMES`), at the distance the fixed camera would have,
-    /// so LOD selection sees the same distances for that point.
-    Orbit,
-    /// bunny-sweep: the bunny stays where the sweep starts and the camera moves instead, backwards and forwards
-    /// along its line of sight through the same distances, so every frame shows what `fixed` shows (the same
-    /// relative geometry under a directional light) while the motion is the camera's, the motion eq. 2 of FSI
-    /// reprojects. Elsewhere the same as `fixed`.
-    Dolly,
-}
-
 pub const ORBIT_AMPLITUDE_DEG: f32 = 30.0;
 pub const ORBIT_PERIOD_FRAMES: f32 = 240.0;
 
@@ -111,7 +132,7 @@ impl Camera {
 /// A scene ready to render: everything a frame needs is a function of the frame number.
 #[derive(Debug, Clone)]
 pub struct Scene {
-    pub name: String,
+    pub kind: SceneKind,
     /// The `count` column of the CSVs: the instance count this block was built for.
     pub count: u32,
     pub models: Arc<[Model]>,
@@ -135,7 +156,7 @@ pub struct Scene {
 /// Scene-level facts that do not depend on the instance count: built once per scene name.
 #[derive(Debug, Clone)]
 pub struct SceneDef {
-    pub name: String,
+    pub kind: SceneKind,
     pub models: Arc<[Model]>,
     pub frames: u32,
     pub width: u32,
@@ -151,14 +172,11 @@ pub struct SceneDef {
 }
 
 impl SceneDef {
-    pub fn new(name: &str, cfg: &SceneConfig) -> Result<SceneDef> {
-        if !SCENES.contains(&name) {
-            return Err(Error::unknown("scene", name, SCENES));
-        }
-        let pv = cfg.resolved(name);
+    pub fn new(kind: SceneKind, cfg: &SceneConfig) -> Result<SceneDef> {
+        let pv = cfg.resolved(kind);
         let fov_y = cfg.fov_deg.to_radians();
-        if !name.starts_with("bunny") {
-            return procedural_def(name, cfg, pv.frames, pv.width, pv.height, fov_y);
+        if !kind.is_bunny() {
+            return procedural_def(kind, cfg, pv.frames, pv.width, pv.height, fov_y);
         }
         let started = std::time::Instant::now();
         let (mesh, mesh_source) = match &cfg.mesh {
@@ -170,21 +188,15 @@ impl SceneDef {
         };
         let model = bunny_model(&mesh, cfg, pv.height, fov_y)?;
         let lod_generation_ms = started.elapsed().as_secs_f64() * 1e3;
-        // The sweep is one bunny whatever --count says.
-        let counts = if name == "bunny-sweep" {
-            vec![1]
-        } else {
-            cfg.counts(name)
-        };
         Ok(SceneDef {
-            name: name.to_string(),
+            kind,
             models: Arc::from(vec![model]),
             frames: pv.frames,
             width: pv.width,
             height: pv.height,
             fov_y,
             schedule: cfg.schedule,
-            counts,
+            counts: cfg.counts(kind),
             camera_mode: cfg.camera,
             mesh_source,
             lod_generation_ms,
@@ -192,7 +204,7 @@ impl SceneDef {
     }
 
     pub fn instantiate(&self, count: u32) -> Scene {
-        if !self.name.starts_with("bunny") {
+        if !self.kind.is_bunny() {
             return self.instantiate_field(count);
         }
         let m = &self.models[0];
@@ -211,8 +223,8 @@ impl SceneDef {
         // Past the last band, with a margin so the coarsest LOD is seen for a while.
         let far_d = last * (1.0 + h) * (1.0 + b) * 1.15;
         let yaw = BUNNY_YAW;
-        let (instances, motion, far_plane) = match self.name.as_str() {
-            "bunny-grid" => {
+        let (instances, motion, far_plane) = match self.kind {
+            SceneKind::BunnyGrid => {
                 // eq. 1: dx = (w - camera_x) / n, objects from the nearest fully visible distance on.
                 let camera_x = 0.0;
                 let w = camera_x + far_d;
@@ -240,7 +252,7 @@ impl SceneDef {
             ),
         };
         Scene {
-            name: self.name.clone(),
+            kind: self.kind,
             count,
             models: self.models.clone(),
             instances,
@@ -297,7 +309,7 @@ impl SceneDef {
         let forward = Vec3::new(0.0, -pitch.sin(), pitch.cos());
         let extent = (to - from).length() + 2.0 * half + 4.0 * m.radius + last;
         Scene {
-            name: self.name.clone(),
+            kind: self.kind,
             count,
             models: self.models.clone(),
             instances,
@@ -322,7 +334,7 @@ impl SceneDef {
 /// except SIMPLE, whose box is no approximation of the sphere at any distance: it switches at 12 sphere
 /// radii (at 320x240 and 60 degrees the sphere is then about 17 pixels across), or at `--switch-distances`.
 fn procedural_def(
-    name: &str,
+    kind: SceneKind,
     cfg: &SceneConfig,
     frames: u32,
     width: u32,
@@ -330,13 +342,14 @@ fn procedural_def(
     fov_y: f32,
 ) -> Result<SceneDef> {
     let started = std::time::Instant::now();
-    let (chain, spin, source) = match name {
-        "simple" => (
+    let name = kind.name();
+    let (chain, spin, source) = match kind {
+        SceneKind::Simple => (
             crate::procgen::simple_chain()?,
             0.0,
             "procedural (src/procgen.rs: sphere and box)",
         ),
-        "windmills" => (
+        SceneKind::Windmills => (
             crate::procgen::windmill_chain()?,
             WINDMILL_SPIN_PER_FRAME,
             "procedural (src/procgen.rs: windmill)",
@@ -352,7 +365,7 @@ fn procedural_def(
     let chain = chain.chain;
     let (center, radius) = chain.lods[0].mesh.bounding_sphere();
     let scale = 1.0;
-    let (switches, switch_source) = match (&cfg.switch_distances, name) {
+    let (switches, switch_source) = match (&cfg.switch_distances, kind) {
         (Some(s), _) => {
             if s.len() != chain.lods.len() - 1 {
                 return Err(Error::Config(format!(
@@ -363,7 +376,7 @@ fn procedural_def(
             }
             (s.clone(), "override")
         }
-        (None, "simple") => (vec![12.0 * radius], "scene"),
+        (None, SceneKind::Simple) => (vec![12.0 * radius], "scene"),
         (None, _) => (
             lod::switch_distances(&chain, scale, cfg.pixel_error, height, fov_y),
             "pixel-error",
@@ -383,14 +396,14 @@ fn procedural_def(
         scale,
     };
     Ok(SceneDef {
-        name: name.to_string(),
+        kind,
         models: Arc::from(vec![model]),
         frames,
         width,
         height,
         fov_y,
         schedule: cfg.schedule,
-        counts: cfg.counts(name),
+        counts: cfg.counts(kind),
         camera_mode: cfg.camera,
         mesh_source: source.to_string(),
         lod_generation_ms,
@@ -441,6 +454,13 @@ fn bunny_model(mesh: &Mesh, cfg: &SceneConfig, height: u32, fov_y: f32) -> Resul
     })
 }
 
+impl SceneDef {
+    /// The scene's name (the CSVs' `scene` column).
+    pub fn name(&self) -> &'static str {
+        self.kind.name()
+    }
+}
+
 impl Model {
     /// Base colour of LOD `lod`, linear RGB.
     pub fn color_of(&self, lod: u32) -> [f32; 3] {
@@ -452,6 +472,11 @@ impl Model {
 }
 
 impl Scene {
+    /// The scene's name (the CSVs' `scene` column).
+    pub fn name(&self) -> &'static str {
+        self.kind.name()
+    }
+
     /// Animation angle of instance `i` on `frame` (radians; windmill blades), with a fixed per-instance phase
     /// so that neighbours do not turn in step.
     pub fn animation_angle(&self, i: usize, frame: u32) -> f32 {
@@ -610,7 +635,7 @@ impl SceneDef {
         let first = self.instantiate(self.counts[0]);
         let instance_build_ms = started.elapsed().as_secs_f64() * 1e3;
         SceneDescription {
-            scene: self.name.clone(),
+            scene: self.name().to_string(),
             profile: format!("{:?}", cfg.profile).to_lowercase(),
             width: self.width,
             height: self.height,
@@ -678,7 +703,7 @@ mod tests {
 
     #[test]
     fn sweep_passes_every_switch_starting_at_lod0() {
-        let def = SceneDef::new("bunny-sweep", &cfg(&[])).unwrap();
+        let def = SceneDef::new(SceneKind::BunnySweep, &cfg(&[])).unwrap();
         let s = def.instantiate(1);
         let m = &s.models[0];
         let d0 = s.instance_distance(0, 0);
@@ -692,7 +717,7 @@ mod tests {
     #[test]
     fn grid_follows_equation_1() {
         let c = cfg(&["--count", "50,7"]);
-        let def = SceneDef::new("bunny-grid", &c).unwrap();
+        let def = SceneDef::new(SceneKind::BunnyGrid, &c).unwrap();
         assert_eq!(def.counts, vec![50, 7]);
         let s = def.instantiate(7);
         assert_eq!(s.instances.len(), 7);
@@ -713,10 +738,10 @@ mod tests {
 
     #[test]
     fn dolly_moves_the_camera_through_the_same_relative_geometry() {
-        let fixed = SceneDef::new("bunny-sweep", &cfg(&[]))
+        let fixed = SceneDef::new(SceneKind::BunnySweep, &cfg(&[]))
             .unwrap()
             .instantiate(1);
-        let dolly = SceneDef::new("bunny-sweep", &cfg(&["--camera", "dolly"]))
+        let dolly = SceneDef::new(SceneKind::BunnySweep, &cfg(&["--camera", "dolly"]))
             .unwrap()
             .instantiate(1);
         let mut eyes = Vec::new();
@@ -741,9 +766,9 @@ mod tests {
 
     #[test]
     fn orbit_keeps_the_distance_and_moves_the_eye() {
-        let def = SceneDef::new("bunny-sweep", &cfg(&["--camera", "orbit"])).unwrap();
+        let def = SceneDef::new(SceneKind::BunnySweep, &cfg(&["--camera", "orbit"])).unwrap();
         let s = def.instantiate(1);
-        let fixed = SceneDef::new("bunny-sweep", &cfg(&[]))
+        let fixed = SceneDef::new(SceneKind::BunnySweep, &cfg(&[]))
             .unwrap()
             .instantiate(1);
         for f in [0, 30, 60, 90, 500] {
@@ -759,16 +784,16 @@ mod tests {
     #[test]
     fn switch_override_must_match_lod_count() {
         let c = cfg(&["--switch-distances", "10,20"]);
-        assert!(SceneDef::new("bunny-sweep", &c).is_err());
+        assert!(SceneDef::new(SceneKind::BunnySweep, &c).is_err());
         let c = cfg(&["--switch-distances", "10,20,40"]);
-        let def = SceneDef::new("bunny-sweep", &c).unwrap();
+        let def = SceneDef::new(SceneKind::BunnySweep, &c).unwrap();
         assert_eq!(def.models[0].switches, vec![10.0, 20.0, 40.0]);
     }
 
     #[test]
     fn switch_distance_halves_with_double_pixel_error() {
-        let a = SceneDef::new("bunny-sweep", &cfg(&[])).unwrap();
-        let b = SceneDef::new("bunny-sweep", &cfg(&["--pixel-error", "2"])).unwrap();
+        let a = SceneDef::new(SceneKind::BunnySweep, &cfg(&[])).unwrap();
+        let b = SceneDef::new(SceneKind::BunnySweep, &cfg(&["--pixel-error", "2"])).unwrap();
         for (x, y) in a.models[0].switches.iter().zip(&b.models[0].switches) {
             assert!((x / y - 2.0).abs() < 1e-3);
         }

@@ -1,0 +1,356 @@
+//! The scene on the GPU: the models' LOD meshes in one vertex and one index buffer, the camera uniform, the
+//! shared opaque pipeline, render passes and instanced draws.
+
+use crate::error::{Error, Result};
+use crate::gpu::context::GpuContext;
+use crate::gpu::draw_list::{DrawList, DrawStats, PipelineIndex};
+use crate::gpu::instances::{InstanceBuffer, UploadCounters};
+use crate::gpu::pipelines::{mesh_pipeline, MeshPipeline, Vertex, MESH_WGSL};
+use crate::gpu::targets::RenderTarget;
+use crate::scene::{Camera, Scene, BACKGROUND};
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+/// Direction towards the light (world) and the ambient term of the Lambert shading.
+pub const LIGHT_DIR: [f32; 3] = [-0.45, 0.8, 0.4];
+pub const AMBIENT: f32 = 0.22;
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct CameraRaw {
+    view_proj: [[f32; 4]; 4],
+    eye: [f32; 4],
+    light: [f32; 4],
+}
+
+/// Where one LOD of one model lives in the shared vertex and index buffers.
+#[derive(Debug, Clone, Copy)]
+pub struct LodRange {
+    pub base_vertex: i32,
+    pub first_index: u32,
+    pub index_count: u32,
+}
+
+impl LodRange {
+    pub fn triangles(&self) -> u64 {
+        self.index_count as u64 / 3
+    }
+}
+
+/// The scene on the GPU: geometry, camera uniform, shared pipelines. Built once per scene block.
+pub struct SceneGpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub vertex_buffer: wgpu::Buffer,
+    pub index_buffer: wgpu::Buffer,
+    /// `lods[model][lod]`.
+    pub lods: Vec<Vec<LodRange>>,
+    pub camera_buffer: wgpu::Buffer,
+    pub camera_layout: wgpu::BindGroupLayout,
+    pub camera_bind_group: wgpu::BindGroup,
+    pub shader: wgpu::ShaderModule,
+    pub opaque_pipeline: wgpu::RenderPipeline,
+    /// The scene has alpha-tested geometry: every mesh pipeline is built with `ALPHA_TEST` on.
+    pub alpha_test: bool,
+    pub uploads: UploadCounters,
+}
+
+impl SceneGpu {
+    /// Builds a pipeline over the shared vertex layout and shader (methods call this in their constructors).
+    pub fn mesh_pipeline(&self, d: &MeshPipeline<'_>) -> wgpu::RenderPipeline {
+        mesh_pipeline(
+            &self.device,
+            &self.shader,
+            &self.camera_layout,
+            self.alpha_test,
+            d,
+        )
+    }
+
+    /// An instance buffer for `capacity` instances.
+    pub fn create_instance_buffer(&self, label: &str, capacity: u32) -> InstanceBuffer {
+        InstanceBuffer::new(&self.device, label, capacity)
+    }
+
+    /// Uploads a built draw list into `buffer` (before the submission that uses it).
+    pub fn upload(&self, buffer: &InstanceBuffer, list: &DrawList) {
+        self.upload_at(buffer, 0, list);
+    }
+
+    /// Uploads a built draw list into `buffer` from instance `first` on ([`InstanceBuffer::write`]), counted
+    /// in `uploads`.
+    pub fn upload_at(&self, buffer: &InstanceBuffer, first: u32, list: &DrawList) {
+        buffer.write(&self.queue, first, list, &self.uploads);
+    }
+
+    pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<SceneGpu> {
+        let device = &ctx.device;
+        let mut vertices: Vec<Vertex> = Vec::new();
+        let mut indices: Vec<u32> = Vec::new();
+        let mut lods = Vec::new();
+        for model in scene.models.iter() {
+            let mut ranges = Vec::new();
+            for lod in &model.chain.lods {
+                let m = &lod.mesh;
+                ranges.push(LodRange {
+                    base_vertex: i32::try_from(vertices.len())
+                        .map_err(|_| Error::Gpu("scene has too many vertices".into()))?,
+                    first_index: indices.len() as u32,
+                    index_count: m.indices.len() as u32,
+                });
+                vertices.extend(m.positions.iter().zip(&m.normals).zip(&m.aux).map(
+                    |((p, n), a)| Vertex {
+                        position: *p,
+                        normal: *n,
+                        aux: *a,
+                    },
+                ));
+                indices.extend_from_slice(&m.indices);
+            }
+            lods.push(ranges);
+        }
+        let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene vertices"),
+            contents: bytemuck::cast_slice(&vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene indices"),
+            contents: bytemuck::cast_slice(&indices),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        let camera_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("camera uniform"),
+            size: std::mem::size_of::<CameraRaw>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let camera_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("camera layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let camera_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("camera bind group"),
+            layout: &camera_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: camera_buffer.as_entire_binding(),
+            }],
+        });
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("mesh.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(MESH_WGSL.into()),
+        });
+        let alpha_test = scene.models.iter().any(|m| {
+            m.chain.lods.iter().any(|l| {
+                l.mesh
+                    .aux
+                    .iter()
+                    .any(|a| a[2] == crate::mesh::AUX_LEAF || a[2] == crate::mesh::AUX_LEAF_CLUSTER)
+            })
+        });
+        let opaque_pipeline = mesh_pipeline(
+            device,
+            &shader,
+            &camera_layout,
+            alpha_test,
+            &MeshPipeline::opaque("opaque pipeline"),
+        );
+        ctx.check_errors()?;
+        Ok(SceneGpu {
+            device: device.clone(),
+            queue: ctx.queue.clone(),
+            vertex_buffer,
+            index_buffer,
+            lods,
+            camera_buffer,
+            camera_layout,
+            camera_bind_group,
+            shader,
+            opaque_pipeline,
+            alpha_test,
+            uploads: UploadCounters::default(),
+        })
+    }
+
+    pub fn write_camera(&self, camera: &Camera) {
+        let l = Vec3::from(LIGHT_DIR).normalize();
+        let raw = CameraRaw {
+            view_proj: camera.view_proj().to_cols_array_2d(),
+            eye: camera.eye.extend(1.0).to_array(),
+            light: [l.x, l.y, l.z, AMBIENT],
+        };
+        self.queue
+            .write_buffer(&self.camera_buffer, 0, bytemuck::bytes_of(&raw));
+    }
+
+    /// A `side` x `side` R32Float texture holding `values` (row-major): the screen-space thresholds of
+    /// `dither`, the visibility texture of FSI. Read with `textureLoad` (no sampler).
+    pub fn create_value_texture(&self, label: &str, side: u32, values: &[f32]) -> wgpu::Texture {
+        debug_assert_eq!(values.len(), (side * side) as usize);
+        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: side,
+                height: side,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        self.queue.write_texture(
+            texture.as_image_copy(),
+            bytemuck::cast_slice(values),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(side * 4),
+                rows_per_image: Some(side),
+            },
+            texture.size(),
+        );
+        texture
+    }
+
+    /// Begins a pass that clears `target` to the background and its depth to 1.
+    pub fn begin_clear_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+        label: &str,
+    ) -> wgpu::RenderPass<'e> {
+        self.begin_pass(encoder, &target.color_view, &target.depth_view, label, true)
+    }
+
+    /// Begins a pass on a colour and a depth view, clearing both (`clear`) or keeping what they hold.
+    pub fn begin_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        color: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+        label: &str,
+        clear: bool,
+    ) -> wgpu::RenderPass<'e> {
+        let [r, g, b] = BACKGROUND;
+        let color_load = if clear {
+            wgpu::LoadOp::Clear(wgpu::Color {
+                r: r as f64,
+                g: g as f64,
+                b: b as f64,
+                a: 1.0,
+            })
+        } else {
+            wgpu::LoadOp::Load
+        };
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: color,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: color_load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: if clear {
+                        wgpu::LoadOp::Clear(1.0)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+    }
+
+    /// Draws `count` instances from absolute instance `first` of `buffer` at (model, LOD) with `pipeline`;
+    /// for methods that need a pass per instance.
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "one draw's parameters, as wgpu's own draw_indexed takes them"
+    )]
+    pub fn draw_instances(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        buffer: &InstanceBuffer,
+        first: u32,
+        count: u32,
+        model: u32,
+        lod: u32,
+        pipeline: &wgpu::RenderPipeline,
+    ) -> DrawStats {
+        pass.set_bind_group(0, &self.camera_bind_group, &[]);
+        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+        pass.set_vertex_buffer(1, buffer.buffer.slice(..));
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        pass.set_pipeline(pipeline);
+        let r = self.lods[model as usize][lod as usize];
+        pass.draw_indexed(
+            r.first_index..r.first_index + r.index_count,
+            r.base_vertex,
+            first..first + count,
+        );
+        DrawStats {
+            triangles: r.triangles() * count as u64,
+            draw_calls: 1,
+        }
+    }
+
+    /// Records the draws of `list` (uploaded to `buffer` at instance `first`, see [`SceneGpu::upload_at`])
+    /// into `pass`, with `pipelines[d.pipeline]` for each draw. Bind groups other than the camera's (group 0)
+    /// are the caller's to set.
+    pub fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        buffer: &InstanceBuffer,
+        first: u32,
+        list: &DrawList,
+        pipelines: &[&wgpu::RenderPipeline],
+    ) -> DrawStats {
+        let mut stats = DrawStats::default();
+        if list.draws.is_empty() {
+            return stats;
+        }
+        pass.set_bind_group(0, &self.camera_bind_group, &[]);
+        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+        pass.set_vertex_buffer(1, buffer.buffer.slice(..));
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        let mut bound: Option<PipelineIndex> = None;
+        for d in &list.draws {
+            if bound != Some(d.pipeline) {
+                pass.set_pipeline(pipelines[d.pipeline as usize]);
+                bound = Some(d.pipeline);
+            }
+            let r = self.lods[d.model as usize][d.lod as usize];
+            pass.draw_indexed(
+                r.first_index..r.first_index + r.index_count,
+                r.base_vertex,
+                first + d.first_instance..first + d.first_instance + d.instance_count,
+            );
+            stats.triangles += r.triangles() * d.instance_count as u64;
+            stats.draw_calls += 1;
+        }
+        stats
+    }
+}

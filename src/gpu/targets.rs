@@ -1,0 +1,68 @@
+//! Render targets: the colour and depth attachments of one viewport.
+
+use crate::formats::{COLOR_FORMAT, DEPTH_FORMAT};
+
+/// Colour (sRGB) and depth attachments of one viewport. The colour texture can also be viewed as plain
+/// Rgba8Unorm, which is how the metric kernels read the stored sRGB-encoded bytes.
+pub struct RenderTarget {
+    pub width: u32,
+    pub height: u32,
+    pub color: wgpu::Texture,
+    pub color_view: wgpu::TextureView,
+    pub color_bytes_view: wgpu::TextureView,
+    pub depth: wgpu::Texture,
+    pub depth_view: wgpu::TextureView,
+}
+
+impl RenderTarget {
+    pub fn new(device: &wgpu::Device, label: &str, width: u32, height: u32) -> RenderTarget {
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let color = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(&format!("{label} colour")),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: COLOR_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[wgpu::TextureFormat::Rgba8Unorm],
+        });
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(&format!("{label} depth")),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        RenderTarget {
+            width,
+            height,
+            color_view: color.create_view(&Default::default()),
+            color_bytes_view: color.create_view(&wgpu::TextureViewDescriptor {
+                label: Some(&format!("{label} colour bytes")),
+                format: Some(wgpu::TextureFormat::Rgba8Unorm),
+                ..Default::default()
+            }),
+            depth_view: depth.create_view(&Default::default()),
+            color,
+            depth,
+        }
+    }
+
+    /// Bytes of colour and depth this target holds.
+    pub fn bytes(&self) -> u64 {
+        self.width as u64 * self.height as u64 * 8
+    }
+}

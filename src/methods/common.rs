@@ -1,0 +1,259 @@
+//! What every method shares: the frame input, the `Method` trait, and the drawing helpers several methods use
+//! (the unpopping schedule and its draw lists, opaque one-LOD-per-instance drawing, per-instance data).
+
+use crate::error::Result;
+use crate::gpu::{DrawList, DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu};
+use crate::scene::Scene;
+use crate::schedule::InstanceState;
+use glam::Mat4;
+
+/// What a method gets for one frame.
+pub struct FrameInput<'a> {
+    pub frame: u32,
+    pub scene: &'a Scene,
+    /// One state per instance, from the shared schedule.
+    pub states: &'a [InstanceState],
+    /// One object-to-world matrix per instance.
+    pub matrices: &'a [Mat4],
+    /// Camera-to-instance-centre distance per instance (what LOD selection used).
+    pub distances: &'a [f32],
+    /// This frame belongs to the timing pass (methods that time a pass of their own do it only then).
+    pub timed: bool,
+}
+
+pub trait Method {
+    /// Writes the frame's per-instance data (through the queue, before the submission) and records its passes
+    /// into `encoder`, leaving the final image in `target`. Returns what it really submitted.
+    fn encode(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) -> DrawStats;
+
+    /// Render-target memory the method holds beyond the frame's own colour and depth target, in bytes.
+    fn extra_target_bytes(&self) -> u64 {
+        0
+    }
+
+    /// GPU milliseconds per frame of the method's own named stage over the last timing pass (FSI: its
+    /// combination pass), or None for methods without one.
+    fn stage_gpu_ms(&self, _ctx: &crate::gpu::GpuContext) -> Result<Option<Vec<Option<f64>>>> {
+        Ok(None)
+    }
+
+    /// Intermediate images worth seeing (`--dump-frames` writes them next to the frame): (name, target).
+    fn debug_targets(&self) -> Vec<(&'static str, &RenderTarget)> {
+        Vec::new()
+    }
+}
+
+/// The Giegl-Wimmer "unpopping" schedule (seed 000 Fig. 2, seed 001 Fig. 1b): one LOD is always opaque. For
+/// k < 0.5 the incoming LOD (`lod_to`) is translucent with alpha 2k over the opaque outgoing one; from k = 0.5
+/// the incoming one is opaque and the outgoing one translucent with alpha 2(1 - k).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Unpop {
+    pub opaque: u32,
+    /// (LOD, alpha) of the translucent draw of a t-instance.
+    pub translucent: Option<(u32, f32)>,
+    /// True from k = 0.5 on: the roles have swapped.
+    pub swapped: bool,
+}
+
+pub(crate) fn unpop(s: &InstanceState) -> Unpop {
+    if !s.in_transition() {
+        return Unpop {
+            opaque: s.lod_from,
+            translucent: None,
+            swapped: false,
+        };
+    }
+    if s.k < 0.5 {
+        Unpop {
+            opaque: s.lod_from,
+            translucent: Some((s.lod_to, 2.0 * s.k)),
+            swapped: false,
+        }
+    } else {
+        Unpop {
+            opaque: s.lod_to,
+            translucent: Some((s.lod_from, 2.0 * (1.0 - s.k))),
+            swapped: true,
+        }
+    }
+}
+
+/// Indices of the instances `select` keeps, farthest first (ties by index, so the order is deterministic).
+pub(crate) fn back_to_front(
+    distances: &[f32],
+    out: &mut Vec<usize>,
+    select: impl Fn(usize) -> bool,
+) {
+    out.clear();
+    out.extend((0..distances.len()).filter(|&i| select(i)));
+    out.sort_by(|&a, &b| distances[b].total_cmp(&distances[a]).then(a.cmp(&b)));
+}
+
+/// The draw lists of the unpopping methods: every instance's opaque LOD, then the translucent LODs of the
+/// t-instances back to front. Kept between frames.
+#[derive(Default)]
+pub(crate) struct UnpopLists {
+    pub opaque: DrawList,
+    pub translucent: DrawList,
+    order: Vec<usize>,
+}
+
+impl UnpopLists {
+    /// Fills and builds both lists and uploads them to `buffer`, opaque first; `pipeline_of` picks the
+    /// translucent draw's pipeline index. Returns the first instance of the translucent list in `buffer`.
+    pub fn prepare(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        buffer: &InstanceBuffer,
+        pipeline_of: impl Fn(&Unpop) -> u8,
+    ) -> u32 {
+        self.opaque.clear();
+        self.translucent.clear();
+        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
+            let u = unpop(s);
+            self.opaque.push(
+                0,
+                inst.model,
+                u.opaque,
+                instance_raw(input, i, s.k, 1.0, u.opaque),
+            );
+        }
+        back_to_front(input.distances, &mut self.order, |i| {
+            input.states[i].in_transition()
+        });
+        for &i in &self.order {
+            let s = &input.states[i];
+            let u = unpop(s);
+            if let Some((lod, alpha)) = u.translucent {
+                let model = input.scene.instances[i].model;
+                self.translucent.push(
+                    pipeline_of(&u),
+                    model,
+                    lod,
+                    instance_raw(input, i, s.k, alpha, lod),
+                );
+            }
+        }
+        self.opaque.build();
+        self.translucent.build_in_order();
+        let n_opaque = self.opaque.instances.len() as u32;
+        gpu.upload_at(buffer, 0, &self.opaque);
+        gpu.upload_at(buffer, n_opaque, &self.translucent);
+        n_opaque
+    }
+}
+
+pub fn instance_raw(input: &FrameInput<'_>, i: usize, k: f32, alpha: f32, lod: u32) -> InstanceRaw {
+    instance_raw_with(input, i, lod, [k, alpha, lod as f32, i as f32])
+}
+
+/// Instance i drawn at `lod`: its matrix, the LOD's colour and its animation angle this frame, with the
+/// method's own `params` (shaders/mesh.wgsl reads them per method).
+pub fn instance_raw_with(
+    input: &FrameInput<'_>,
+    i: usize,
+    lod: u32,
+    params: [f32; 4],
+) -> InstanceRaw {
+    let inst = &input.scene.instances[i];
+    let model = &input.scene.models[inst.model as usize];
+    let [r, g, b] = model.color_of(lod);
+    InstanceRaw::new(
+        &input.matrices[i],
+        [r, g, b, input.scene.animation_angle(i, input.frame)],
+        params,
+    )
+}
+
+/// Shared by methods that draw every instance once, opaque, at one LOD each.
+pub struct OpaqueInstances {
+    list: DrawList,
+    buffer: InstanceBuffer,
+}
+
+impl OpaqueInstances {
+    pub fn new(gpu: &SceneGpu, scene: &Scene, label: &str) -> Self {
+        OpaqueInstances {
+            list: DrawList::default(),
+            buffer: gpu.create_instance_buffer(label, scene.instances.len() as u32),
+        }
+    }
+
+    /// Draws instance i at `lod_of(state_i)` into a cleared `target`.
+    pub fn encode(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+        label: &str,
+        lod_of: impl Fn(&InstanceState) -> u32,
+    ) -> DrawStats {
+        self.list.clear();
+        for (i, (inst, state)) in input.scene.instances.iter().zip(input.states).enumerate() {
+            let lod = lod_of(state);
+            self.list.push(
+                0,
+                inst.model,
+                lod,
+                instance_raw(input, i, state.k, 1.0, lod),
+            );
+        }
+        self.list.build();
+        gpu.upload(&self.buffer, &self.list);
+        let mut pass = gpu.begin_clear_pass(encoder, target, label);
+        gpu.draw(
+            &mut pass,
+            &self.buffer,
+            0,
+            &self.list,
+            &[&gpu.opaque_pipeline],
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn st(from: u32, to: u32, k: f32) -> InstanceState {
+        InstanceState {
+            lod_from: from,
+            lod_to: to,
+            k,
+        }
+    }
+
+    #[test]
+    fn unpopping_keeps_one_lod_opaque() {
+        assert_eq!(unpop(&st(1, 1, 0.0)).translucent, None);
+        let a = unpop(&st(0, 1, 0.2));
+        assert_eq!((a.opaque, a.swapped), (0, false));
+        assert_eq!(a.translucent, Some((1, 0.4)));
+        let b = unpop(&st(0, 1, 0.5));
+        assert_eq!((b.opaque, b.swapped), (1, true));
+        assert_eq!(b.translucent, Some((0, 1.0)));
+        let c = unpop(&st(0, 1, 0.9));
+        assert_eq!(c.opaque, 1);
+        let (lod, alpha) = c.translucent.unwrap();
+        assert_eq!(lod, 0);
+        assert!((alpha - 0.2).abs() < 1e-6);
+        // Alpha is continuous through the swap: 2k -> 1 from below, 2(1-k) = 1 at k = 0.5.
+        let below = unpop(&st(0, 1, 0.4999)).translucent.unwrap().1;
+        assert!((below - 1.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn back_to_front_sorts_farthest_first() {
+        let mut order = Vec::new();
+        back_to_front(&[3.0, 9.0, 1.0, 9.0], &mut order, |i| i != 2);
+        assert_eq!(order, vec![1, 3, 0]);
+    }
+}

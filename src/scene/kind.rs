@@ -1,0 +1,189 @@
+//! The scenes lodbench knows, by name, and what each profile (size preset) sets for each. Everything the rest
+//! of the program asks about a scene's kind (its name, whether it is a bunny scene, its frame and instance
+//! counts per profile) is answered here, so no other module matches scene names.
+
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// Size and length presets; explicit flags override them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Profile {
+    /// A minute's look at everything: small viewport, few frames.
+    Quick,
+    /// What CI runs on a software adapter.
+    Ci,
+    /// The papers' sizes: 800x600, 3,600 timed frames, the full instance counts.
+    Paper,
+}
+
+/// `--camera`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum CameraMode {
+    /// The scene's own camera (fixed for the bunny scenes).
+    Fixed,
+    /// The eye swings around the point it looks at (the swept bunny, or the first grid bunny) by
+    /// `ORBIT_AMPLITUDE_DEG` * sin(2 pi f / `ORBIT_PERIOD_FRAMES`), at the distance the fixed camera would have,
+    /// so LOD selection sees the same distances for that point.
+    Orbit,
+    /// bunny-sweep: the bunny stays where the sweep starts and the camera moves instead, backwards and forwards
+    /// along its line of sight through the same distances, so every frame shows what `fixed` shows (the same
+    /// relative geometry under a directional light) while the motion is the camera's, the motion eq. 2 of FSI
+    /// reprojects. Elsewhere the same as `fixed`.
+    Dolly,
+}
+
+/// What a profile sets for one scene.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ProfileValues {
+    pub width: u32,
+    pub height: u32,
+    pub frames: u32,
+    pub warmup: u32,
+}
+
+/// The paper's counts for bunny-grid (seed 003 section 6).
+pub const PAPER_COUNTS: [u32; 5] = [50, 250, 500, 1000, 2000];
+
+/// A scene `--scene` accepts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SceneKind {
+    /// The popping experiment of seed 003 section 6: one bunny moved along the line of sight and back.
+    BunnySweep,
+    /// The performance experiment of seed 003 section 6, eq. 1: n bunnies on the +x axis.
+    BunnyGrid,
+    /// Seed 000's SIMPLE: a field of spheres whose LOD1 is a box.
+    Simple,
+    /// Seed 000's WINDMILLS: a field of windmills with turning blades.
+    Windmills,
+    /// Seed 000's TREES: a field of alpha-tested trees.
+    Trees,
+}
+
+impl SceneKind {
+    /// Every scene, in the order runs use when `--scene` is absent.
+    pub const ALL: [SceneKind; 5] = [
+        SceneKind::BunnySweep,
+        SceneKind::BunnyGrid,
+        SceneKind::Simple,
+        SceneKind::Windmills,
+        SceneKind::Trees,
+    ];
+
+    /// The name `--scene` takes and the CSVs' `scene` column holds.
+    pub const fn name(self) -> &'static str {
+        match self {
+            SceneKind::BunnySweep => "bunny-sweep",
+            SceneKind::BunnyGrid => "bunny-grid",
+            SceneKind::Simple => "simple",
+            SceneKind::Windmills => "windmills",
+            SceneKind::Trees => "trees",
+        }
+    }
+
+    /// Every scene name, in [`SceneKind::ALL`]'s order.
+    pub fn names() -> Vec<&'static str> {
+        Self::ALL.iter().map(|k| k.name()).collect()
+    }
+
+    /// The scene called `name`, or an error listing the valid names.
+    pub fn from_name(name: &str) -> Result<SceneKind> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| Error::unknown("scene", name, &Self::names()))
+    }
+
+    /// The Stanford-bunny scenes of seed 003 (the others are seed 000's procedural camera flights).
+    pub fn is_bunny(self) -> bool {
+        matches!(self, SceneKind::BunnySweep | SceneKind::BunnyGrid)
+    }
+
+    /// What `profile` sets for this scene.
+    ///
+    /// bunny-grid is a static scene: every frame is the same picture, so its timing needs fewer frames at small
+    /// profiles, and its instance counts make each frame far heavier on a software adapter. bunny-sweep needs
+    /// many frames: `pop` compares consecutive error images, so the bunny must move by well under a pixel per
+    /// frame for a LOD switch to stand out from the error pattern moving with the bunny (docs/measurement.md,
+    /// "Reading pop"). At 320x240, 2,400 frames is the fewest for which every discrete switch frame is a local
+    /// maximum of pop; 600 frames (quick) is only a look. The procedural scenes of seed 000 (simple, windmills,
+    /// trees) are camera flights over a field: their frames are heavy on a software adapter, so the small
+    /// profiles keep few frames and instances.
+    pub fn profile(self, profile: Profile) -> ProfileValues {
+        let frames = |grid: u32, flight: u32, sweep: u32| match self {
+            SceneKind::BunnyGrid => grid,
+            SceneKind::BunnySweep => sweep,
+            _ => flight,
+        };
+        match profile {
+            Profile::Quick => ProfileValues {
+                width: 320,
+                height: 240,
+                frames: frames(20, 60, 600),
+                warmup: 5,
+            },
+            Profile::Ci => ProfileValues {
+                width: 320,
+                height: 240,
+                frames: frames(30, 120, 2400),
+                warmup: 10,
+            },
+            Profile::Paper => ProfileValues {
+                width: 800,
+                height: 600,
+                frames: 3600,
+                warmup: 120,
+            },
+        }
+    }
+
+    /// Instance counts under a profile, unless --count is given: bunny-grid's sweep of counts (seed 003), the
+    /// paper's 4,000 windmills and trees (seed 000 section 4; SIMPLE's count is not given there: 1,000), and
+    /// small fields for the small profiles. bunny-sweep is one bunny whatever --count says.
+    pub fn profile_counts(self, profile: Profile) -> Vec<u32> {
+        use Profile::*;
+        use SceneKind::*;
+        match (self, profile) {
+            (BunnySweep, _) => vec![1],
+            (BunnyGrid, Quick) => vec![50],
+            (BunnyGrid, Ci) => vec![50, 250],
+            (BunnyGrid, Paper) => PAPER_COUNTS.to_vec(),
+            (Simple, Quick) => vec![36],
+            (Simple, Ci) => vec![64],
+            (Simple, Paper) => vec![1000],
+            (Windmills, Quick) => vec![9],
+            (Windmills, Ci) => vec![16],
+            (Windmills, Paper) => vec![4000],
+            (Trees, Quick) => vec![4],
+            (Trees, Ci) => vec![6],
+            (Trees, Paper) => vec![4000],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_unknown_names_list_the_valid_ones() {
+        for k in SceneKind::ALL {
+            assert_eq!(SceneKind::from_name(k.name()).unwrap(), k);
+        }
+        let msg = SceneKind::from_name("bunny-swep").unwrap_err().to_string();
+        assert!(msg.contains("bunny-swep") && msg.contains("trees"), "{msg}");
+    }
+
+    #[test]
+    fn profiles_per_kind() {
+        use SceneKind::*;
+        assert_eq!(BunnySweep.profile(Profile::Ci).frames, 2400);
+        assert_eq!(BunnyGrid.profile(Profile::Ci).frames, 30);
+        assert_eq!(Trees.profile(Profile::Quick).frames, 60);
+        assert_eq!(Simple.profile(Profile::Paper).frames, 3600);
+        assert_eq!(BunnySweep.profile_counts(Profile::Paper), vec![1]);
+        assert_eq!(Windmills.profile_counts(Profile::Paper), vec![4000]);
+    }
+}

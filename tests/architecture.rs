@@ -1,0 +1,270 @@
+//! The module graph of src/ has no circle: every file's imports (its `use` items and the paths it names through
+//! `crate::`, `super::` or a child module) point to files that never import it back, directly or through
+//! others. Test modules (`#[cfg(test)]`) are left out: they may import anything. docs/ARCHITECTURE.md shows the
+//! listing; `cargo test --test architecture -- --nocapture` prints it.
+
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "a test or bench fails by panicking"
+)]
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use syn::visit::Visit;
+
+/// A file's module path: src/gpu/mod.rs -> [gpu], src/gpu/targets.rs -> [gpu, targets].
+fn module_path(rel: &Path) -> Vec<String> {
+    let mut parts: Vec<String> = rel
+        .with_extension("")
+        .iter()
+        .map(|p| p.to_string_lossy().into_owned())
+        .collect();
+    if matches!(parts.last().map(String::as_str), Some("mod" | "lib")) {
+        parts.pop();
+    }
+    parts
+}
+
+struct Graph {
+    /// Module path -> file (relative to src/).
+    modules: BTreeMap<Vec<String>, String>,
+}
+
+impl Graph {
+    /// The file of the deepest module that `path` names.
+    fn file_of(&self, path: &[String]) -> Option<&String> {
+        (1..=path.len())
+            .rev()
+            .find_map(|n| self.modules.get(&path[..n]))
+    }
+}
+
+struct Refs<'g> {
+    graph: &'g Graph,
+    me: Vec<String>,
+    deps: BTreeSet<String>,
+}
+
+impl Refs<'_> {
+    fn add(&mut self, segments: Vec<String>) {
+        let Some(first) = segments.first() else {
+            return;
+        };
+        let absolute: Vec<String> = match first.as_str() {
+            "crate" => segments[1..].to_vec(),
+            "super" => {
+                let mut base = self.me.clone();
+                let mut rest = &segments[..];
+                while rest.first().is_some_and(|s| s == "super") {
+                    base.pop();
+                    rest = &rest[1..];
+                }
+                base.extend_from_slice(rest);
+                base
+            }
+            "self" => [self.me.clone(), segments[1..].to_vec()].concat(),
+            child => {
+                let mut p = self.me.clone();
+                p.push(child.to_string());
+                if !self.graph.modules.contains_key(&p) {
+                    return;
+                }
+                [self.me.clone(), segments].concat()
+            }
+        };
+        if let Some(f) = self.graph.file_of(&absolute) {
+            self.deps.insert(f.clone());
+        }
+    }
+
+    fn use_tree(&mut self, prefix: Vec<String>, tree: &syn::UseTree) {
+        match tree {
+            syn::UseTree::Path(p) => {
+                let mut next = prefix;
+                next.push(p.ident.to_string());
+                self.use_tree(next, &p.tree);
+            }
+            syn::UseTree::Name(n) => {
+                let mut full = prefix;
+                if n.ident != "self" {
+                    full.push(n.ident.to_string());
+                }
+                self.add(full);
+            }
+            syn::UseTree::Rename(r) => {
+                let mut full = prefix;
+                full.push(r.ident.to_string());
+                self.add(full);
+            }
+            syn::UseTree::Glob(_) => self.add(prefix),
+            syn::UseTree::Group(g) => {
+                for t in &g.items {
+                    self.use_tree(prefix.clone(), t);
+                }
+            }
+        }
+    }
+}
+
+fn is_cfg_test(attrs: &[syn::Attribute]) -> bool {
+    attrs.iter().any(|a| {
+        a.path().is_ident("cfg")
+            && a.parse_args::<syn::Meta>()
+                .is_ok_and(|m| m.path().is_ident("test"))
+    })
+}
+
+impl<'ast> Visit<'ast> for Refs<'_> {
+    fn visit_item_mod(&mut self, m: &'ast syn::ItemMod) {
+        if !is_cfg_test(&m.attrs) {
+            syn::visit::visit_item_mod(self, m);
+        }
+    }
+    fn visit_item_use(&mut self, u: &'ast syn::ItemUse) {
+        self.use_tree(Vec::new(), &u.tree);
+    }
+    fn visit_path(&mut self, p: &'ast syn::Path) {
+        self.add(p.segments.iter().map(|s| s.ident.to_string()).collect());
+        syn::visit::visit_path(self, p);
+    }
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// file -> the files it imports, for every file of the library under `src`.
+fn imports(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    files.retain(|p| !p.ends_with("main.rs"));
+    let rel = |p: &PathBuf| p.strip_prefix(src).unwrap().to_path_buf();
+    let graph = Graph {
+        modules: files
+            .iter()
+            .map(|p| (module_path(&rel(p)), rel(p).to_string_lossy().into_owned()))
+            .collect(),
+    };
+    let mut edges = BTreeMap::new();
+    for p in &files {
+        let ast = syn::parse_file(&std::fs::read_to_string(p).unwrap())
+            .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        let name = rel(p).to_string_lossy().into_owned();
+        let mut refs = Refs {
+            graph: &graph,
+            me: module_path(&rel(p)),
+            deps: BTreeSet::new(),
+        };
+        refs.visit_file(&ast);
+        refs.deps.remove(&name);
+        edges.insert(name, refs.deps);
+    }
+    edges
+}
+
+/// The files that lie on a circle of imports (Tarjan's strongly connected components of more than one file).
+fn circles(edges: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
+    struct T<'e> {
+        edges: &'e BTreeMap<String, BTreeSet<String>>,
+        index: BTreeMap<&'e str, usize>,
+        low: BTreeMap<&'e str, usize>,
+        stack: Vec<&'e str>,
+        out: Vec<Vec<String>>,
+    }
+    impl<'e> T<'e> {
+        fn visit(&mut self, v: &'e str) {
+            let i = self.index.len();
+            self.index.insert(v, i);
+            self.low.insert(v, i);
+            self.stack.push(v);
+            for w in &self.edges[v] {
+                let w = w.as_str();
+                if !self.index.contains_key(w) {
+                    self.visit(w);
+                    self.low.insert(v, self.low[v].min(self.low[w]));
+                } else if self.stack.contains(&w) {
+                    self.low.insert(v, self.low[v].min(self.index[w]));
+                }
+            }
+            if self.low[v] == self.index[v] {
+                let mut comp = Vec::new();
+                while let Some(w) = self.stack.pop() {
+                    comp.push(w.to_string());
+                    if w == v {
+                        break;
+                    }
+                }
+                if comp.len() > 1 {
+                    comp.sort();
+                    self.out.push(comp);
+                }
+            }
+        }
+    }
+    let mut t = T {
+        edges,
+        index: BTreeMap::new(),
+        low: BTreeMap::new(),
+        stack: Vec::new(),
+        out: Vec::new(),
+    };
+    for v in edges.keys() {
+        if !t.index.contains_key(v.as_str()) {
+            t.visit(v);
+        }
+    }
+    t.out
+}
+
+#[test]
+fn module_imports_form_no_circle() {
+    // ARCHITECTURE_SRC points the check at another tree (e.g. an older commit's src/, to compare).
+    let src = std::env::var_os("ARCHITECTURE_SRC")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("src"));
+    let edges = imports(&src);
+    for (file, deps) in &edges {
+        let deps: Vec<&str> = deps.iter().map(String::as_str).collect();
+        println!("{file:<24} -> {}", deps.join(", "));
+    }
+    let found = circles(&edges);
+    assert!(found.is_empty(), "import circles: {found:?}");
+}
+
+#[test]
+fn a_circle_is_found() {
+    // The checker itself: two files importing each other, and a child re-exported by its parent that
+    // imports the parent back (the shape the methods' registry had).
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path();
+    std::fs::create_dir_all(src.join("m")).unwrap();
+    std::fs::write(src.join("lib.rs"), "pub mod a;\npub mod b;\npub mod m;\n").unwrap();
+    std::fs::write(src.join("a.rs"), "use crate::b::B;\npub struct A;\n").unwrap();
+    std::fs::write(src.join("b.rs"), "pub struct B(crate::a::A);\n").unwrap();
+    std::fs::write(
+        src.join("m/mod.rs"),
+        "pub mod x;\npub struct Opt;\npub fn f() { x::X::new(); }\n",
+    )
+    .unwrap();
+    std::fs::write(
+        src.join("m/x.rs"),
+        "use super::Opt;\npub struct X;\n#[cfg(test)]\nmod tests { use crate::a::A; }\n",
+    )
+    .unwrap();
+    let found = circles(&imports(src));
+    assert_eq!(
+        found,
+        vec![
+            vec!["a.rs".to_string(), "b.rs".to_string()],
+            vec!["m/mod.rs".to_string(), "m/x.rs".to_string()],
+        ]
+    );
+}
