@@ -90,7 +90,7 @@ pub enum FsiCheck {
     /// that moved here). The tolerance is a pixel, not a pixel's half-width, so that an image that magnifies
     /// between frames leaves no pixel without a match. Like eq. 2 it assumes objects do not move: a moving
     /// t-instance's older fragments can miss by more than a pixel, and then its holes show what is behind it
-    /// (measured in the README).
+    /// (measured in docs/findings/fsi-forward-check.md).
     Forward,
 }
 
