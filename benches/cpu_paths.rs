@@ -94,9 +94,11 @@ fn csv_export(c: &mut Criterion) {
             lod_mean: f as f64 / 1200.0,
             rmse: 0.01,
             pop: 0.001,
+            lodpop: 0.0,
             de2000_mean: 0.1,
             flip_mean: None,
             combine_gpu_ms: None,
+            lag_rmse: None,
         })
         .collect();
     let dir = tempfile::tempdir().unwrap();

@@ -5,10 +5,12 @@
 
 Writes into each folder a `figures/` subfolder and `report.md` (the summary table and every figure that folder's
 data allows):
-  - sweep_<scene>.png       rmse and pop along the path per method, discrete LOD switch frames marked;
-  - fig6_<scene>.png        seed 003 Fig. 6: popping per method (mean rmse, max pop; bunny-sweep or any moving scene);
-  - transitions_<scene>.png the largest pop of each method within 5 frames of each transition of the path (up to 16
-                            transitions), also as a table in report.md;
+  - sweep_<scene>.png       rmse, pop and lodpop along the path per method, discrete LOD switch frames marked;
+  - fig6_<scene>.png        seed 003 Fig. 6: popping per method (mean rmse, max pop, max lodpop; bunny-sweep or any
+                            moving scene);
+  - transitions_<scene>.png per transition of the path (up to 16), the largest lodpop and pop of each method (from
+                            transitions.csv: the transition's frames and the 2 after; older folders without it: the
+                            largest pop within 5 frames), also as tables in report.md;
   - fig5_<scene>.png        seed 003 Fig. 5: median frame time against instance count per method (scenes run with
                             several --count values, e.g. bunny-grid), with bootstrap 95 % intervals;
   - cost_<scene>.png        error against cost: mean rmse and max pop against median GPU time, per method;
@@ -67,7 +69,8 @@ def save(fig, path):
 
 
 def sweep_figure(scene, by_method, path):
-    fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
+    has_lodpop = "lodpop" in next(iter(by_method.values()))[0]
+    fig, axes = plt.subplots(3 if has_lodpop else 2, 1, figsize=(10, 8.5 if has_lodpop else 6), sharex=True)
     first = next(iter(by_method.values()))
     for f in switch_frames(first):
         for ax in axes:
@@ -76,9 +79,13 @@ def sweep_figure(scene, by_method, path):
         frames = [int(r["frame"]) for r in rows]
         axes[0].plot(frames, [num(r["rmse"]) for r in rows], lw=0.9, label=method)
         axes[1].plot(frames, [num(r["pop"]) for r in rows], lw=0.9, label=method)
+        if has_lodpop:
+            axes[2].plot(frames, [num(r["lodpop"]) for r in rows], lw=0.9, label=method)
     axes[0].set_ylabel("rmse (seed 003 sec. 6)")
-    axes[1].set_ylabel("pop")
-    axes[1].set_xlabel("frame (grey: discrete LOD switches)")
+    axes[1].set_ylabel("pop (motion included)")
+    if has_lodpop:
+        axes[2].set_ylabel("lodpop (pose held)")
+    axes[-1].set_xlabel("frame (grey: discrete LOD switches)")
     axes[0].legend(ncol=4, fontsize=8)
     axes[0].set_title(f"{scene}: error along the path")
     save(fig, path)
@@ -88,8 +95,11 @@ def fig6(scene, summary, path):
     methods = [r["method"] for r in summary]
     x = np.arange(len(methods))
     fig, ax = plt.subplots(figsize=(9, 4))
-    ax.bar(x - 0.2, [num(r["rmse_mean"]) for r in summary], 0.4, label="mean rmse")
-    ax.bar(x + 0.2, [num(r["pop_max"]) for r in summary], 0.4, label="max pop")
+    bars = [("rmse_mean", "mean rmse"), ("pop_max", "max pop"), ("lodpop_max", "max lodpop")]
+    bars = [(c, label) for c, label in bars if c in summary[0]]
+    w = 0.8 / len(bars)
+    for i, (c, label) in enumerate(bars):
+        ax.bar(x - 0.4 + (i + 0.5) * w, [num(r[c]) for r in summary], w, label=label)
     ax.set_xticks(x, methods, rotation=20)
     ax.set_title(f"{scene}: popping per method (cf. seed 003 Fig. 6)")
     ax.legend()
@@ -118,17 +128,43 @@ def transition_pops(by_method, window=TRANSITION_WINDOW):
     return out
 
 
+def transition_table(rows, scene):
+    """Per transition from transitions.csv (one scene, the first count): [(first, last, lods, {method: (max lodpop,
+    max pop)})], the reference left out."""
+    rows = [r for r in rows if r["scene"] == scene]
+    if not rows:
+        return []
+    first_count = min((r["count"] for r in rows), key=int)
+    out = OrderedDict()
+    for r in rows:
+        if r["count"] != first_count or r["method"].startswith("reference"):
+            continue
+        key = int(r["transition"])
+        entry = out.setdefault(key, (int(r["first_frame"]), int(r["last_frame"]), r["lods"], OrderedDict()))
+        entry[3][r["method"]] = (num(r["lodpop_max"]), num(r["pop_max"]))
+    return list(out.values())
+
+
 def transitions_figure(scene, per_transition, path):
-    methods = list(per_transition[0][2])
+    """Bars per transition and method: lodpop (top) and pop (bottom) from transitions.csv, or pop alone from the
+    frames (older folders: `per_transition` entries are (first, last, {method: pop}))."""
+    with_lodpop = len(per_transition[0]) == 4
+    methods = list(per_transition[0][-1])
     x = np.arange(len(per_transition))
     width = 0.8 / len(methods)
-    fig, ax = plt.subplots(figsize=(max(8, 1.3 * len(per_transition) + 3), 4))
-    for i, m in enumerate(methods):
-        ax.bar(x - 0.4 + (i + 0.5) * width, [p[m] for _, _, p in per_transition], width, label=m)
-    ax.set_xticks(x, [f"frames {a}-{b}" for a, b, _ in per_transition], rotation=20, fontsize=8)
-    ax.set_ylabel(f"max pop within {TRANSITION_WINDOW} frames")
-    ax.set_title(f"{scene}: popping per transition and method")
-    ax.legend(fontsize=7, ncol=2)
+    panels = [("max lodpop (pose held)", 0), ("max pop (motion included)", 1)] if with_lodpop else \
+        [(f"max pop within {TRANSITION_WINDOW} frames", None)]
+    fig, axes = plt.subplots(len(panels), 1, figsize=(max(8, 1.3 * len(per_transition) + 3), 3.6 * len(panels)),
+                             squeeze=False)
+    for ax, (label, k) in zip(axes[:, 0], panels):
+        for i, m in enumerate(methods):
+            vals = [p[-1][m] if k is None else p[-1][m][k] for p in per_transition]
+            ax.bar(x - 0.4 + (i + 0.5) * width, vals, width, label=m)
+        ticks = [f"frames {p[0]}-{p[1]}" + (f"\n{p[2]}" if with_lodpop else "") for p in per_transition]
+        ax.set_xticks(x, ticks, rotation=20, fontsize=8)
+        ax.set_ylabel(label)
+    axes[0, 0].set_title(f"{scene}: popping per transition and method")
+    axes[0, 0].legend(fontsize=7, ncol=2)
     save(fig, path)
 
 
@@ -361,6 +397,7 @@ def markdown_table(rows, columns):
 def report(folder: Path, transition: str = "worst") -> list:
     frames = read_csv(folder / "frames.csv")
     summary = read_csv(folder / "summary.csv")
+    transitions_csv = read_csv(folder / "transitions.csv") if (folder / "transitions.csv").is_file() else None
     figs = folder / "figures"
     figs.mkdir(exist_ok=True)
     made = []
@@ -371,7 +408,7 @@ def report(folder: Path, transition: str = "worst") -> list:
     first_viewport = summary[0]["viewport"] if swept else None
     if variable and not swept:
         # Each value of the swept variable is its own series, in the figures and the tables.
-        for r in summary + frames:
+        for r in summary + frames + (transitions_csv or []):
             r["method"] = f"{r['method']} ({variable} {r[variable]})"
     for (scene,), all_viewports in group(summary, "scene").items():
         if swept:
@@ -392,7 +429,12 @@ def report(folder: Path, transition: str = "worst") -> list:
             made.append((f"sweep_{scene}.png", f"{scene}: rmse and pop per frame"))
             fig6(scene, [r for r in scene_summary if r["count"] == first_count], figs / f"fig6_{scene}.png")
             made.append((f"fig6_{scene}.png", f"{scene}: popping per method"))
-            per_transition = transition_pops(by_method)
+            if transitions_csv is not None:
+                scene_transitions = [r for r in transitions_csv
+                                     if not swept or r["viewport"] == first_viewport]
+                per_transition = transition_table(scene_transitions, scene)
+            else:
+                per_transition = transition_pops(by_method)
             if 0 < len(per_transition) <= 16:
                 transitions_figure(scene, per_transition, figs / f"transitions_{scene}.png")
                 made.append((f"transitions_{scene}.png", f"{scene}: popping per transition"))
@@ -407,13 +449,21 @@ def report(folder: Path, transition: str = "worst") -> list:
         made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
     columns = ([variable] if variable else []) + ["scene", "method", "count", "frames", "gpu_ms_median", "gpu_ms_median_ci95_lo",
                "gpu_ms_median_ci95_hi", "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
-               "de2000_mean"]
+               "de2000_mean"] + (["lodpop_max", "lodpop_sum"] if summary and "lodpop_max" in summary[0] else [])
     text = [f"# lodbench report: {folder.name}", "", "## Summary", "", markdown_table(summary, columns), ""]
     for scene, per_transition in tables:
-        methods = list(per_transition[0][2])
-        rows = [{"transition": f"frames {a}-{b}", **{m: f"{p[m]:.4f}" for m in methods}} for a, b, p in per_transition]
-        text += [f"## {scene}: max pop within {TRANSITION_WINDOW} frames of each transition", "",
-                 markdown_table(rows, ["transition"] + methods), ""]
+        methods = list(per_transition[0][-1])
+        if len(per_transition[0]) == 4:
+            for k, what in ((0, "max lodpop (pose held)"), (1, "max pop (motion included)")):
+                rows = [{"transition": f"frames {a}-{b} ({lods})", **{m: f"{p[m][k]:.4f}" for m in methods}}
+                        for a, b, lods, p in per_transition]
+                text += [f"## {scene}: {what} of each transition (its frames and the 2 after)", "",
+                         markdown_table(rows, ["transition"] + methods), ""]
+        else:
+            rows = [{"transition": f"frames {a}-{b}", **{m: f"{p[m]:.4f}" for m in methods}}
+                    for a, b, p in per_transition]
+            text += [f"## {scene}: max pop within {TRANSITION_WINDOW} frames of each transition", "",
+                     markdown_table(rows, ["transition"] + methods), ""]
     for name, caption in made:
         text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
     (folder / "report.md").write_text("\n".join(text))

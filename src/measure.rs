@@ -9,12 +9,13 @@
 //!   reduces their difference to scalars on the GPU; the scalars of all frames are read back once at the end.
 
 use crate::error::{Error, Result};
+use crate::gpu::diff::DiffKernel;
 use crate::gpu::metrics::MetricKernel;
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::{DrawStats, GpuContext, RenderTarget, SceneGpu, TextureReadback};
 use crate::methods::{Build, FrameInput, Method, MethodOptions, Registry};
 use crate::metrics::FrameMetrics;
-use crate::records::{BlockInfo, FrameRecord};
+use crate::records::{transitions, BlockInfo, FrameRecord, TransitionPair, TransitionRecord};
 use crate::scene::Scene;
 use crate::schedule::{InstanceState, LodSchedule};
 use glam::Mat4;
@@ -47,6 +48,8 @@ pub struct FrameDriver<'s> {
 pub struct FrameFacts {
     pub lod_mean: f64,
     pub t_instances: u32,
+    /// The LODs the t-instances go between.
+    pub pair: TransitionPair,
 }
 
 impl<'s> FrameDriver<'s> {
@@ -72,13 +75,17 @@ impl<'s> FrameDriver<'s> {
         self.distances.clear();
         let mut lod_sum = 0.0f64;
         let mut t = 0u32;
+        let mut pair = TransitionPair::None;
         let eye = self.scene.camera(frame).eye;
         for (i, inst) in self.scene.instances.iter().enumerate() {
             let d = self.scene.instance_position(i, frame).distance(eye);
             let switches = &self.scene.models[inst.model as usize].switches;
             let s = self.schedule.update(i, d, switches);
             lod_sum += s.lod_value() as f64;
-            t += s.in_transition() as u32;
+            if s.in_transition() {
+                t += 1;
+                pair = pair.with(s.lod_from, s.lod_to);
+            }
             self.states.push(s);
             self.distances.push(d);
             self.matrices.push(self.scene.instance_matrix(i, frame));
@@ -86,6 +93,7 @@ impl<'s> FrameDriver<'s> {
         FrameFacts {
             lod_mean: lod_sum / self.scene.instances.len().max(1) as f64,
             t_instances: t,
+            pair,
         }
     }
 
@@ -104,6 +112,7 @@ impl<'s> FrameDriver<'s> {
 /// One method's measurement on one scene block.
 pub struct BlockOutput {
     pub rows: Vec<FrameRecord>,
+    pub transitions: Vec<TransitionRecord>,
     pub info: BlockInfo,
 }
 
@@ -146,6 +155,9 @@ struct QualityPass {
     metrics: Vec<FrameMetrics>,
     /// `--metrics flip`: mean FLIP per frame.
     flip: Vec<Option<f64>>,
+    lodpop: Vec<f64>,
+    /// Methods with a lag (FSI): lag_rmse per frame.
+    lag: Option<Vec<f64>>,
     ms_per_frame: f64,
     metric_gpu_ms_median: Option<f64>,
 }
@@ -158,6 +170,13 @@ pub struct BlockRunner<'a> {
     timing_target: RenderTarget,
     method_target: RenderTarget,
     reference_target: RenderTarget,
+    /// lodpop's counterfactual frames: the frame without the method's lag (`now`) and with the previous
+    /// schedule (`before`), both at the current pose.
+    now_target: RenderTarget,
+    before_target: RenderTarget,
+    /// lodpop: pair 0 = (method, before), pair 1 = (now, before); lag: (method, now).
+    lodpop_kernel: DiffKernel,
+    lag_kernel: DiffKernel,
     reference: Box<dyn Method>,
     setup: MethodSetup,
     kernel: MetricKernel,
@@ -196,6 +215,19 @@ impl<'a> BlockRunner<'a> {
         let timing_target = RenderTarget::new(&ctx.device, "timing target", w, h);
         let method_target = RenderTarget::new(&ctx.device, "method target", w, h);
         let reference_target = RenderTarget::new(&ctx.device, "reference target", w, h);
+        let now_target = RenderTarget::new(&ctx.device, "lodpop now target", w, h);
+        let before_target = RenderTarget::new(&ctx.device, "lodpop before target", w, h);
+        let lodpop_kernel = DiffKernel::new(
+            ctx,
+            "lodpop",
+            &[
+                (&method_target, &before_target),
+                (&now_target, &before_target),
+            ],
+            scene.frames,
+        )?;
+        let lag_kernel =
+            DiffKernel::new(ctx, "lag", &[(&method_target, &now_target)], scene.frames)?;
         let reference = Registry::builtin().create("reference", &build(&gpu, scene, &setup))?;
         let kernel = MetricKernel::new(ctx, &method_target, &reference_target, scene.frames)?;
         let timer = GpuTimer::new(ctx, scene.frames);
@@ -214,6 +246,10 @@ impl<'a> BlockRunner<'a> {
             timing_target,
             method_target,
             reference_target,
+            now_target,
+            before_target,
+            lodpop_kernel,
+            lag_kernel,
             reference,
             setup,
             kernel,
@@ -270,15 +306,19 @@ impl<'a> BlockRunner<'a> {
                 lod_mean: timing.facts[f].lod_mean,
                 rmse: quality.metrics[f].rmse,
                 pop: quality.metrics[f].pop,
+                lodpop: quality.lodpop[f],
                 de2000_mean: quality.metrics[f].de2000,
                 flip_mean: quality.flip[f],
                 combine_gpu_ms: timing
                     .stage_ms
                     .as_ref()
                     .and_then(|s| s.get(f).copied().flatten()),
+                lag_rmse: quality.lag.as_ref().map(|l| l[f]),
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let pairs: Vec<TransitionPair> = timing.facts.iter().map(|f| f.pair).collect();
         Ok(BlockOutput {
+            transitions: transitions(&rows, &pairs),
             rows,
             info: BlockInfo {
                 scene: scene.name().to_string(),
@@ -401,6 +441,11 @@ impl<'a> BlockRunner<'a> {
         let frames = scene.frames;
         driver.reset();
         let mut flip = vec![None; frames as usize];
+        let mut has_lag = false;
+        // The states of the last frames, newest first (lodpop's schedule history).
+        let depth = method.lodpop_history().max(1);
+        let mut history: std::collections::VecDeque<Vec<InstanceState>> =
+            std::collections::VecDeque::with_capacity(depth + 1);
         let pass_start = Instant::now();
         let mut in_flight = std::collections::VecDeque::new();
         for f in 0..frames {
@@ -409,6 +454,10 @@ impl<'a> BlockRunner<'a> {
             self.gpu.write_camera(&scene.camera(f));
             let input = driver.input(f);
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            if f == 0 {
+                self.lodpop_kernel.clear(&mut encoder);
+                self.lag_kernel.clear(&mut encoder);
+            }
             self.reference
                 .encode(&self.gpu, &input, &mut encoder, &self.reference_target);
             method.encode(&self.gpu, &input, &mut encoder, &self.method_target);
@@ -431,7 +480,7 @@ impl<'a> BlockRunner<'a> {
                 _ => false,
             };
             // The method's intermediate images (FSI's LOD buffers), only for dumped frames.
-            let extras: Vec<(&str, TextureReadback)> = if dump {
+            let mut extras: Vec<(&str, TextureReadback)> = if dump {
                 method
                     .debug_targets()
                     .into_iter()
@@ -444,7 +493,52 @@ impl<'a> BlockRunner<'a> {
             } else {
                 Vec::new()
             };
-            let index = ctx.queue.submit([encoder.finish()]);
+            let mut index = ctx.queue.submit([encoder.finish()]);
+
+            // lodpop and lag: the counterfactual frames at this pose, in a submission of their own (the method
+            // writes its instance data again through the queue, which must not reach the frame above).
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            let unlagged =
+                method.encode_unlagged(&self.gpu, &input, &mut encoder, &self.now_target);
+            has_lag |= unlagged;
+            if unlagged {
+                self.lag_kernel.encode(&ctx.queue, &mut encoder, f, 0);
+            }
+            history.push_front(driver.states.clone());
+            history.truncate(depth + 1);
+            let changed = history.len() > 1
+                && (history.iter().skip(1).any(|h| *h != history[0])
+                    || (depth > 1 && history.iter().flatten().any(|s| s.in_transition())));
+            if changed {
+                let earlier: Vec<&[InstanceState]> =
+                    history.iter().skip(1).map(Vec::as_slice).collect();
+                method.encode_before(
+                    &self.gpu,
+                    &input,
+                    &earlier,
+                    &mut encoder,
+                    &self.before_target,
+                );
+                self.lodpop_kernel
+                    .encode(&ctx.queue, &mut encoder, f, unlagged as usize);
+            }
+            if dump {
+                for (name, show, target) in [
+                    ("lodpop-now", unlagged, &self.now_target),
+                    ("lodpop-before", changed, &self.before_target),
+                ] {
+                    if show {
+                        let rb =
+                            TextureReadback::color(&ctx.device, name, target.width, target.height);
+                        rb.encode_copy(&mut encoder, target);
+                        extras.push((name, rb));
+                    }
+                }
+            }
+            if unlagged || changed {
+                index = ctx.queue.submit([encoder.finish()]);
+            }
+
             if let (true, Some((m, r))) = (read, &self.readback) {
                 let method_rgba = m.read(ctx)?;
                 let reference_rgba = r.read(ctx)?;
@@ -481,6 +575,12 @@ impl<'a> BlockRunner<'a> {
         ctx.wait_idle()?;
         let ms_per_frame = pass_start.elapsed().as_secs_f64() * 1e3 / frames as f64;
         let metrics = self.kernel.read(ctx, frames)?;
+        let lodpop = self.lodpop_kernel.read(ctx, frames)?;
+        let lag = if has_lag {
+            Some(self.lag_kernel.read(ctx, frames)?)
+        } else {
+            None
+        };
         let metric_gpu_ms_median = match &self.metric_timer {
             Some(t) => {
                 let ms: Vec<f64> = t.read(ctx)?.into_iter().flatten().collect();
@@ -491,6 +591,8 @@ impl<'a> BlockRunner<'a> {
         Ok(QualityPass {
             metrics,
             flip,
+            lodpop,
+            lag,
             ms_per_frame,
             metric_gpu_ms_median,
         })

@@ -24,6 +24,24 @@ pub fn rmse_srgb(method: &[u8], reference: &[u8]) -> f64 {
     (sum / pixels as f64).sqrt()
 }
 
+/// Root mean square over pixels and R, G, B of `a - b` (encoded values in [0, 1]): lodpop, a method's frame
+/// against the same frame rendered with the previous frame's LOD schedule, and lag_rmse (the oracle of
+/// `shaders/diff.wgsl`).
+pub fn rms_difference(a: &[u8], b: &[u8]) -> f64 {
+    assert_eq!(a.len(), b.len(), "images of different sizes");
+    let pixels = a.len() / 4;
+    if pixels == 0 {
+        return 0.0;
+    }
+    let sum: f64 = a
+        .chunks_exact(4)
+        .zip(b.chunks_exact(4))
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] as f64 - q[c] as f64) / 255.0))
+        .map(|d| d * d)
+        .sum();
+    (sum / (3 * pixels) as f64).sqrt()
+}
+
 /// The signed per-channel error image E = method - reference (RGB, encoded values in [-1, 1]).
 pub fn error_image(method: &[u8], reference: &[u8]) -> Vec<f32> {
     assert_eq!(method.len(), reference.len(), "images of different sizes");
@@ -394,5 +412,15 @@ mod tests {
         let a = img(&[[255, 0, 0]]);
         let b = img(&[[0, 0, 0]]);
         assert!((difference_image(&a, &b)[0] - 1.0 / 3.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn rms_difference_over_pixels_and_channels() {
+        let a = [10u8, 20, 30, 255, 0, 0, 0, 255];
+        let b = [10u8, 20, 30, 0, 255, 0, 0, 0];
+        // One channel of one pixel differs by 1.0 (alpha ignored): sqrt(1 / 6).
+        assert!((rms_difference(&a, &b) - (1.0f64 / 6.0).sqrt()).abs() < 1e-12);
+        assert_eq!(rms_difference(&a, &a), 0.0);
+        assert_eq!(rms_difference(&[], &[]), 0.0);
     }
 }

@@ -25,12 +25,19 @@ pub struct FrameRecord {
     pub lod_mean: f64,
     pub rmse: f64,
     pub pop: f64,
+    /// RMS over pixels and channels of the method's frame minus the same frame rendered with the previous
+    /// frame's LOD schedule at this frame's pose (docs/measurement.md, "lodpop"); 0 where the schedule did not
+    /// change.
+    pub lodpop: f64,
     /// Mean CIEDE2000 over pixels between method and reference frame (sRGB D65 -> XYZ -> CIELAB).
     pub de2000_mean: f64,
     /// Mean FLIP error, with `--metrics ...,flip` (empty otherwise).
     pub flip_mean: Option<f64>,
     /// GPU time of FSI's combination pass within gpu_ms (empty for other methods or without timestamps).
     pub combine_gpu_ms: Option<f64>,
+    /// `fsi*` only: RMS of the method's frame minus the same combination with every LOD buffer drawn at this
+    /// frame's pose (its one-frame lag; 0 for fsi-sameframe).
+    pub lag_rmse: Option<f64>,
 }
 
 /// One row of summary.csv: one method on one scene block.
@@ -56,6 +63,10 @@ pub struct SummaryRecord {
     pub rmse_max: f64,
     pub pop_max: f64,
     pub pop_p95: f64,
+    /// Largest, 95th percentile and sum over frames of lodpop.
+    pub lodpop_max: f64,
+    pub lodpop_p95: f64,
+    pub lodpop_sum: f64,
     /// Mean over frames of de2000_mean, and its largest frame.
     pub de2000_mean: f64,
     pub de2000_max: f64,
@@ -67,6 +78,9 @@ pub struct SummaryRecord {
     pub tri_alternation_max: f64,
     /// Median GPU time of FSI's combination pass (empty for other methods).
     pub combine_gpu_ms_median: Option<f64>,
+    /// `fsi*` only: mean and largest lag_rmse.
+    pub lag_rmse_mean: Option<f64>,
+    pub lag_rmse_max: Option<f64>,
 }
 
 impl SummaryRecord {
@@ -77,6 +91,7 @@ impl SummaryRecord {
         seed: u64,
     ) -> Option<SummaryRecord> {
         let first = rows.first()?;
+        let lag: Option<Vec<f64>> = rows.iter().map(|r| r.lag_rmse).collect();
         let gpu: Vec<f64> = rows.iter().filter_map(|r| r.gpu_ms).collect();
         let cpu: Vec<f64> = rows.iter().map(|r| r.cpu_ms).collect();
         let pop: Vec<f64> = rows.iter().map(|r| r.pop).collect();
@@ -104,6 +119,10 @@ impl SummaryRecord {
             rmse_max: rows.iter().map(|r| r.rmse).fold(0.0, f64::max),
             pop_max: pop.iter().copied().fold(0.0, f64::max),
             pop_p95: percentile(&pop, 95.0).unwrap_or(0.0),
+            lodpop_max: rows.iter().map(|r| r.lodpop).fold(0.0, f64::max),
+            lodpop_p95: percentile(&rows.iter().map(|r| r.lodpop).collect::<Vec<_>>(), 95.0)
+                .unwrap_or(0.0),
+            lodpop_sum: rows.iter().map(|r| r.lodpop).sum(),
             de2000_mean: mean(rows.iter().map(|r| r.de2000_mean)),
             de2000_max: rows.iter().map(|r| r.de2000_mean).fold(0.0, f64::max),
             flip_mean: rows
@@ -120,6 +139,8 @@ impl SummaryRecord {
                     .collect::<Vec<_>>(),
                 50.0,
             ),
+            lag_rmse_mean: lag.as_ref().map(|v| mean(v.iter().copied())),
+            lag_rmse_max: lag.map(|v| v.into_iter().fold(0.0, f64::max)),
         })
     }
 }
@@ -140,6 +161,111 @@ pub fn tri_alternation_max(rows: &[FrameRecord]) -> f64 {
             }
         })
         .fold(0.0, f64::max)
+}
+
+/// Which LODs the instances in transition on one frame go between.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TransitionPair {
+    /// No instance in transition.
+    #[default]
+    None,
+    /// Every t-instance goes from the first LOD to the second.
+    One(u32, u32),
+    /// t-instances between different pairs of LODs.
+    Mixed,
+}
+
+impl TransitionPair {
+    /// The pair of a frame whose t-instances include one going `from` -> `to`.
+    pub fn with(self, from: u32, to: u32) -> TransitionPair {
+        match self {
+            TransitionPair::None => TransitionPair::One(from, to),
+            TransitionPair::One(a, b) if (a, b) == (from, to) => self,
+            _ => TransitionPair::Mixed,
+        }
+    }
+
+    fn text(self) -> String {
+        match self {
+            TransitionPair::None => String::new(),
+            TransitionPair::One(a, b) => format!("{a}->{b}"),
+            TransitionPair::Mixed => "mixed".into(),
+        }
+    }
+}
+
+/// Frames after a transition's last frame that still count as its own in transitions.csv: the frame after it
+/// shows the end state (a schedule change, so lodpop's) and, for FSI, the frame after that still combines a
+/// buffer from inside the transition.
+pub const TRANSITION_TAIL: u32 = 2;
+
+/// One row of transitions.csv: one transition of the path (a maximal run of frames with an instance in
+/// transition) for one method on one scene block, with its largest figures over the transition's frames and
+/// the [`TRANSITION_TAIL`] frames after it.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct TransitionRecord {
+    pub scene: String,
+    pub method: String,
+    pub count: u32,
+    /// 0-based index of the transition along the path.
+    pub transition: u32,
+    /// First and last frame with an instance in transition.
+    pub first_frame: u32,
+    pub last_frame: u32,
+    /// `lod_from->lod_to` of the t-instances (of the first frame's), or `mixed`.
+    pub lods: String,
+    pub lodpop_max: f64,
+    pub lodpop_max_frame: u32,
+    pub pop_max: f64,
+    pub pop_max_frame: u32,
+    pub rmse_max: f64,
+}
+
+/// The transitions of one block: `rows` its frame records in frame order, `pairs` each frame's pair.
+pub fn transitions(rows: &[FrameRecord], pairs: &[TransitionPair]) -> Vec<TransitionRecord> {
+    let mut out = Vec::new();
+    let mut f = 0;
+    while f < rows.len() {
+        if rows[f].t_instances == 0 {
+            f += 1;
+            continue;
+        }
+        let first = f;
+        while f < rows.len() && rows[f].t_instances > 0 {
+            f += 1;
+        }
+        let last = f - 1;
+        let window = &rows[first..(last + 1 + TRANSITION_TAIL as usize).min(rows.len())];
+        let argmax = |value: fn(&FrameRecord) -> f64| {
+            window
+                .iter()
+                .fold((0.0f64, window[0].frame), |(best, at), r| {
+                    if value(r) > best {
+                        (value(r), r.frame)
+                    } else {
+                        (best, at)
+                    }
+                })
+        };
+        let (lodpop_max, lodpop_max_frame) = argmax(|r| r.lodpop);
+        let (pop_max, pop_max_frame) = argmax(|r| r.pop);
+        let r0 = &rows[first];
+        out.push(TransitionRecord {
+            scene: r0.scene.clone(),
+            method: r0.method.clone(),
+            count: r0.count,
+            transition: out.len() as u32,
+            first_frame: r0.frame,
+            last_frame: rows[last].frame,
+            lods: pairs.get(first).copied().unwrap_or_default().text(),
+            lodpop_max,
+            lodpop_max_frame,
+            pop_max,
+            pop_max_frame,
+            rmse_max: argmax(|r| r.rmse).0,
+        });
+    }
+    out
 }
 
 /// Per (scene, count, method) block: sizes and the cost of the two passes.
@@ -188,9 +314,11 @@ pub(crate) mod tests {
             lod_mean: 0.0,
             rmse,
             pop,
+            lodpop: 0.0,
             de2000_mean: rmse / 2.0,
             flip_mean: None,
             combine_gpu_ms: None,
+            lag_rmse: None,
         }
     }
 
@@ -240,5 +368,38 @@ pub(crate) mod tests {
         // The intervals hold the statistic, and are the same for the same seed.
         assert!(s.rmse_mean_ci95_lo <= s.rmse_mean && s.rmse_mean <= s.rmse_mean_ci95_hi);
         assert_eq!(s, SummaryRecord::from_frames(&rows, 0, 7).unwrap());
+    }
+
+    #[test]
+    fn transitions_are_runs_of_frames_in_transition_with_a_tail() {
+        let t = [0u32, 1, 1, 0, 0, 0, 2, 0];
+        let rows: Vec<FrameRecord> = t
+            .iter()
+            .enumerate()
+            .map(|(f, &n)| FrameRecord {
+                t_instances: n,
+                lodpop: [0.0, 0.1, 0.3, 0.2, 0.0, 0.05, 0.4, 0.0][f],
+                ..row(f as u32, None, 0.01 * f as f64, 0.0)
+            })
+            .collect();
+        let pairs: Vec<TransitionPair> = t
+            .iter()
+            .map(|&n| match n {
+                0 => TransitionPair::None,
+                1 => TransitionPair::None.with(0, 1),
+                _ => TransitionPair::None.with(0, 1).with(1, 2),
+            })
+            .collect();
+        let tr = transitions(&rows, &pairs);
+        assert_eq!(tr.len(), 2);
+        assert_eq!((tr[0].first_frame, tr[0].last_frame), (1, 2));
+        assert_eq!(tr[0].lods, "0->1");
+        // Frames 1-4 (two after the last): the largest lodpop 0.3 at frame 2, rmse at frame 4.
+        assert_eq!((tr[0].lodpop_max, tr[0].lodpop_max_frame), (0.3, 2));
+        assert!((tr[0].rmse_max - 0.04).abs() < 1e-12);
+        assert_eq!((tr[1].first_frame, tr[1].lods.as_str()), (6, "mixed"));
+        // The tail is cut at the end of the path.
+        assert!((tr[1].rmse_max - 0.07).abs() < 1e-12);
+        assert!(transitions(&rows[..1], &pairs[..1]).is_empty());
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::config::RunConfig;
 use crate::error::{Error, Result};
-use crate::export::csv::{write_summary, FramesWriter};
+use crate::export::csv::{write_summary, write_transitions, FramesWriter};
 use crate::export::manifest::{now_rfc3339, RunManifest, RunStatus};
 use crate::export::png::FrameDumper;
 use crate::gpu::GpuContext;
@@ -47,7 +47,12 @@ pub fn prepare_output(dir: &Path) -> Result<()> {
     let probe = dir.join(".lodbench-write-test");
     std::fs::write(&probe, b"").map_err(|e| out_err(format!("is not writable ({e})")))?;
     let _ = std::fs::remove_file(&probe);
-    for stale in ["frames.csv", "summary.csv", "frames.csv.partial"] {
+    for stale in [
+        "frames.csv",
+        "summary.csv",
+        "transitions.csv",
+        "frames.csv.partial",
+    ] {
         let p = dir.join(stale);
         if p.exists() {
             std::fs::remove_file(&p).map_err(|e| Error::io(&p, e))?;
@@ -123,6 +128,7 @@ fn run_blocks(
     };
     let mut frames_csv = FramesWriter::create(out_dir)?;
     let mut summaries = Vec::new();
+    let mut transitions = Vec::new();
 
     let total: u64 = defs
         .iter()
@@ -176,6 +182,7 @@ fn run_blocks(
                     },
                 )?;
                 frames_csv.write_block(&out.rows)?;
+                transitions.extend(out.transitions);
                 // Each block's bootstrap has its own seed, derived from --seed and the block's position.
                 let block_seed = cfg.seed.wrapping_add(summaries.len() as u64 + 1);
                 let extra = out.info.extra_target_bytes;
@@ -190,13 +197,14 @@ fn run_blocks(
     progress.finish_and_clear();
     frames_csv.finish()?;
     write_summary(out_dir, &summaries)?;
+    write_transitions(out_dir, &transitions)?;
     Ok(summaries)
 }
 
 /// The table printed at the end of a run.
 pub fn summary_table(s: &RunSummary) -> String {
     let mut out = format!(
-        "{:<12} {:<13} {:>5} {:>6} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>7}\n",
+        "{:<12} {:<15} {:>5} {:>6} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>10} {:>7}\n",
         "scene",
         "method",
         "count",
@@ -207,6 +215,7 @@ pub fn summary_table(s: &RunSummary) -> String {
         "rmse",
         "rmse_max",
         "pop_max",
+        "lodpop_max",
         "q/t"
     );
     let fmt_opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.3}"));
@@ -217,7 +226,7 @@ pub fn summary_table(s: &RunSummary) -> String {
             .find(|b| b.scene == r.scene && b.method == r.method && b.count == r.count)
             .map_or(f64::NAN, |b| b.quality_to_timing_ratio);
         out.push_str(&format!(
-            "{:<12} {:<13} {:>5} {:>6} {:>9} {:>9.3} {:>10.0} {:>9.5} {:>9.5} {:>9.5} {:>7.2}\n",
+            "{:<12} {:<15} {:>5} {:>6} {:>9} {:>9.3} {:>10.0} {:>9.5} {:>9.5} {:>9.5} {:>10.5} {:>7.2}\n",
             r.scene,
             r.method,
             r.count,
@@ -228,6 +237,7 @@ pub fn summary_table(s: &RunSummary) -> String {
             r.rmse_mean,
             r.rmse_max,
             r.pop_max,
+            r.lodpop_max,
             ratio
         ));
     }

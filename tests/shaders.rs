@@ -67,6 +67,8 @@ fn entry_points_the_renderer_uses_exist() {
     }
     let metrics = entry_points(&validate(&dir.join("metrics.wgsl")));
     assert_eq!(metrics, vec!["main".to_string()]);
+    let diff = entry_points(&validate(&dir.join("diff.wgsl")));
+    assert_eq!(diff, vec!["main".to_string()]);
 }
 
 #[test]

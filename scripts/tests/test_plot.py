@@ -33,7 +33,8 @@ def test_sweep_folder(dump, tmp_path):
             assert im.width > 300 and im.height > 200
     assert "| bunny-sweep | dither |" in report
     assert "| bunny-sweep | fsi |" in report
-    assert "## bunny-sweep: max pop within 5 frames of each transition" in report
+    assert "## bunny-sweep: max lodpop (pose held) of each transition (its frames and the 2 after)" in report
+    assert "## bunny-sweep: max pop (motion included) of each transition (its frames and the 2 after)" in report
 
 
 def test_contact_sheet_transition_choice(dump, tmp_path):

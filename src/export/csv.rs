@@ -3,12 +3,13 @@
 //! an interrupted run keeps what it measured without leaving a file that looks complete.
 
 use crate::error::{Error, Result};
-use crate::records::{FrameRecord, SummaryRecord};
+use crate::records::{FrameRecord, SummaryRecord, TransitionRecord};
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
 pub const FRAMES_CSV: &str = "frames.csv";
 pub const SUMMARY_CSV: &str = "summary.csv";
+pub const TRANSITIONS_CSV: &str = "transitions.csv";
 pub const PARTIAL_SUFFIX: &str = ".partial";
 
 /// Appends frame rows to `frames.csv.partial`; `finish` renames it to `frames.csv`.
@@ -47,10 +48,10 @@ impl FramesWriter {
     }
 }
 
-/// Writes summary.csv (through a temporary file, so it appears whole or not at all).
-pub fn write_summary(dir: &Path, rows: &[SummaryRecord]) -> Result<PathBuf> {
-    let path = dir.join(SUMMARY_CSV);
-    let tmp = dir.join(format!("{SUMMARY_CSV}{PARTIAL_SUFFIX}"));
+/// Writes `rows` to `name` in `dir` through a temporary file, so it appears whole or not at all.
+fn write_whole<T: serde::Serialize>(dir: &Path, name: &str, rows: &[T]) -> Result<PathBuf> {
+    let path = dir.join(name);
+    let tmp = dir.join(format!("{name}{PARTIAL_SUFFIX}"));
     {
         let file = File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
         let mut w = ::csv::Writer::from_writer(file);
@@ -61,6 +62,16 @@ pub fn write_summary(dir: &Path, rows: &[SummaryRecord]) -> Result<PathBuf> {
     }
     std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, e))?;
     Ok(path)
+}
+
+/// Writes summary.csv (whole or not at all).
+pub fn write_summary(dir: &Path, rows: &[SummaryRecord]) -> Result<PathBuf> {
+    write_whole(dir, SUMMARY_CSV, rows)
+}
+
+/// Writes transitions.csv (whole or not at all).
+pub fn write_transitions(dir: &Path, rows: &[TransitionRecord]) -> Result<PathBuf> {
+    write_whole(dir, TRANSITIONS_CSV, rows)
 }
 
 #[cfg(test)]
@@ -76,7 +87,7 @@ mod tests {
         assert!(!dir.path().join(FRAMES_CSV).exists());
         let partial = std::fs::read_to_string(dir.path().join("frames.csv.partial")).unwrap();
         assert!(partial.starts_with(
-            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,t_instances,lod_mean,rmse,pop,de2000_mean,flip_mean,combine_gpu_ms\n"
+            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,t_instances,lod_mean,rmse,pop,lodpop,de2000_mean,flip_mean,combine_gpu_ms,lag_rmse\n"
         ));
         assert!(
             partial.contains("s,m,1,0,,2.0,100,1,0,0.0,0.5,0.0"),

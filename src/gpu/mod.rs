@@ -3,6 +3,7 @@
 //! the scene's data (`crate::scene`), never the methods, the configuration or the runner.
 
 pub mod context;
+pub mod diff;
 pub mod draw_list;
 pub mod instances;
 pub mod metrics;

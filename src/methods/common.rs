@@ -8,6 +8,7 @@ use crate::schedule::InstanceState;
 use glam::Mat4;
 
 /// What a method gets for one frame.
+#[derive(Clone, Copy)]
 pub struct FrameInput<'a> {
     pub frame: u32,
     pub scene: &'a Scene,
@@ -46,6 +47,49 @@ pub trait Method {
     /// Intermediate images worth seeing (`--dump-frames` writes them next to the frame): (name, target).
     fn debug_targets(&self) -> Vec<(&'static str, &RenderTarget)> {
         Vec::new()
+    }
+
+    /// lodpop's counterfactual (docs/measurement.md, "lodpop"): records into `before` the frame this method
+    /// would show at this frame's pose (`input`'s matrices, camera and animation) had the LOD schedule stayed
+    /// where it was `depth()` frames ago: `history[0]` holds the states of frame t-1, `history[1]` those of
+    /// t-2 (present when `lodpop_history` is 2). Called after `encode` of the same frame, in a submission of
+    /// its own, never in the timing pass. The default, right for a method whose frame is a function of this
+    /// frame's states and pose alone, draws the frame again with the states of t-1.
+    fn encode_before(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        history: &[&[InstanceState]],
+        encoder: &mut wgpu::CommandEncoder,
+        before: &RenderTarget,
+    ) {
+        let previous = FrameInput {
+            states: history[0],
+            timed: false,
+            ..*input
+        };
+        self.encode(gpu, &previous, encoder, before);
+    }
+
+    /// How many earlier frames' states this method's frame depends on (1 for a frame that is a function of the
+    /// current states; FSI's older LOD buffer makes it 2).
+    fn lodpop_history(&self) -> usize {
+        1
+    }
+
+    /// For a method whose frame lags the pose (FSI, whose older LOD buffer was rendered at the previous
+    /// frame's camera and instance transforms): records into `now` this frame as it would be with every
+    /// buffer rendered at this frame's pose, and returns true. lodpop then compares `now` with `before`, and
+    /// lag_rmse compares the method's own frame with `now`. The default (no lag) returns false and records
+    /// nothing: lodpop compares the method's frame with `before`.
+    fn encode_unlagged(
+        &mut self,
+        _gpu: &SceneGpu,
+        _input: &FrameInput<'_>,
+        _encoder: &mut wgpu::CommandEncoder,
+        _now: &RenderTarget,
+    ) -> bool {
+        false
     }
 }
 

@@ -245,6 +245,73 @@ impl LodBuffer {
     }
 }
 
+/// The combination pass's inputs: `buffers[newer]` as the newer LOD buffer, the other as the older.
+fn combine_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[LodBuffer; 2],
+    newer: usize,
+    uniform: &wgpu::Buffer,
+    combined_view: &wgpu::TextureView,
+) -> wgpu::BindGroup {
+    let (n, o) = (&buffers[newer], &buffers[1 - newer]);
+    let views = [
+        &n.target.color_bytes_view,
+        &n.target.depth_view,
+        &n.id_view,
+        &o.target.color_bytes_view,
+        &o.target.depth_view,
+        &o.id_view,
+    ];
+    let mut entries: Vec<wgpu::BindGroupEntry> = views
+        .into_iter()
+        .enumerate()
+        .map(|(binding, view)| wgpu::BindGroupEntry {
+            binding: binding as u32,
+            resource: wgpu::BindingResource::TextureView(view),
+        })
+        .collect();
+    entries.push(wgpu::BindGroupEntry {
+        binding: 6,
+        resource: uniform.as_entire_binding(),
+    });
+    entries.push(wgpu::BindGroupEntry {
+        binding: 7,
+        resource: wgpu::BindingResource::TextureView(combined_view),
+    });
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("fsi combine inputs"),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// How one LOD buffer drew one instance: enough to draw it again at another pose (lodpop's counterfactual).
+#[derive(Debug, Clone, Copy)]
+struct Choice {
+    pipeline: u8,
+    model: u32,
+    lod: u32,
+    params: [f32; 4],
+}
+
+/// The two LOD buffers' choices the combination of one quality-pass frame used: (newer, older).
+struct FrameChoices {
+    frame: u32,
+    newer: Vec<Choice>,
+    older: Vec<Choice>,
+}
+
+/// lodpop's scratch objects, made on first use (never in a timing-only use): two LOD buffers, their
+/// combination inputs with a same-pixel uniform, and instance room for four buffer renders in one submission.
+struct Scratch {
+    buffers: [LodBuffer; 2],
+    /// Holds the same-pixel uniform (kept alive by the bind group).
+    group: wgpu::BindGroup,
+    instances: InstanceBuffer,
+    lists: [DrawList; 4],
+}
+
 /// A t-instance's toggle: the frame its transition started (its phase 0; may be before the pass's first frame,
 /// see [`Fsi::encode`]), its (lod_from, lod_to), the LOD it started with.
 type Started = (i64, (u32, u32), u32);
@@ -281,6 +348,12 @@ pub struct Fsi {
     previous_k: Vec<Option<f32>>,
     margin: Vec<f32>,
     combine_timer: Option<GpuTimer>,
+    combine_layout: wgpu::BindGroupLayout,
+    combined_view: wgpu::TextureView,
+    /// What each LOD buffer drew last (per buffer), and the last two quality-pass frames' choices.
+    choices: [Vec<Choice>; 2],
+    recent: std::collections::VecDeque<FrameChoices>,
+    scratch: Option<Scratch>,
     /// Texture repeats per object-space unit, per model (1 / object-space radius).
     repeats_per_unit: Vec<f32>,
     id_format: wgpu::TextureFormat,
@@ -423,39 +496,24 @@ impl Fsi {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let combine_group = |newer: usize| {
-            let (n, o) = (&buffers[newer], &buffers[1 - newer]);
-            let views = [
-                &n.target.color_bytes_view,
-                &n.target.depth_view,
-                &n.id_view,
-                &o.target.color_bytes_view,
-                &o.target.depth_view,
-                &o.id_view,
-            ];
-            let mut entries: Vec<wgpu::BindGroupEntry> = views
-                .into_iter()
-                .enumerate()
-                .map(|(binding, view)| wgpu::BindGroupEntry {
-                    binding: binding as u32,
-                    resource: wgpu::BindingResource::TextureView(view),
-                })
-                .collect();
-            entries.push(wgpu::BindGroupEntry {
-                binding: 6,
-                resource: combine_uniform.as_entire_binding(),
-            });
-            entries.push(wgpu::BindGroupEntry {
-                binding: 7,
-                resource: wgpu::BindingResource::TextureView(&combined_view),
-            });
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("fsi combine inputs"),
-                layout: &combine_layout,
-                entries: &entries,
-            })
-        };
-        let combine_groups = [combine_group(0), combine_group(1)];
+        let combine_groups = [
+            combine_group(
+                device,
+                &combine_layout,
+                &buffers,
+                0,
+                &combine_uniform,
+                &combined_view,
+            ),
+            combine_group(
+                device,
+                &combine_layout,
+                &buffers,
+                1,
+                &combine_uniform,
+                &combined_view,
+            ),
+        ];
         Fsi {
             variant,
             forward_check: variant == Variant::Sequential && options.fsi_check == FsiCheck::Forward,
@@ -485,6 +543,11 @@ impl Fsi {
                 .map(|m| m.scale / m.radius.max(f32::MIN_POSITIVE))
                 .collect(),
             id_format: format,
+            combine_layout,
+            combined_view,
+            choices: [Vec::new(), Vec::new()],
+            recent: std::collections::VecDeque::new(),
+            scratch: None,
         }
     }
 
@@ -534,6 +597,8 @@ impl Fsi {
     fn prepare(&mut self, gpu: &SceneGpu, input: &FrameInput<'_>, slot: usize, toggle: Toggle) {
         let list = &mut self.lists[slot];
         list.clear();
+        let choices = &mut self.choices[slot];
+        choices.clear();
         for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
             if s.in_transition() {
                 let lod = match (toggle, self.started[i]) {
@@ -556,6 +621,12 @@ impl Fsi {
                     lod,
                     instance_raw_with(input, i, lod, params),
                 );
+                choices.push(Choice {
+                    pipeline: T_PIPELINE,
+                    model: inst.model,
+                    lod,
+                    params,
+                });
             } else {
                 let lod = s.lod_from;
                 let params = [0.0, 1.0, lod as f32, 0.0];
@@ -565,6 +636,12 @@ impl Fsi {
                     lod,
                     instance_raw_with(input, i, lod, params),
                 );
+                choices.push(Choice {
+                    pipeline: N_PIPELINE,
+                    model: inst.model,
+                    lod,
+                    params,
+                });
             }
         }
         list.build();
@@ -583,7 +660,26 @@ impl Fsi {
         buffer: usize,
         instances: u32,
     ) -> DrawStats {
-        let b = &self.buffers[buffer];
+        self.render_into(
+            gpu,
+            encoder,
+            &self.buffers[buffer],
+            &self.lists[slot],
+            &self.instances,
+            slot as u32 * instances,
+        )
+    }
+
+    /// Draws `list` (uploaded to `instances` from `first` on) into LOD buffer `b`, cleared first.
+    fn render_into(
+        &self,
+        gpu: &SceneGpu,
+        encoder: &mut wgpu::CommandEncoder,
+        b: &LodBuffer,
+        list: &DrawList,
+        instances: &InstanceBuffer,
+        first: u32,
+    ) -> DrawStats {
         let [r, g, bl] = crate::scene::BACKGROUND;
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("fsi LOD buffer pass"),
@@ -627,15 +723,125 @@ impl Fsi {
         pass.set_bind_group(1, &self.vis_group, &[]);
         gpu.draw(
             &mut pass,
-            &self.instances,
-            slot as u32 * instances,
-            &self.lists[slot],
+            instances,
+            first,
+            list,
             &[&self.n_pipeline, &self.t_pipeline],
         )
     }
 }
 
 impl Fsi {
+    /// The combination pass over the LOD buffers of `group`, into `target`.
+    fn combine(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        group: &wgpu::BindGroup,
+        target: &RenderTarget,
+    ) {
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("fsi combine pass"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.combine_pipeline);
+            pass.set_bind_group(0, group, &[]);
+            pass.dispatch_workgroups(target.width.div_ceil(8), target.height.div_ceil(8), 1);
+        }
+        // Same bytes, sRGB-tagged: copies between the two formats are plain copies.
+        encoder.copy_texture_to_texture(
+            self.combined.as_image_copy(),
+            target.color.as_image_copy(),
+            self.combined.size(),
+        );
+    }
+
+    /// The scratch objects of lodpop's counterfactuals, made on first use.
+    fn scratch(&mut self, gpu: &SceneGpu, scene: &Scene) -> &Scratch {
+        let (w, h) = (scene.width, scene.height);
+        let n = scene.instances.len() as u32;
+        let (device, layout, view, format) = (
+            &gpu.device,
+            &self.combine_layout,
+            &self.combined_view,
+            self.id_format,
+        );
+        self.scratch.get_or_insert_with(|| {
+            let buffers = [
+                LodBuffer::new(gpu, "fsi lodpop buffer 0", w, h, format),
+                LodBuffer::new(gpu, "fsi lodpop buffer 1", w, h, format),
+            ];
+            let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fsi lodpop combine uniform"),
+                size: std::mem::size_of::<CombineRaw>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            // Both buffers at one pose: no reprojection, no forward check (fsi-sameframe's combination).
+            let raw = CombineRaw {
+                reproject: Mat4::IDENTITY.to_cols_array_2d(),
+                forward: Mat4::IDENTITY.to_cols_array_2d(),
+                size_mode: [w as f32, h as f32, 1.0, 0.0],
+            };
+            gpu.queue
+                .write_buffer(&uniform, 0, bytemuck::bytes_of(&raw));
+            Scratch {
+                group: combine_group(device, layout, &buffers, 0, &uniform, view),
+                buffers,
+                instances: InstanceBuffer::new(device, "fsi lodpop instances", 4 * n),
+                lists: Default::default(),
+            }
+        })
+    }
+
+    /// Draws the combination that `choices` describes with both LOD buffers at `input`'s pose into `target`,
+    /// using scratch lists `2 * half` and `2 * half + 1`.
+    fn encode_at_pose(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        choices: (&[Choice], &[Choice]),
+        half: usize,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) {
+        self.scratch(gpu, input.scene);
+        let Some(mut scratch) = self.scratch.take() else {
+            return;
+        };
+        let n = input.scene.instances.len() as u32;
+        for (k, c) in [choices.0, choices.1].into_iter().enumerate() {
+            let slot = 2 * half + k;
+            let list = &mut scratch.lists[slot];
+            list.clear();
+            for (i, ch) in c.iter().enumerate() {
+                list.push(
+                    ch.pipeline,
+                    ch.model,
+                    ch.lod,
+                    instance_raw_with(input, i, ch.lod, ch.params),
+                );
+            }
+            list.build();
+            gpu.upload_at(&scratch.instances, slot as u32 * n, list);
+            self.render_into(
+                gpu,
+                encoder,
+                &scratch.buffers[k],
+                list,
+                &scratch.instances,
+                slot as u32 * n,
+            );
+        }
+        self.combine(encoder, &scratch.group, target);
+        self.scratch = Some(scratch);
+    }
+
+    /// The recorded choices of `frame`'s combination.
+    fn choices_of(&self, frame: u32) -> Option<&FrameChoices> {
+        self.recent.iter().find(|c| c.frame == frame)
+    }
+
     /// Reads both LOD buffers back (colour, depth, id), after the frames that wrote them were submitted.
     pub fn read_lod_buffers(&self, ctx: &GpuContext) -> Result<[LodBufferImage; 2]> {
         let read = |b: &LodBuffer| -> Result<LodBufferImage> {
@@ -720,6 +926,17 @@ impl Method for Fsi {
         self.prepare(gpu, input, newer, new_toggle);
         stats += self.render(gpu, encoder, newer, newer, n);
         self.previous = Some((f, camera));
+        if !input.timed {
+            // The quality pass keeps what the combination used, for lodpop's counterfactuals.
+            if self.recent.len() == 2 {
+                self.recent.pop_front();
+            }
+            self.recent.push_back(FrameChoices {
+                frame: f,
+                newer: self.choices[newer].clone(),
+                older: self.choices[1 - newer].clone(),
+            });
+        }
 
         let same_pixel = self.variant != Variant::Sequential;
         let raw = CombineRaw {
@@ -738,25 +955,50 @@ impl Method for Fsi {
         if let Some(t) = timer {
             t.begin(encoder, f);
         }
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("fsi combine pass"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.combine_pipeline);
-            pass.set_bind_group(0, &self.combine_groups[newer], &[]);
-            pass.dispatch_workgroups(target.width.div_ceil(8), target.height.div_ceil(8), 1);
-        }
-        // Same bytes, sRGB-tagged: copies between the two formats are plain copies.
-        encoder.copy_texture_to_texture(
-            self.combined.as_image_copy(),
-            target.color.as_image_copy(),
-            self.combined.size(),
-        );
+        self.combine(encoder, &self.combine_groups[newer], target);
         if let Some(t) = timer {
             t.end(encoder, f);
         }
         stats
+    }
+
+    /// X_t: this frame's combination with both LOD buffers drawn at this frame's pose (the newer buffer's
+    /// choices of t, the older buffer's of t-1): the frame without FSI's one-frame lag.
+    fn encode_unlagged(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        now: &RenderTarget,
+    ) -> bool {
+        let Some(c) = self.choices_of(input.frame) else {
+            return false;
+        };
+        let (newer, older) = (c.newer.clone(), c.older.clone());
+        self.encode_at_pose(gpu, input, (&newer, &older), 0, encoder, now);
+        true
+    }
+
+    /// X'_(t-1): frame t-1's combination (its newer buffer's choices of t-1, its older buffer's of t-2) with
+    /// both buffers drawn at this frame's pose. lodpop = RMS(X_t - X'_(t-1)).
+    fn encode_before(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        _history: &[&[InstanceState]],
+        encoder: &mut wgpu::CommandEncoder,
+        before: &RenderTarget,
+    ) {
+        let previous = input.frame.checked_sub(1).and_then(|p| self.choices_of(p));
+        let Some(c) = previous.or_else(|| self.choices_of(input.frame)) else {
+            return;
+        };
+        let (newer, older) = (c.newer.clone(), c.older.clone());
+        self.encode_at_pose(gpu, input, (&newer, &older), 1, encoder, before);
+    }
+
+    fn lodpop_history(&self) -> usize {
+        2
     }
 
     fn extra_target_bytes(&self) -> u64 {

@@ -1,0 +1,47 @@
+// The RMS difference of two frames, per frame slot, as an exact integer sum (the CPU twin is
+// metrics::rms_difference): lodbench's lodpop (a method's frame against the same frame rendered with the
+// previous frame's LOD schedule) and FSI's lag_rmse (its frame against the same combination without the lag).
+//
+// Both images are read through Rgba8Unorm views of the sRGB targets, i.e. as the stored sRGB-encoded bytes.
+// Per pixel, with d = a - b per channel: |d.r|^2 + |d.g|^2 + |d.b|^2 -> rms = sqrt(sum / (3 * 255^2 * pixels)).
+// One workgroup per row, 64 invocations, no barriers (as shaders/metrics.wgsl, for the same reasons); a run of at
+// most 8192 / 64 = 128 pixels keeps each partial sum below 2^32 (128 * 3 * 255^2).
+
+struct Params {
+    width: u32,
+    height: u32,
+    slot: u32,
+    pad: u32,
+};
+
+@group(0) @binding(0) var a_img: texture_2d<f32>;
+@group(0) @binding(1) var b_img: texture_2d<f32>;
+@group(0) @binding(2) var<storage, read_write> sums: array<atomic<u32>>;
+@group(0) @binding(3) var<uniform> params: Params;
+
+const LANES: u32 = 64u;
+
+fn to_bytes(v: vec4<f32>) -> vec3<i32> {
+    return vec3<i32>(round(clamp(v.rgb, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0));
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let y = gid.y;
+    if (y >= params.height) {
+        return;
+    }
+    var sum = 0u;
+    for (var x = gid.x; x < params.width; x = x + LANES) {
+        let p = vec2<i32>(i32(x), i32(y));
+        let d = to_bytes(textureLoad(a_img, p, 0)) - to_bytes(textureLoad(b_img, p, 0));
+        sum = sum + u32(d.x * d.x + d.y * d.y + d.z * d.z);
+    }
+    if (sum != 0u) {
+        let lo = params.slot * 2u;
+        let old = atomicAdd(&sums[lo], sum);
+        if (old + sum < old) {
+            atomicAdd(&sums[lo + 1u], 1u);
+        }
+    }
+}

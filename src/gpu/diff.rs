@@ -1,0 +1,153 @@
+//! The difference kernel of `shaders/diff.wgsl`: the RMS difference between two frames, per frame, as exact
+//! integer sums in one slot per frame, read back once at the end of a pass. It compares fixed pairs of targets
+//! (bound once); `encode` picks the pair.
+
+use crate::error::Result;
+use crate::gpu::context::GpuContext;
+use crate::gpu::targets::RenderTarget;
+
+pub const DIFF_WGSL: &str = include_str!("../../shaders/diff.wgsl");
+
+pub struct DiffKernel {
+    pipeline: wgpu::ComputePipeline,
+    bind_groups: Vec<wgpu::BindGroup>,
+    params: wgpu::Buffer,
+    sums: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    width: u32,
+    height: u32,
+    frames: u32,
+}
+
+impl DiffKernel {
+    /// Compares each pair `(a, b)` of `pairs` (all of one size), with a slot for each of up to `frames` frames.
+    pub fn new(
+        ctx: &GpuContext,
+        label: &str,
+        pairs: &[(&RenderTarget, &RenderTarget)],
+        frames: u32,
+    ) -> Result<DiffKernel> {
+        let device = &ctx.device;
+        let (width, height) = pairs.first().map_or((1, 1), |(a, _)| (a.width, a.height));
+        let frames = frames.max(1);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("diff.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(DIFF_WGSL.into()),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: None,
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let size = frames as u64 * 8;
+        let sums = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let layout = pipeline.get_bind_group_layout(0);
+        let bind_groups = pairs
+            .iter()
+            .map(|(a, b)| {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(label),
+                    layout: &layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::TextureView(&a.color_bytes_view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::TextureView(&b.color_bytes_view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: sums.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: params.as_entire_binding(),
+                        },
+                    ],
+                })
+            })
+            .collect();
+        ctx.check_errors()?;
+        Ok(DiffKernel {
+            pipeline,
+            bind_groups,
+            params,
+            sums,
+            readback,
+            width,
+            height,
+            frames,
+        })
+    }
+
+    /// Zeroes every slot (at the start of a pass): a frame whose slot is never written reads 0.
+    pub fn clear(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.sums, 0, None);
+    }
+
+    /// Records the difference of pair `pair` into `frame`'s slot. One call per submission: the slot travels
+    /// in a uniform written through the queue.
+    pub fn encode(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: u32,
+        pair: usize,
+    ) {
+        let slot = frame.min(self.frames - 1);
+        queue.write_buffer(
+            &self.params,
+            0,
+            bytemuck::cast_slice(&[self.width, self.height, slot, 0]),
+        );
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("diff pass"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_groups[pair], &[]);
+        pass.dispatch_workgroups(1, self.height, 1);
+    }
+
+    /// The RMS difference of frames `0..frames` (0 for a frame never encoded), after their submissions.
+    pub fn read(&self, ctx: &GpuContext, frames: u32) -> Result<Vec<f64>> {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.sums, 0, &self.readback, 0, None);
+        ctx.queue.submit([encoder.finish()]);
+        let pixels = self.width as f64 * self.height as f64;
+        let n = frames.min(self.frames) as usize;
+        ctx.read_buffer(&self.readback, |bytes| {
+            let words: &[u32] = bytemuck::cast_slice(bytes);
+            (0..n)
+                .map(|f| {
+                    let sum = words[2 * f] as u64 | (words[2 * f + 1] as u64) << 32;
+                    (sum as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt()
+                })
+                .collect()
+        })
+    }
+}

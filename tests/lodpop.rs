@@ -1,0 +1,215 @@
+//! lodpop, the popping score that holds the pose fixed (docs/measurement.md, "lodpop"), on the software
+//! adapter: (a) zero without transitions while pop is not; (b) discrete's only on its switch frames; (c) every
+//! smooth method below discrete at every transition of a bunny sweep; (d) the GPU kernel against the CPU
+//! oracle on dumped frames, for lodpop and FSI's lag_rmse; and fsi-sameframe, which has no lag, at lag 0.
+
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "a test or bench fails by panicking"
+)]
+
+use clap::Parser;
+use lodbench::cli::{Cli, Command};
+use lodbench::config::RunConfig;
+use std::collections::HashMap;
+use std::path::Path;
+
+type Rows = Vec<HashMap<String, String>>;
+
+fn run(out: &Path, args: &[&str]) -> Rows {
+    let mut argv = vec!["lodbench", "run", "--out", out.to_str().unwrap()];
+    argv.extend_from_slice(args);
+    let Command::Run(r) = Cli::try_parse_from(argv).unwrap().command else {
+        unreachable!()
+    };
+    lodbench::runner::run(&RunConfig::from_args(&r).unwrap()).unwrap();
+    read_csv(&out.join("frames.csv"))
+}
+
+fn read_csv(path: &Path) -> Rows {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let headers = r.headers().unwrap().clone();
+    r.records()
+        .map(|rec| {
+            let rec = rec.unwrap();
+            headers
+                .iter()
+                .zip(rec.iter())
+                .map(|(h, v)| (h.to_string(), v.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+fn col(rows: &Rows, method: &str, name: &str) -> Vec<f64> {
+    rows.iter()
+        .filter(|r| r["method"] == method)
+        .map(|r| r[name].parse::<f64>().unwrap())
+        .collect()
+}
+
+const METHODS: &str =
+    "discrete,alpha,alpha-2pass,alpha-zwrite,dither,geomorph,fsi,fsi-noreproject,fsi-sameframe";
+
+/// (a) Two bunnies that never change LOD (the near one at LOD0, the far one at LOD1) while the camera orbits
+/// the near one: every method's lodpop is exactly 0 on every frame, while pop is not (the far bunny's LOD1
+/// error moves on screen).
+#[rustfmt::skip]
+#[test]
+fn no_schedule_change_no_lodpop() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = run(
+        dir.path(),
+        &[
+            "--scene", "bunny-grid", "--count", "2", "--camera", "orbit", "--frames", "24", "--width",
+            "96", "--height", "72", "--method", METHODS,
+        ],
+    );
+    for m in METHODS.split(',') {
+        assert!(col(&rows, m, "t_instances").iter().all(|&t| t == 0.0), "{m}: a transition");
+        assert!(col(&rows, m, "lodpop").iter().all(|&x| x == 0.0), "{m}: lodpop not 0");
+        assert!(col(&rows, m, "pop").iter().any(|&x| x > 0.0), "{m}: pop all 0");
+    }
+}
+
+/// A small bunny sweep of every method, run once for (b) and (c).
+fn sweep(dir: &Path) -> Rows {
+    run(
+        dir,
+        &[
+            "--scene",
+            "bunny-sweep",
+            "--frames",
+            "400",
+            "--width",
+            "160",
+            "--height",
+            "120",
+            "--method",
+            METHODS,
+        ],
+    )
+}
+
+#[test]
+fn discrete_pops_only_at_its_switches_and_smooth_methods_pop_less() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = sweep(dir.path());
+
+    // (b) discrete's picture changes with the schedule only where its LOD switches, which is where its
+    // triangle count changes.
+    let tri = col(&rows, "discrete", "triangles");
+    let lodpop = col(&rows, "discrete", "lodpop");
+    let switches: Vec<usize> = (1..tri.len()).filter(|&f| tri[f] != tri[f - 1]).collect();
+    assert_eq!(
+        switches.len(),
+        6,
+        "three switches out, three back: {switches:?}"
+    );
+    for (f, &x) in lodpop.iter().enumerate() {
+        assert_eq!(x > 0.0, switches.contains(&f), "frame {f}: lodpop {x}");
+    }
+
+    // (c) Per transition, every smooth method's largest lodpop is below discrete's.
+    let transitions = read_csv(&dir.path().join("transitions.csv"));
+    let max_of = |m: &str, t: &str| -> f64 {
+        transitions
+            .iter()
+            .find(|r| r["method"] == m && r["transition"] == t)
+            .unwrap_or_else(|| panic!("{m} transition {t}"))["lodpop_max"]
+            .parse()
+            .unwrap()
+    };
+    let n = transitions
+        .iter()
+        .filter(|r| r["method"] == "discrete")
+        .count();
+    assert_eq!(n, 6, "six transitions on the path");
+    for t in 0..n {
+        let t = t.to_string();
+        let d = max_of("discrete", &t);
+        assert!(d > 0.0);
+        for m in METHODS.split(',').skip(1) {
+            let x = max_of(m, &t);
+            assert!(
+                x < d,
+                "transition {t}: {m} lodpop {x} not below discrete's {d}"
+            );
+        }
+    }
+}
+
+/// (d) The GPU's lodpop and lag_rmse against `metrics::rms_difference` on the dumped frames (the method's
+/// frame, or FSI's lag-free frame, against the frame with the previous schedule), to 1e-5; fsi-sameframe's lag
+/// is exactly 0, since its frame is its lag-free frame.
+#[test]
+fn gpu_lodpop_and_lag_match_the_cpu_oracle() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = run(
+        dir.path(),
+        &[
+            "--scene",
+            "bunny-sweep",
+            "--frames",
+            "120",
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--method",
+            "alpha,dither,fsi,fsi-sameframe",
+            "--dump-frames",
+            "--dump-transitions",
+        ],
+    );
+    let frames = dir.path().join("frames");
+    let load = |stem: &str, name: &str| -> Option<Vec<u8>> {
+        let p = frames.join(format!("{stem}_{name}.png"));
+        p.exists()
+            .then(|| image::open(&p).unwrap().to_rgba8().into_raw())
+    };
+    let (mut lodpop_checked, mut lag_checked) = (0, 0);
+    for r in &rows {
+        let stem = format!(
+            "bunny-sweep_{}_c1_f{:05}",
+            r["method"],
+            r["frame"].parse::<u32>().unwrap()
+        );
+        let Some(method) = load(&stem, "method") else {
+            continue;
+        };
+        let now = load(&stem, "lodpop-now");
+        if let Some(before) = load(&stem, "lodpop-before") {
+            let cpu = lodbench::metrics::rms_difference(now.as_ref().unwrap_or(&method), &before);
+            let gpu: f64 = r["lodpop"].parse().unwrap();
+            assert!(
+                (cpu - gpu).abs() < 1e-5,
+                "{stem}: lodpop gpu {gpu} cpu {cpu}"
+            );
+            lodpop_checked += 1;
+        }
+        if let Some(now) = &now {
+            let cpu = lodbench::metrics::rms_difference(&method, now);
+            let gpu: f64 = r["lag_rmse"].parse().unwrap();
+            assert!((cpu - gpu).abs() < 1e-5, "{stem}: lag gpu {gpu} cpu {cpu}");
+            lag_checked += 1;
+        }
+    }
+    assert!(
+        lodpop_checked >= 20,
+        "{lodpop_checked} lodpop frames checked"
+    );
+    assert!(lag_checked >= 10, "{lag_checked} lag frames checked");
+    assert!(col(&rows, "fsi-sameframe", "lag_rmse")
+        .iter()
+        .all(|&x| x == 0.0));
+    assert!(
+        col(&rows, "fsi", "lag_rmse").iter().any(|&x| x > 0.0),
+        "fsi shows no lag"
+    );
+    assert!(rows
+        .iter()
+        .filter(|r| r["method"] == "alpha")
+        .all(|r| r["lag_rmse"].is_empty()));
+}
