@@ -34,6 +34,21 @@ pub enum Command {
     Describe(DescribeArgs),
     /// Run a sweep described in a TOML file (scenes/experiments/) into one results folder.
     Experiment(ExperimentArgs),
+    /// Score each method's clip of each transition of a run (made with --dump-frames --dump-transitions)
+    /// against the reference's with ColorVideoVDP; writes perceptual.csv and compares with lodpop.
+    Perceptual(PerceptualArgs),
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct PerceptualArgs {
+    /// A results folder of `lodbench run ... --dump-frames --dump-transitions`.
+    pub dir: PathBuf,
+    /// ColorVideoVDP display model (standard_fhd: 24-inch 1920x1080 at 60 cm, 200 cd/m2; standard_4k, ...).
+    #[arg(long, default_value = "standard_fhd")]
+    pub display: String,
+    /// Frames per second the clips are shown at.
+    #[arg(long, default_value_t = 60.0)]
+    pub fps: f32,
 }
 
 #[derive(Debug, Clone, Args)]

@@ -33,6 +33,10 @@ pub enum Error {
     Json(#[from] serde_json::Error),
     #[error("PNG {}: {problem}", path.display())]
     Image { path: PathBuf, problem: String },
+    #[error("results folder {}: {problem}", path.display())]
+    Results { path: PathBuf, problem: String },
+    #[error("ColorVideoVDP: {0}")]
+    Perceptual(String),
     #[error("interrupted by signal")]
     Interrupted,
 }

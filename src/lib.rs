@@ -26,6 +26,7 @@ pub mod methods;
 pub mod metrics;
 pub mod morph;
 pub mod noise;
+pub mod perceptual;
 pub mod procgen;
 pub mod records;
 pub mod rng;

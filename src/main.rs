@@ -16,6 +16,7 @@ fn main() -> ExitCode {
         Command::List => list(),
         Command::Describe(args) => describe(&args),
         Command::Experiment(args) => experiment(&args),
+        Command::Perceptual(args) => perceptual(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -87,6 +88,23 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
         .unwrap_or_else(|| runner::default_out_dir(&[e.name.as_str()]));
     let folders = e.run(&out)?;
     println!("{} run(s) in {}", folders.len(), out.display());
+    Ok(())
+}
+
+fn perceptual(args: &lodbench::cli::PerceptualArgs) -> lodbench::Result<()> {
+    let settings = lodbench::perceptual::PerceptualSettings {
+        display: args.display.clone(),
+        fps: args.fps,
+    };
+    let records = lodbench::perceptual::check(&args.dir, &settings)?;
+    print!("{}", lodbench::perceptual::table(&records));
+    println!(
+        "{} clips scored; {}",
+        records.len(),
+        args.dir
+            .join(lodbench::perceptual::PERCEPTUAL_CSV)
+            .display()
+    );
     Ok(())
 }
 

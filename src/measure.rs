@@ -15,7 +15,9 @@ use crate::gpu::timing::GpuTimer;
 use crate::gpu::{DrawStats, GpuContext, RenderTarget, SceneGpu, TextureReadback};
 use crate::methods::{Build, FrameInput, Method, MethodOptions, Registry};
 use crate::metrics::FrameMetrics;
-use crate::records::{transitions, BlockInfo, FrameRecord, TransitionPair, TransitionRecord};
+use crate::records::{
+    near_transitions, transitions, BlockInfo, FrameRecord, TransitionPair, TransitionRecord,
+};
 use crate::scene::Scene;
 use crate::schedule::{InstanceState, LodSchedule};
 use glam::Mat4;
@@ -283,10 +285,12 @@ impl<'a> BlockRunner<'a> {
         let mut driver = FrameDriver::new(scene);
         self.warm_up(method.as_mut(), &mut driver, warmup, progress)?;
         let timing = self.timing_pass(method.as_mut(), &mut driver, progress)?;
+        let t_instances: Vec<u32> = timing.facts.iter().map(|f| f.t_instances).collect();
+        let near = near_transitions(&t_instances);
         let quality = self.quality_pass(
             method.as_mut(),
             &mut driver,
-            dump_every,
+            (dump_every, &near),
             progress,
             &mut on_frames,
         )?;
@@ -433,7 +437,7 @@ impl<'a> BlockRunner<'a> {
         &mut self,
         method: &mut dyn Method,
         driver: &mut FrameDriver<'_>,
-        dump_every: u32,
+        (dump_every, near_transition): (u32, &[bool]),
         progress: &ProgressBar,
         on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<QualityPass> {
@@ -450,7 +454,7 @@ impl<'a> BlockRunner<'a> {
         let mut in_flight = std::collections::VecDeque::new();
         for f in 0..frames {
             check_interrupt()?;
-            let facts = driver.advance(f);
+            driver.advance(f);
             self.gpu.write_camera(&scene.camera(f));
             let input = driver.input(f);
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -470,7 +474,7 @@ impl<'a> BlockRunner<'a> {
             }
             let dump = self.dump
                 && f % dump_every == 0
-                && (!self.dump_transitions_only || facts.t_instances > 0);
+                && (!self.dump_transitions_only || near_transition[f as usize]);
             let read = match &self.readback {
                 Some((m, r)) if dump || self.flip => {
                     m.encode_copy(&mut encoder, &self.method_target);

@@ -199,10 +199,27 @@ impl TransitionPair {
 /// buffer from inside the transition.
 pub const TRANSITION_TAIL: u32 = 2;
 
+/// Frames before a transition's first frame that `--dump-transitions` dumps too, so a clip of the transition
+/// (`lodbench perceptual`) starts from the picture before it.
+pub const TRANSITION_LEAD: u32 = 2;
+
+/// Per frame: whether it lies within [`TRANSITION_LEAD`] frames before or [`TRANSITION_TAIL`] frames after a
+/// frame with an instance in transition (the frames `--dump-transitions` dumps).
+pub fn near_transitions(t_instances: &[u32]) -> Vec<bool> {
+    let n = t_instances.len();
+    let mut near = vec![false; n];
+    for (f, _) in t_instances.iter().enumerate().filter(|(_, &t)| t > 0) {
+        let lo = f.saturating_sub(TRANSITION_LEAD as usize);
+        let hi = (f + TRANSITION_TAIL as usize).min(n.saturating_sub(1));
+        near[lo..=hi].fill(true);
+    }
+    near
+}
+
 /// One row of transitions.csv: one transition of the path (a maximal run of frames with an instance in
 /// transition) for one method on one scene block, with its largest figures over the transition's frames and
 /// the [`TRANSITION_TAIL`] frames after it.
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize, PartialEq)]
 pub struct TransitionRecord {
     pub scene: String,
     pub method: String,
@@ -401,5 +418,15 @@ pub(crate) mod tests {
         // The tail is cut at the end of the path.
         assert!((tr[1].rmse_max - 0.07).abs() < 1e-12);
         assert!(transitions(&rows[..1], &pairs[..1]).is_empty());
+    }
+
+    #[test]
+    fn near_transitions_adds_the_lead_and_the_tail() {
+        let near = near_transitions(&[0, 0, 0, 1, 0, 0, 0, 0, 1]);
+        assert_eq!(
+            near,
+            vec![false, true, true, true, true, true, true, true, true]
+        );
+        assert!(near_transitions(&[0, 0]).iter().all(|&x| !x));
     }
 }

@@ -1,0 +1,235 @@
+//! `lodbench perceptual RUN_DIR`: an independent perceptual check of the popping ranking. For each transition
+//! of a run (its transitions.csv), the dumped frames around it (`--dump-frames --dump-transitions`: the
+//! transition's frames, the 2 before and the 2 after) form a clip of each method and one of the reference; the
+//! clip's quality against the reference's is ColorVideoVDP's JOD (Mantiuk et al., SIGGRAPH 2024; 10 = no
+//! visible difference, lower is worse), computed by the pure-Rust port `colorvideovdp` (validated by its
+//! authors against the PyTorch reference to 3e-6 JOD). It reads only the PNGs, not lodbench's numbers, and
+//! writes `perceptual.csv` beside them with each transition's lodpop for comparison.
+
+use crate::error::{Error, Result};
+use crate::export::png::FrameDumper;
+use crate::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use colorvideovdp::{Color, Cvvdp, DisplayModel, Execution, Image, Options};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+pub const PERCEPTUAL_CSV: &str = "perceptual.csv";
+
+/// One row of perceptual.csv: one method's clip of one transition.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct PerceptualRecord {
+    pub scene: String,
+    pub method: String,
+    pub count: u32,
+    pub transition: u32,
+    /// The clip: frames `clip_first..=clip_last`.
+    pub clip_first: u32,
+    pub clip_last: u32,
+    /// ColorVideoVDP's JOD of the method's clip against the reference's (10 = no visible difference).
+    pub jod: f64,
+    /// From transitions.csv, for comparison.
+    pub lodpop_max: f64,
+    pub pop_max: f64,
+}
+
+/// The settings of the check.
+#[derive(Debug, Clone)]
+pub struct PerceptualSettings {
+    /// A display model of ColorVideoVDP (`standard_fhd`: a 24-inch 1920x1080 monitor at 60 cm, 200 cd/m2).
+    pub display: String,
+    /// Frames per second the clips are shown at.
+    pub fps: f32,
+}
+
+fn results_error(dir: &Path, problem: impl Into<String>) -> Error {
+    Error::Results {
+        path: dir.to_path_buf(),
+        problem: problem.into(),
+    }
+}
+
+/// A dumped PNG as ColorVideoVDP's input: interleaved RGB, the stored sRGB-encoded values in [0, 1].
+fn load(path: &Path) -> Result<Image> {
+    let img = image::open(path)
+        .map_err(|e| Error::Image {
+            path: path.to_path_buf(),
+            problem: e.to_string(),
+        })?
+        .to_rgb8();
+    let (w, h) = img.dimensions();
+    let data = img
+        .into_raw()
+        .into_iter()
+        .map(|b| b as f32 / 255.0)
+        .collect();
+    Image::new(w as usize, h as usize, 3, data).map_err(|e| Error::Perceptual(e.to_string()))
+}
+
+/// Scores every method's clip of every transition in `dir` and writes `dir/perceptual.csv`.
+pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<PerceptualRecord>> {
+    let transitions_csv = dir.join("transitions.csv");
+    if !transitions_csv.is_file() {
+        return Err(results_error(
+            dir,
+            "has no transitions.csv (a complete lodbench run, made with this version?)",
+        ));
+    }
+    let frames_dir = dir.join("frames");
+    if !frames_dir.is_dir() {
+        return Err(results_error(
+            dir,
+            "has no frames/: run with --dump-frames --dump-transitions",
+        ));
+    }
+    let mut reader = csv::Reader::from_path(&transitions_csv)?;
+    let transitions = reader
+        .deserialize::<TransitionRecord>()
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let display = DisplayModel::from_name(&settings.display).map_err(|e| {
+        let names = DisplayModel::names().unwrap_or_default().join(", ");
+        Error::Perceptual(format!(
+            "display {}: {e} (the displays: {names})",
+            settings.display
+        ))
+    })?;
+    let metric = Cvvdp::new(
+        display,
+        Options::default().with_execution(Execution::Parallel),
+    )
+    .map_err(|e| Error::Perceptual(e.to_string()))?;
+    // The last frame of each block, so the clip stops at the end of the path.
+    let last_frame = |t: &TransitionRecord| -> u32 {
+        transitions
+            .iter()
+            .filter(|o| o.scene == t.scene && o.count == t.count)
+            .map(|o| o.last_frame + TRANSITION_TAIL)
+            .max()
+            .unwrap_or(t.last_frame)
+    };
+    let path_of = |t: &TransitionRecord, method: &str, f: u32, kind: &str| -> PathBuf {
+        frames_dir.join(format!(
+            "{}_{kind}.png",
+            FrameDumper::stem(&t.scene, method, t.count, f)
+        ))
+    };
+    let mut out = Vec::new();
+    for t in transitions.iter().filter(|t| t.method != "reference") {
+        let first = t.first_frame.saturating_sub(TRANSITION_LEAD);
+        let mut last = (t.last_frame + TRANSITION_TAIL).min(last_frame(t));
+        // The path may end inside the tail: keep the frames that were dumped at the end.
+        while last > t.last_frame && !path_of(t, &t.method, last, "method").is_file() {
+            last -= 1;
+        }
+        let mut test = Vec::new();
+        let mut reference = Vec::new();
+        for f in first..=last {
+            let m = path_of(t, &t.method, f, "method");
+            if !m.is_file() {
+                return Err(results_error(
+                    dir,
+                    format!(
+                        "{} is missing: the clip of transition {} needs every frame from {first} to {last} \
+                         (run with --dump-frames --dump-transitions and --dump-every 1)",
+                        m.display(),
+                        t.transition
+                    ),
+                ));
+            }
+            test.push(load(&m)?);
+            reference.push(load(&path_of(t, &t.method, f, "reference"))?);
+        }
+        let p = metric
+            .predict_video(&test, &reference, settings.fps, Color::Srgb)
+            .map_err(|e| Error::Perceptual(e.to_string()))?;
+        out.push(PerceptualRecord {
+            scene: t.scene.clone(),
+            method: t.method.clone(),
+            count: t.count,
+            transition: t.transition,
+            clip_first: first,
+            clip_last: last,
+            jod: p.jod as f64,
+            lodpop_max: t.lodpop_max,
+            pop_max: t.pop_max,
+        });
+    }
+    let path = dir.join(PERCEPTUAL_CSV);
+    let mut w = csv::Writer::from_path(&path)?;
+    for r in &out {
+        w.serialize(r)?;
+    }
+    w.flush().map_err(|e| Error::io(&path, e))?;
+    Ok(out)
+}
+
+/// Kendall's tau-b between two scores of the same items (1: the same order, -1: reversed; ties count for
+/// neither); None for fewer than two items or no untied pair.
+pub fn kendall_tau(a: &[f64], b: &[f64]) -> Option<f64> {
+    let n = a.len().min(b.len());
+    let (mut concordant, mut discordant, mut ties_a, mut ties_b) = (0.0f64, 0.0, 0.0, 0.0);
+    for i in 0..n {
+        for j in i + 1..n {
+            let (da, db) = (a[i] - a[j], b[i] - b[j]);
+            match (da == 0.0, db == 0.0) {
+                (true, true) => {}
+                (true, false) => ties_a += 1.0,
+                (false, true) => ties_b += 1.0,
+                _ if da.signum() == db.signum() => concordant += 1.0,
+                _ => discordant += 1.0,
+            }
+        }
+    }
+    let denominator = (concordant + discordant + ties_a) * (concordant + discordant + ties_b);
+    (denominator > 0.0).then(|| (concordant - discordant) / denominator.sqrt())
+}
+
+/// The table `lodbench perceptual` prints: per transition, each method's JOD and lodpop, and Kendall's tau
+/// between the ranking by JOD (higher is better) and by lodpop (lower is better).
+pub fn table(records: &[PerceptualRecord]) -> String {
+    let mut out = String::new();
+    let mut keys: Vec<(String, u32, u32)> = Vec::new();
+    for r in records {
+        let k = (r.scene.clone(), r.count, r.transition);
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    for (scene, count, transition) in keys {
+        let rows: Vec<&PerceptualRecord> = records
+            .iter()
+            .filter(|r| r.scene == scene && r.count == count && r.transition == transition)
+            .collect();
+        let jod: Vec<f64> = rows.iter().map(|r| r.jod).collect();
+        let lodpop: Vec<f64> = rows.iter().map(|r| -r.lodpop_max).collect();
+        let tau = kendall_tau(&jod, &lodpop).map_or("-".into(), |t| format!("{t:.2}"));
+        out.push_str(&format!(
+            "{scene} n={count} transition {transition} (frames {}-{}): Kendall tau(JOD, -lodpop) = {tau}\n",
+            rows[0].clip_first, rows[0].clip_last
+        ));
+        for r in rows {
+            out.push_str(&format!(
+                "  {:<16} JOD {:>7.4}  lodpop_max {:.5}  pop_max {:.5}\n",
+                r.method, r.jod, r.lodpop_max, r.pop_max
+            ));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kendall_tau_of_orders() {
+        assert_eq!(
+            kendall_tau(&[1.0, 2.0, 3.0], &[10.0, 20.0, 30.0]),
+            Some(1.0)
+        );
+        assert_eq!(kendall_tau(&[1.0, 2.0, 3.0], &[3.0, 2.0, 1.0]), Some(-1.0));
+        let t = kendall_tau(&[1.0, 2.0, 3.0, 4.0], &[1.0, 3.0, 2.0, 4.0]).unwrap();
+        assert!((t - 4.0 / 6.0).abs() < 1e-12);
+        assert_eq!(kendall_tau(&[1.0], &[1.0]), None);
+        assert_eq!(kendall_tau(&[1.0, 1.0], &[2.0, 2.0]), None);
+    }
+}
