@@ -426,7 +426,7 @@ def report(folder: Path, transition: str = "worst") -> list:
             by_method = group([r for r in scene_frames if r["count"] == first_count], "method")
             sweep_figure(scene, OrderedDict((m, rs) for (m,), rs in by_method.items()),
                          figs / f"sweep_{scene}.png")
-            made.append((f"sweep_{scene}.png", f"{scene}: rmse and pop per frame"))
+            made.append((f"sweep_{scene}.png", f"{scene}: rmse, pop" + (" and lodpop" if "lodpop" in scene_frames[0] else "") + " per frame"))
             fig6(scene, [r for r in scene_summary if r["count"] == first_count], figs / f"fig6_{scene}.png")
             made.append((f"fig6_{scene}.png", f"{scene}: popping per method"))
             if transitions_csv is not None:
