@@ -11,6 +11,10 @@
     reason = "a test or bench fails by panicking"
 )]
 
+mod common;
+
+use common::{read_csv, Row};
+
 use clap::Parser;
 use lodbench::cli::{Cli, Command};
 use lodbench::config::RunConfig;
@@ -25,23 +29,6 @@ use std::sync::OnceLock;
 const COLUMNS: [&str; 4] = ["rmse_mean", "rmse_max", "pop_max", "pop_p95"];
 const REL: f64 = 0.01;
 const ABS: f64 = 2e-6;
-
-type Row = HashMap<String, String>;
-
-fn read_csv(path: &Path) -> Vec<Row> {
-    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let headers = r.headers().unwrap().clone();
-    r.records()
-        .map(|rec| {
-            let rec = rec.unwrap();
-            headers
-                .iter()
-                .zip(rec.iter())
-                .map(|(h, v)| (h.to_string(), v.to_string()))
-                .collect()
-        })
-        .collect()
-}
 
 /// The run's output folder, made once per test binary.
 fn ci_run() -> &'static PathBuf {

@@ -9,13 +9,14 @@
     reason = "a test or bench fails by panicking"
 )]
 
+mod common;
+
+use common::{col, read_csv, Rows};
+
 use clap::Parser;
 use lodbench::cli::{Cli, Command};
 use lodbench::config::RunConfig;
-use std::collections::HashMap;
 use std::path::Path;
-
-type Rows = Vec<HashMap<String, String>>;
 
 fn run(out: &Path, args: &[&str]) -> Rows {
     let mut argv = vec!["lodbench", "run", "--out", out.to_str().unwrap()];
@@ -25,28 +26,6 @@ fn run(out: &Path, args: &[&str]) -> Rows {
     };
     lodbench::runner::run(&RunConfig::from_args(&r).unwrap()).unwrap();
     read_csv(&out.join("frames.csv"))
-}
-
-fn read_csv(path: &Path) -> Rows {
-    let mut r = csv::Reader::from_path(path).unwrap();
-    let headers = r.headers().unwrap().clone();
-    r.records()
-        .map(|rec| {
-            let rec = rec.unwrap();
-            headers
-                .iter()
-                .zip(rec.iter())
-                .map(|(h, v)| (h.to_string(), v.to_string()))
-                .collect()
-        })
-        .collect()
-}
-
-fn col(rows: &Rows, method: &str, name: &str) -> Vec<f64> {
-    rows.iter()
-        .filter(|r| r["method"] == method)
-        .map(|r| r[name].parse::<f64>().unwrap())
-        .collect()
 }
 
 const METHODS: &str =

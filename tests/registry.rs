@@ -9,6 +9,10 @@
     reason = "a test or bench fails by panicking"
 )]
 
+mod common;
+
+use common::read_csv;
+
 use clap::Parser;
 use lodbench::cli::{Cli, Command};
 use lodbench::config::RunConfig;
@@ -47,21 +51,6 @@ impl Method for LodTo {
 fn registry_with_lod_to() -> Registry {
     // The one registry line.
     Registry::builtin().with(MethodEntry { name: "lod-to", about: "switch at k = 0", create: |b| Ok(Box::new(LodTo::new(b.gpu, b.scene))), options: |_| None }).unwrap()
-}
-
-fn read_csv(path: &std::path::Path) -> Vec<HashMap<String, String>> {
-    let mut r = csv::Reader::from_path(path).unwrap();
-    let headers = r.headers().unwrap().clone();
-    r.records()
-        .map(|rec| {
-            let rec = rec.unwrap();
-            headers
-                .iter()
-                .zip(rec.iter())
-                .map(|(h, v)| (h.to_string(), v.to_string()))
-                .collect()
-        })
-        .collect()
 }
 
 #[test]

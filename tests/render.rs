@@ -6,6 +6,10 @@
     reason = "a test or bench fails by panicking"
 )]
 
+mod common;
+
+use common::{col, read_csv};
+
 use clap::Parser;
 use indicatif::ProgressBar;
 use lodbench::cli::{Cli, Command};
@@ -15,7 +19,6 @@ use lodbench::measure::BlockRunner;
 use lodbench::metrics::SequenceMetrics;
 use lodbench::runner;
 use lodbench::scene::{SceneConfig, SceneDef, SceneKind};
-use std::collections::HashMap;
 use std::path::Path;
 
 fn run_config(args: &[&str]) -> RunConfig {
@@ -39,34 +42,6 @@ fn scene_from(args: &[&str]) -> lodbench::scene::Scene {
     SceneDef::new(SceneKind::BunnySweep, &cfg)
         .unwrap()
         .instantiate(1)
-}
-
-type Rows = Vec<HashMap<String, String>>;
-
-fn read_csv(path: &Path) -> Rows {
-    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let headers = r.headers().unwrap().clone();
-    r.records()
-        .map(|rec| {
-            let rec = rec.unwrap();
-            headers
-                .iter()
-                .zip(rec.iter())
-                .map(|(h, v)| (h.to_string(), v.to_string()))
-                .collect()
-        })
-        .collect()
-}
-
-fn col(rows: &Rows, method: &str, name: &str) -> Vec<f64> {
-    rows.iter()
-        .filter(|r| r["method"] == method)
-        .map(|r| {
-            r[name]
-                .parse::<f64>()
-                .unwrap_or_else(|_| panic!("{name}={}", r[name]))
-        })
-        .collect()
 }
 
 /// Issue 2's "done means", on the ci profile: the three files; reference rows score 0; discrete scores 0 while

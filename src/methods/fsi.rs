@@ -295,6 +295,20 @@ struct Choice {
     params: [f32; 4],
 }
 
+/// Fills and builds `list` with instance i drawn as `choices[i]` at `input`'s pose.
+fn fill_list(list: &mut DrawList, input: &FrameInput<'_>, choices: &[Choice]) {
+    list.clear();
+    for (i, c) in choices.iter().enumerate() {
+        list.push(
+            c.pipeline,
+            c.model,
+            c.lod,
+            instance_raw_with(input, i, c.lod, c.params),
+        );
+    }
+    list.build();
+}
+
 /// The two LOD buffers' choices the combination of one quality-pass frame used: (newer, older).
 struct FrameChoices {
     frame: u32,
@@ -496,24 +510,16 @@ impl Fsi {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let combine_groups = [
+        let combine_groups = [0, 1].map(|newer| {
             combine_group(
                 device,
                 &combine_layout,
                 &buffers,
-                0,
+                newer,
                 &combine_uniform,
                 &combined_view,
-            ),
-            combine_group(
-                device,
-                &combine_layout,
-                &buffers,
-                1,
-                &combine_uniform,
-                &combined_view,
-            ),
-        ];
+            )
+        });
         Fsi {
             variant,
             forward_check: variant == Variant::Sequential && options.fsi_check == FsiCheck::Forward,
@@ -595,12 +601,10 @@ impl Fsi {
     /// Fills list `slot` with the scene as LOD buffer `parity` shows it and uploads it to its half of the
     /// instance buffer.
     fn prepare(&mut self, gpu: &SceneGpu, input: &FrameInput<'_>, slot: usize, toggle: Toggle) {
-        let list = &mut self.lists[slot];
-        list.clear();
         let choices = &mut self.choices[slot];
         choices.clear();
         for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            if s.in_transition() {
+            choices.push(if s.in_transition() {
                 let lod = match (toggle, self.started[i]) {
                     (Toggle::Buffer(0), _) => s.lod_from,
                     (Toggle::Buffer(_), _) => s.lod_to,
@@ -609,46 +613,32 @@ impl Fsi {
                     }
                     (Toggle::AtFrame(_), None) => first_lod(s),
                 };
-                let params = [
-                    self.repeats_per_unit[inst.model as usize],
-                    tau_with_margin(s, lod, self.margin[i]),
-                    lod as f32,
-                    (i + 1) as f32,
-                ];
-                list.push(
-                    T_PIPELINE,
-                    inst.model,
-                    lod,
-                    instance_raw_with(input, i, lod, params),
-                );
-                choices.push(Choice {
+                Choice {
                     pipeline: T_PIPELINE,
                     model: inst.model,
                     lod,
-                    params,
-                });
+                    params: [
+                        self.repeats_per_unit[inst.model as usize],
+                        tau_with_margin(s, lod, self.margin[i]),
+                        lod as f32,
+                        (i + 1) as f32,
+                    ],
+                }
             } else {
                 let lod = s.lod_from;
-                let params = [0.0, 1.0, lod as f32, 0.0];
-                list.push(
-                    N_PIPELINE,
-                    inst.model,
-                    lod,
-                    instance_raw_with(input, i, lod, params),
-                );
-                choices.push(Choice {
+                Choice {
                     pipeline: N_PIPELINE,
                     model: inst.model,
                     lod,
-                    params,
-                });
-            }
+                    params: [0.0, 1.0, lod as f32, 0.0],
+                }
+            });
         }
-        list.build();
+        fill_list(&mut self.lists[slot], input, choices);
         gpu.upload_at(
             &self.instances,
             slot as u32 * input.scene.instances.len() as u32,
-            list,
+            &self.lists[slot],
         );
     }
 
@@ -813,16 +803,7 @@ impl Fsi {
         for (k, c) in [choices.0, choices.1].into_iter().enumerate() {
             let slot = 2 * half + k;
             let list = &mut scratch.lists[slot];
-            list.clear();
-            for (i, ch) in c.iter().enumerate() {
-                list.push(
-                    ch.pipeline,
-                    ch.model,
-                    ch.lod,
-                    instance_raw_with(input, i, ch.lod, ch.params),
-                );
-            }
-            list.build();
+            fill_list(list, input, c);
             gpu.upload_at(&scratch.instances, slot as u32 * n, list);
             self.render_into(
                 gpu,
