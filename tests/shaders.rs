@@ -59,6 +59,9 @@ fn entry_points_the_renderer_uses_exist() {
         "fs_translucent",
         "fs_translucent_occluded",
         "fs_dither",
+        "fs_depth_masked",
+        "fs_fsi_n",
+        "fs_fsi_t",
     ] {
         assert!(
             mesh.contains(&e.to_string()),
@@ -67,6 +70,8 @@ fn entry_points_the_renderer_uses_exist() {
     }
     let metrics = entry_points(&validate(&dir.join("metrics.wgsl")));
     assert_eq!(metrics, vec!["main".to_string()]);
+    let combine = entry_points(&validate(&dir.join("fsi_combine.wgsl")));
+    assert!(combine.contains(&"cs_combine".to_string()), "{combine:?}");
     let diff = entry_points(&validate(&dir.join("diff.wgsl")));
     assert_eq!(diff, vec!["main".to_string()]);
 }
