@@ -136,7 +136,8 @@ fn ci_sweep_reference_and_discrete() {
     assert_eq!(pop_max, pop[argmax]);
 }
 
-/// The same flags twice give identical rmse and pop columns (and everything else that is not a time).
+/// The same flags twice give identical quality columns (and everything else that is not a time), for every
+/// method: the frame-sequential ones (fsi*) and the noise-driven one (dither) included.
 #[test]
 fn same_flags_same_metrics() {
     let dir = tempfile::tempdir().unwrap();
@@ -145,12 +146,12 @@ fn same_flags_same_metrics() {
         let cfg = run_config(&[
             "--scene",
             "bunny-sweep",
-            "--method",
-            "discrete",
-            "--profile",
-            "ci",
+            "--width",
+            "160",
+            "--height",
+            "120",
             "--frames",
-            "240",
+            "120",
             "--out",
             out.to_str().unwrap(),
         ]);
@@ -159,17 +160,33 @@ fn same_flags_same_metrics() {
     };
     let a = run_once("a");
     let b = run_once("b");
-    for name in [
-        "rmse",
-        "pop",
-        "de2000_mean",
-        "triangles",
-        "draw_calls",
-        "t_instances",
-        "lod_mean",
-    ] {
-        let (x, y) = (col(&a, "discrete", name), col(&b, "discrete", name));
-        assert_eq!(x, y, "column {name} differs between identical runs");
+    for method in lodbench::methods::names() {
+        for name in [
+            "rmse",
+            "pop",
+            "lodpop",
+            "de2000_mean",
+            "triangles",
+            "draw_calls",
+            "t_instances",
+            "lod_mean",
+        ] {
+            let (x, y) = (col(&a, method, name), col(&b, method, name));
+            assert_eq!(x.len(), 120, "{method}");
+            assert_eq!(
+                x, y,
+                "{method}: column {name} differs between identical runs"
+            );
+        }
+        if method.starts_with("fsi") {
+            let lag = |rows: &Vec<common::Row>| -> Vec<String> {
+                rows.iter()
+                    .filter(|r| r["method"] == method)
+                    .map(|r| r["lag_rmse"].clone())
+                    .collect()
+            };
+            assert_eq!(lag(&a), lag(&b), "{method}: lag_rmse differs");
+        }
     }
     assert!(col(&a, "discrete", "rmse").iter().any(|&x| x > 0.0));
 }
