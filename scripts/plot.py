@@ -5,7 +5,8 @@
 
 Writes into each folder a `figures/` subfolder and `report.md` (the summary table and every figure that folder's
 data allows):
-  - sweep_<scene>.png       rmse, pop and lodpop along the path per method, discrete LOD switch frames marked;
+  - sweep_<scene>.png       rmse, pop and lodpop along the path per method, and FSI's lag_rmse, discrete LOD switch
+                            frames marked;
   - fig6_<scene>.png        seed 003 Fig. 6: popping per method (mean rmse, max pop, max lodpop; bunny-sweep or any
                             moving scene);
   - transitions_<scene>.png per transition of the path (up to 16), the largest lodpop and pop of each method (from
@@ -70,7 +71,9 @@ def save(fig, path):
 
 def sweep_figure(scene, by_method, path):
     has_lodpop = "lodpop" in next(iter(by_method.values()))[0]
-    fig, axes = plt.subplots(3 if has_lodpop else 2, 1, figsize=(10, 8.5 if has_lodpop else 6), sharex=True)
+    lagged = [m for m, rows in by_method.items() if rows and rows[0].get("lag_rmse", "") != ""]
+    panels = 2 + has_lodpop + bool(lagged)
+    fig, axes = plt.subplots(panels, 1, figsize=(10, 3 + 2.8 * (panels - 1)), sharex=True)
     first = next(iter(by_method.values()))
     for f in switch_frames(first):
         for ax in axes:
@@ -85,6 +88,13 @@ def sweep_figure(scene, by_method, path):
     axes[1].set_ylabel("pop (motion included)")
     if has_lodpop:
         axes[2].set_ylabel("lodpop (pose held)")
+    if lagged:
+        for method in lagged:
+            rows = by_method[method]
+            axes[-1].plot([int(r["frame"]) for r in rows], [num(r["lag_rmse"]) for r in rows], lw=0.9,
+                          label=method)
+        axes[-1].set_ylabel("lag_rmse (fsi*)")
+        axes[-1].legend(fontsize=8)
     axes[-1].set_xlabel("frame (grey: discrete LOD switches)")
     axes[0].legend(ncol=4, fontsize=8)
     axes[0].set_title(f"{scene}: error along the path")
