@@ -181,6 +181,27 @@ impl GpuContext {
     }
 
     /// Maps `buffer` for reading, waits, and hands its bytes to `f`.
+    /// The first `count` 64-bit sums of a kernel's `sums` buffer, each stored as two u32 words (low, high)
+    /// that shaders add with a carry: copied into the mappable `readback` (at least as large) and read.
+    pub fn read_u64_sums(
+        &self,
+        sums: &wgpu::Buffer,
+        readback: &wgpu::Buffer,
+        count: usize,
+    ) -> Result<Vec<u64>> {
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(sums, 0, readback, 0, None);
+        self.queue.submit([encoder.finish()]);
+        self.read_buffer(readback, |bytes| {
+            let words: &[u32] = bytemuck::cast_slice(bytes);
+            words
+                .chunks_exact(2)
+                .take(count)
+                .map(|w| w[0] as u64 | (w[1] as u64) << 32)
+                .collect()
+        })
+    }
+
     pub fn read_buffer<T>(&self, buffer: &wgpu::Buffer, f: impl FnOnce(&[u8]) -> T) -> Result<T> {
         let (tx, rx) = std::sync::mpsc::channel();
         buffer.map_async(wgpu::MapMode::Read, .., move |r| {

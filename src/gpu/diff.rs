@@ -135,19 +135,12 @@ impl DiffKernel {
 
     /// The RMS difference of frames `0..frames` (0 for a frame never encoded), after their submissions.
     pub fn read(&self, ctx: &GpuContext, frames: u32) -> Result<Vec<f64>> {
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(&self.sums, 0, &self.readback, 0, None);
-        ctx.queue.submit([encoder.finish()]);
         let pixels = self.width as f64 * self.height as f64;
         let n = frames.min(self.frames) as usize;
-        ctx.read_buffer(&self.readback, |bytes| {
-            let words: &[u32] = bytemuck::cast_slice(bytes);
-            (0..n)
-                .map(|f| {
-                    let sum = words[2 * f] as u64 | (words[2 * f + 1] as u64) << 32;
-                    (sum as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt()
-                })
-                .collect()
-        })
+        let sums = ctx.read_u64_sums(&self.sums, &self.readback, n)?;
+        Ok(sums
+            .into_iter()
+            .map(|sum| (sum as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt())
+            .collect())
     }
 }

@@ -126,28 +126,18 @@ impl MetricKernel {
         pass.dispatch_workgroups(1, self.height, 1);
     }
 
-    /// rmse and pop of frames `0..frames`, after their submissions.
+    /// rmse, pop and de2000 of frames `0..frames`, after their submissions.
     pub fn read(&self, ctx: &GpuContext, frames: u32) -> Result<Vec<FrameMetrics>> {
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(&self.sums, 0, &self.readback, 0, None);
-        ctx.queue.submit([encoder.finish()]);
         let pixels = self.width as f64 * self.height as f64;
         let n = frames.min(self.frames) as usize;
-        ctx.read_buffer(&self.readback, |bytes| {
-            let words: &[u32] = bytemuck::cast_slice(bytes);
-            (0..n)
-                .map(|f| {
-                    let w = &words[f * 6..f * 6 + 6];
-                    let rmse_sum = w[0] as u64 | (w[1] as u64) << 32;
-                    let pop_sum = w[2] as u64 | (w[3] as u64) << 32;
-                    let de_sum = w[4] as u64 | (w[5] as u64) << 32;
-                    FrameMetrics {
-                        rmse: (rmse_sum as f64 / (9.0 * 255.0 * 255.0 * pixels)).sqrt(),
-                        pop: (pop_sum as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt(),
-                        de2000: de_sum as f64 / (65536.0 * pixels),
-                    }
-                })
-                .collect()
-        })
+        let sums = ctx.read_u64_sums(&self.sums, &self.readback, 3 * n)?;
+        Ok(sums
+            .chunks_exact(3)
+            .map(|s| FrameMetrics {
+                rmse: (s[0] as f64 / (9.0 * 255.0 * 255.0 * pixels)).sqrt(),
+                pop: (s[1] as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt(),
+                de2000: s[2] as f64 / (65536.0 * pixels),
+            })
+            .collect())
     }
 }
