@@ -95,10 +95,11 @@ fn csv_export(c: &mut Criterion) {
             rmse: 0.01,
             pop: 0.001,
             lodpop: 0.0,
-            de2000_mean: 0.1,
+            de2000_mean: Some(0.1),
             flip_mean: None,
             combine_gpu_ms: None,
             lag_rmse: None,
+            round: f / 360,
         })
         .collect();
     let dir = tempfile::tempdir().unwrap();

@@ -184,10 +184,8 @@ def fig5(scene, summary, path):
         rows = sorted(rows, key=lambda r: int(r["count"]))
         n = [int(r["count"]) for r in rows]
         med = np.array([num(r["gpu_ms_median"]) for r in rows])
-        lo = np.array([num(r.get("gpu_ms_median_ci95_lo")) for r in rows])
-        hi = np.array([num(r.get("gpu_ms_median_ci95_hi")) for r in rows])
-        ax.errorbar(n, med, yerr=[np.nan_to_num(med - lo), np.nan_to_num(hi - med)], marker="o", capsize=3,
-                    label=method[0])
+        # No error bars on absolute times: compare methods by summary.csv's ratio_to_baseline and its interval.
+        ax.plot(n, med, marker="o", label=method[0])
     ax.set_xlabel("models")
     ax.set_ylabel("median GPU frame time, ms")
     ax.set_title(f"{scene}: frame time against model count (cf. seed 003 Fig. 5)")
@@ -457,8 +455,9 @@ def report(folder: Path, transition: str = "worst") -> list:
                     made.append((f"fsi_buffers_{scene}.png", f"{scene}: FSI's two LOD buffers and the combined frame"))
         cost(scene, scene_summary, figs / f"cost_{scene}.png")
         made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
-    columns = ([variable] if variable else []) + ["scene", "method", "count", "frames", "gpu_ms_median", "gpu_ms_median_ci95_lo",
-               "gpu_ms_median_ci95_hi", "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
+    columns = ([variable] if variable else []) + ["scene", "method", "count", "frames", "gpu_ms_median",
+               "gpu_ms_median_transition", "ratio_to_baseline", "ratio_to_baseline_ci95_lo", "ratio_to_baseline_ci95_hi",
+               "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
                "de2000_mean"] + (["lodpop_max", "lodpop_sum"] if summary and "lodpop_max" in summary[0] else [])
     text = [f"# lodbench report: {folder.name}", "", "## Summary", "", markdown_table(summary, columns), ""]
     for scene, per_transition in tables:

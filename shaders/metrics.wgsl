@@ -2,18 +2,23 @@
 // matched to 1e-5 (seed 003 section 6 steps 5-6 for rmse; lodbench's temporal popping score for pop).
 //
 // Both images are read through Rgba8Unorm views of the sRGB targets, i.e. as the stored sRGB-encoded bytes.
+// (Reading storage-buffer copies of the two frames instead measured no faster on lavapipe: docs/findings/timing.md.)
 // Per pixel, with a and b the method and reference bytes and e = a - b per channel:
 //   rmse term  (|e.r| + |e.g| + |e.b|)^2                 -> rmse = sqrt(sum / (9 * 255^2 * pixels))
 //   pop term   |e_t - e_{t-1}|^2 summed over R, G, B      -> pop  = sqrt(sum / (3 * 255^2 * pixels))
 //   de2000     CIEDE2000 (sRGB D65 -> XYZ -> CIELAB, as colour-science), only for pixels that differ, in f32,
 //              rounded to 1/65536                         -> de2000_mean = sum / (65536 * pixels)
 // e_t is kept per pixel in `prev_error` for the next frame. Each frame slot holds three 64-bit sums (6 words).
+// Two pipeline-overridable switches: DE2000 adds de2000 (`--metrics de2000`, which costs more than the rest);
+// WORKGROUP_REDUCE sums the row's 64 partial sums in workgroup memory behind a barrier and adds them with one
+// invocation (`--metric-reduction workgroup`) instead of each invocation adding its own (the default, `atomics`,
+// measured faster on lavapipe: docs/measurement.md, "Cost of the quality pass").
 //
 // One workgroup per row, 64 invocations; invocation i sums the pixels i, i + 64, i + 128, ... of its row
-// (neighbouring invocations read neighbouring pixels), then adds its two sums to a 64-bit total made of two u32
-// atomics per frame slot. No workgroup barriers: they are cheap on GPUs but very slow on software adapters,
-// where CI runs. A run of at most 8192 / 64 = 128 pixels keeps each partial sum below 2^32 (128 * 780300 for
-// pop; 128 * 65536 * 120 for de2000, CIEDE2000 staying below 120 between sRGB colours).
+// (neighbouring invocations read neighbouring pixels), then its sums reach a 64-bit total made of two u32
+// atomics per frame slot, directly or through the workgroup reduction. A run of at most 8192 / 64 = 128 pixels
+// keeps each partial sum below 2^32 (128 * 780300 for pop; 128 * 65536 * 120 for de2000, CIEDE2000 staying
+// below 120 between sRGB colours); the reduction carries into the high word.
 
 struct Params {
     width: u32,
@@ -118,23 +123,42 @@ fn ciede2000(lab1: vec3<f32>, lab2: vec3<f32>) -> f32 {
     return sqrt(max(x * x + y * y + z * z + rt * y * z, 0.0));
 }
 
-@compute @workgroup_size(64, 1, 1)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let y = gid.y;
-    if (y >= params.height) {
-        return;
+var<workgroup> partial: array<vec3<u32>, 64>;
+
+// Adds `v` to the 64-bit (lo, hi) pair.
+fn add_pair(acc: vec2<u32>, v: u32) -> vec2<u32> {
+    let lo = acc.x + v;
+    return vec2<u32>(lo, acc.y + select(0u, 1u, lo < v));
+}
+
+fn add_u64_pair(lo: u32, v: vec2<u32>) {
+    if (v.x != 0u) {
+        add_u64(lo, v.x);
     }
+    if (v.y != 0u) {
+        atomicAdd(&sums[lo + 1u], v.y);
+    }
+}
+
+override DE2000: bool = false;
+override WORKGROUP_REDUCE: bool = false;
+
+@compute @workgroup_size(64, 1, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let y = gid.y;
     var rmse_sum = 0u;
     var pop_sum = 0u;
     var de_sum = 0u;
-    for (var x = gid.x; x < params.width; x = x + LANES) {
+    // Rows past the image still take part in the workgroup's barrier, with nothing to add.
+    let width = select(0u, params.width, y < params.height);
+    for (var x = gid.x; x < width; x = x + LANES) {
         let p = vec2<i32>(i32(x), i32(y));
         let a = to_bytes(textureLoad(method_img, p, 0));
         let b = to_bytes(textureLoad(reference_img, p, 0));
         let e = a - b;
         let s = u32(abs(e.x) + abs(e.y) + abs(e.z));
         rmse_sum = rmse_sum + s * s;
-        if (s != 0u) {
+        if (DE2000 && s != 0u) {
             de_sum = de_sum + u32(round(ciede2000(srgb_to_lab(a), srgb_to_lab(b)) * DE_SCALE));
         }
         let idx = y * params.width + x;
@@ -151,13 +175,27 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let biased = vec3<u32>(e + vec3<i32>(255));
         prev_error[idx] = biased.x | (biased.y << 10u) | (biased.z << 20u);
     }
-    if (rmse_sum != 0u) {
-        add_u64(params.slot * 6u, rmse_sum);
+    let slot = params.slot * 6u;
+    if (!WORKGROUP_REDUCE) {
+        add_u64_pair(slot, vec2<u32>(rmse_sum, 0u));
+        add_u64_pair(slot + 2u, vec2<u32>(pop_sum, 0u));
+        add_u64_pair(slot + 4u, vec2<u32>(de_sum, 0u));
+        return;
     }
-    if (pop_sum != 0u) {
-        add_u64(params.slot * 6u + 2u, pop_sum);
-    }
-    if (de_sum != 0u) {
-        add_u64(params.slot * 6u + 4u, de_sum);
+    partial[lid] = vec3<u32>(rmse_sum, pop_sum, de_sum);
+    workgroupBarrier();
+    if (lid == 0u) {
+        var r = vec2<u32>(0u);
+        var p = vec2<u32>(0u);
+        var d = vec2<u32>(0u);
+        for (var i = 0u; i < LANES; i = i + 1u) {
+            let v = partial[i];
+            r = add_pair(r, v.x);
+            p = add_pair(p, v.y);
+            d = add_pair(d, v.z);
+        }
+        add_u64_pair(slot, r);
+        add_u64_pair(slot + 2u, p);
+        add_u64_pair(slot + 4u, d);
     }
 }

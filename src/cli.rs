@@ -5,7 +5,7 @@
 //! (`crate::defaults::clap_defaults`), so a file and a command line with the same settings are the same run.
 
 use crate::methods::MethodOptions;
-use crate::metrics::Metric;
+use crate::metrics::{Metric, MetricReduction};
 use crate::scene::{CameraMode, Profile};
 use crate::schedule::FadeMode;
 use clap::{Args, Parser, Subcommand};
@@ -140,13 +140,26 @@ pub struct RunArgs {
     /// Seed of every random choice (recorded in run.json).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Timing rounds: the timed frames are cut into this many consecutive segments, and round r times every
+    /// method of the block over segment r, in an order shuffled from --seed (recorded in run.json), so drift
+    /// of the machine falls on every method alike. The paired ratios and their intervals are over rounds.
+    #[arg(long, default_value_t = 20)]
+    pub rounds: u32,
+    /// The method every method's time is divided by, round by round (summary.csv `ratio_to_baseline`);
+    /// default `discrete` when it is run. A name repeated in --method is `NAME#2`, `NAME#3`, ...
+    #[arg(long)]
+    pub baseline: Option<String>,
     #[command(flatten)]
     #[serde(flatten)]
     pub method_options: MethodOptions,
-    /// Image metrics per frame (rmse, pop and de2000 are always computed; flip adds NVIDIA FLIP, on the CPU).
-    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Metric::Rmse, Metric::Pop, Metric::De2000])]
+    /// Image metrics per frame (rmse, pop and lodpop are always computed; de2000 adds CIEDE2000 to the metric
+    /// kernel; flip adds NVIDIA FLIP, on the CPU).
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Metric::Rmse, Metric::Pop])]
     #[serde(deserialize_with = "one_or_many")]
     pub metrics: Vec<Metric>,
+    /// How the metric kernel sums a row: per-invocation atomics (default) or a workgroup-memory reduction.
+    #[arg(long, value_enum, default_value_t = MetricReduction::Atomics)]
+    pub metric_reduction: MetricReduction,
     /// Output folder (default results/<scene>-<time>/).
     #[arg(long)]
     pub out: Option<PathBuf>,

@@ -6,7 +6,7 @@ use crate::cli::{RunArgs, SceneArgs};
 use crate::error::{Error, Result};
 use crate::formats::{COLOR_FORMAT, DEPTH_FORMAT, MAX_SIDE, MSAA_SAMPLES};
 use crate::methods::{MethodOptions, Registry};
-use crate::metrics::Metric;
+use crate::metrics::{Metric, MetricReduction};
 use crate::scene::{ProfileValues, SceneConfig, SceneKind};
 use crate::schedule::ScheduleParams;
 use serde::Serialize;
@@ -90,11 +90,16 @@ pub struct RunConfig {
     /// Explicit --warmup; None = the profile's.
     pub warmup: Option<u32>,
     pub seed: u64,
+    /// `--rounds`: timing rounds per block (at most one per frame).
+    pub rounds: u32,
+    /// `--baseline`, resolved: the label every method's time is divided by (None: no ratios).
+    pub baseline: Option<String>,
     /// Every method's flags (recorded whether or not the method runs).
     #[serde(flatten)]
     pub method_options: MethodOptions,
     /// `--metrics` (rmse, pop, de2000 always; flip when listed).
     pub metrics: Vec<Metric>,
+    pub metric_reduction: MetricReduction,
     pub out: Option<PathBuf>,
     pub adapter: Option<String>,
     pub dump_frames: bool,
@@ -118,7 +123,20 @@ impl RunConfig {
             .iter()
             .map(|n| SceneKind::from_name(n))
             .collect::<Result<Vec<_>>>()?;
-        let methods = resolve_names("method", &a.method, &registry.names())?;
+        let methods = resolve_methods(&a.method, &registry.names())?;
+        if a.rounds == 0 {
+            return Err(Error::Config("--rounds must be at least 1".into()));
+        }
+        let baseline = match &a.baseline {
+            Some(b) if methods.iter().any(|m| m == b.trim()) => Some(b.trim().to_string()),
+            Some(b) => {
+                return Err(Error::Config(format!(
+                    "--baseline {b} is not among the methods run ({})",
+                    methods.join(", ")
+                )))
+            }
+            None => methods.iter().find(|m| *m == "discrete").cloned(),
+        };
         if a.dump_every == 0 {
             return Err(Error::Config("--dump-every must be at least 1".into()));
         }
@@ -134,8 +152,11 @@ impl RunConfig {
             scene: SceneConfig::from_args(&a.scene_args)?,
             warmup: a.warmup,
             seed: a.seed,
+            rounds: a.rounds,
+            baseline,
             method_options: a.method_options,
             metrics: a.metrics.clone(),
+            metric_reduction: a.metric_reduction,
             out: a.out.clone(),
             adapter: a.adapter.clone(),
             dump_frames: a.dump_frames,
@@ -174,6 +195,30 @@ pub fn resolve_names(kind: &'static str, given: &[String], valid: &[&str]) -> Re
     Ok(out)
 }
 
+/// The methods' labels: checked against the registry in the user's order; a name given again runs again as
+/// `NAME#2`, `NAME#3`, ... (an A/A comparison); empty = every method once.
+pub fn resolve_methods(given: &[String], valid: &[&str]) -> Result<Vec<String>> {
+    if given.is_empty() {
+        return Ok(valid.iter().map(|s| s.to_string()).collect());
+    }
+    let mut out: Vec<String> = Vec::new();
+    for name in given {
+        let name = name.trim();
+        let base = crate::methods::base_name(name);
+        if !valid.contains(&base) {
+            return Err(Error::unknown("method", name, valid));
+        }
+        let mut label = name.to_string();
+        let mut k = 2;
+        while out.contains(&label) {
+            label = format!("{base}#{k}");
+            k += 1;
+        }
+        out.push(label);
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -187,6 +232,36 @@ mod tests {
             Command::Run(r) => r,
             _ => unreachable!(),
         }
+    }
+
+    #[test]
+    fn a_repeated_method_runs_again_under_its_own_label() {
+        let c = RunConfig::from_args(&run_args(&["--method", "discrete,alpha,discrete,discrete"]))
+            .unwrap();
+        assert_eq!(c.methods, ["discrete", "alpha", "discrete#2", "discrete#3"]);
+        assert_eq!(c.baseline.as_deref(), Some("discrete"));
+        let c = RunConfig::from_args(&run_args(&["--method", "alpha,fsi"])).unwrap();
+        assert_eq!(c.baseline, None, "no discrete, no default baseline");
+        let c = RunConfig::from_args(&run_args(&[
+            "--method",
+            "alpha,alpha",
+            "--baseline",
+            "alpha#2",
+        ]))
+        .unwrap();
+        assert_eq!(c.baseline.as_deref(), Some("alpha#2"));
+        let e = RunConfig::from_args(&run_args(&["--method", "alpha", "--baseline", "discrete"]))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--baseline discrete") && e.contains("alpha"),
+            "{e}"
+        );
+        let e = RunConfig::from_args(&run_args(&["--method", "alpha#x"]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("alpha#x"), "{e}");
+        assert!(RunConfig::from_args(&run_args(&["--rounds", "0"])).is_err());
     }
 
     #[test]

@@ -218,7 +218,7 @@ impl Experiment {
             folders.push(folder);
         }
         if let Some(var) = &self.variable {
-            for file in ["frames.csv", "summary.csv", "transitions.csv"] {
+            for file in ["frames.csv", "summary.csv", "transitions.csv", "rounds.csv"] {
                 merge(out, file, var, &self.runs, &folders)?;
             }
         }

@@ -8,6 +8,21 @@ use lodbench::{gpu, methods, runner, Error};
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
 
+/// `print!` / `println!` to stdout that give up quietly when stdout is gone (`lodbench describe ... | head`):
+/// a closed pipe is no error of lodbench's, and `print!` would panic on it.
+macro_rules! out {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stdout(), $($t)*);
+    }};
+}
+macro_rules! outln {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     quiet_wayland_probe();
@@ -49,14 +64,14 @@ fn run(args: &lodbench::cli::RunArgs) -> lodbench::Result<()> {
         }
     });
     let summary = runner::run(&cfg)?;
-    print!("{}", runner::summary_table(&summary));
-    println!("results in {}", summary.out_dir.display());
+    out!("{}", runner::summary_table(&summary));
+    outln!("results in {}", summary.out_dir.display());
     Ok(())
 }
 
 fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
     let e = lodbench::experiment::Experiment::load(&args.file)?;
-    println!(
+    outln!(
         "experiment {} ({} run{}{}): {}",
         e.name,
         e.runs.len(),
@@ -68,7 +83,7 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
     );
     if args.check {
         for r in &e.runs {
-            println!(
+            outln!(
                 "  {} scenes {:?} methods {:?}",
                 r.value.as_deref().unwrap_or("-"),
                 r.config.scenes.iter().map(|s| s.name()).collect::<Vec<_>>(),
@@ -87,7 +102,7 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
         .clone()
         .unwrap_or_else(|| runner::default_out_dir(&[e.name.as_str()]));
     let folders = e.run(&out)?;
-    println!("{} run(s) in {}", folders.len(), out.display());
+    outln!("{} run(s) in {}", folders.len(), out.display());
     Ok(())
 }
 
@@ -97,8 +112,8 @@ fn perceptual(args: &lodbench::cli::PerceptualArgs) -> lodbench::Result<()> {
         fps: args.fps,
     };
     let records = lodbench::perceptual::check(&args.dir, &settings)?;
-    print!("{}", lodbench::perceptual::table(&records));
-    println!(
+    out!("{}", lodbench::perceptual::table(&records));
+    outln!(
         "{} clips scored; {}",
         records.len(),
         args.dir
@@ -109,21 +124,21 @@ fn perceptual(args: &lodbench::cli::PerceptualArgs) -> lodbench::Result<()> {
 }
 
 fn list() -> lodbench::Result<()> {
-    println!("scenes:  {}", SceneKind::names().join(", "));
-    println!("methods:");
+    outln!("scenes:  {}", SceneKind::names().join(", "));
+    outln!("methods:");
     for m in methods::BUILTIN {
-        println!("  {:<16} {}", m.name, m.about);
+        outln!("  {:<16} {}", m.name, m.about);
     }
     let adapters = gpu::context::enumerate_adapters();
     if adapters.is_empty() {
-        println!("adapters: none found");
-        println!("  {}", gpu::context::NO_ADAPTER_HELP);
+        outln!("adapters: none found");
+        outln!("  {}", gpu::context::NO_ADAPTER_HELP);
     } else {
-        println!("adapters (best first; `--adapter SUBSTRING` picks one):");
+        outln!("adapters (best first; `--adapter SUBSTRING` picks one):");
         for a in adapters {
             let i = a.get_info();
             let ts = a.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-            println!(
+            outln!(
                 "  {}  [{:?}, {:?}, driver {} {}{}]",
                 i.name,
                 i.backend,
@@ -142,25 +157,37 @@ fn describe(args: &DescribeArgs) -> lodbench::Result<()> {
     let def = SceneDef::new(SceneKind::from_name(&args.scene)?, &cfg)?;
     let d = def.describe(&cfg);
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&d)?);
+        outln!("{}", serde_json::to_string_pretty(&d)?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{}: profile {}, {}x{}, fov {} deg, {} frames, instance counts {:?}",
-        d.scene, d.profile, d.width, d.height, d.fov_y_deg, d.frames, d.instance_counts
+        d.scene,
+        d.profile,
+        d.width,
+        d.height,
+        d.fov_y_deg,
+        d.frames,
+        d.instance_counts
     );
-    println!("mesh: {}", d.mesh);
+    outln!("mesh: {}", d.mesh);
     for m in &d.models {
-        println!(
+        outln!(
             "model {} (radius {:.3}, switch distances from {}):",
-            m.name, m.radius, m.switch_source
+            m.name,
+            m.radius,
+            m.switch_source
         );
-        println!(
+        outln!(
             "  {:>4} {:>10} {:>9} {:>14} {:>16}",
-            "lod", "triangles", "vertices", "error_abs", "switch_distance"
+            "lod",
+            "triangles",
+            "vertices",
+            "error_abs",
+            "switch_distance"
         );
         for l in &m.lods {
-            println!(
+            outln!(
                 "  {:>4} {:>10} {:>9} {:>14.6} {:>16}",
                 l.info.lod,
                 l.info.triangles,
@@ -171,6 +198,6 @@ fn describe(args: &DescribeArgs) -> lodbench::Result<()> {
             );
         }
     }
-    println!("motion: {}", serde_json::to_string(&d.motion)?);
+    outln!("motion: {}", serde_json::to_string(&d.motion)?);
     Ok(())
 }

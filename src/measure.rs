@@ -1,20 +1,25 @@
-//! The measurement of one method on one scene block: a warm-up, a timing pass and a quality pass over the same
+//! The measurement of the methods of one scene block: warm-up, timing rounds and a quality pass over the same
 //! frames, then one frame record per frame, built once every figure of the frame is known.
 //!
-//! - Timing pass: `warmup` untimed frames, then `frames` timed frames; nothing but the method's own work is in
-//!   a timed frame (no metric, no read-back). Each frame is submitted and waited for, so `cpu_ms` is a true
-//!   encode-to-completion time and frames never overlap; GPU timestamps are resolved into one buffer and read
-//!   once after the pass, so reading them never stalls the timed frames.
-//! - Quality pass: per frame the reference and the method are rendered into two targets and the metric kernel
-//!   reduces their difference to scalars on the GPU; the scalars of all frames are read back once at the end.
+//! - Warm-up ([`WarmUpPlan`]): `warmup` untimed frames, then the first frames of each distinct transition, so
+//!   every pipeline a method uses has run once before timing.
+//! - Timing rounds ([`BlockRunner::time_methods`]): the path is cut into `rounds` consecutive segments; round r
+//!   times every method over segment r in a seeded shuffled order, each method continuing its own walk, so drift
+//!   of the machine's speed falls on all methods alike and each round pairs the methods on the same frames.
+//!   Nothing but the method's own work is in a timed frame (no metric, no read-back, no stage timestamps). Each
+//!   frame is submitted and waited for, so `cpu_ms` is a true encode-to-completion time and frames never
+//!   overlap; GPU timestamps are resolved into one buffer per method and read once after the rounds.
+//! - Quality pass ([`BlockRunner::measure_quality`]): per frame the reference and the method are rendered into
+//!   two targets and the metric kernel reduces their difference to scalars on the GPU; the scalars of all
+//!   frames are read back once at the end. FSI's combination pass is timed here.
 
 use crate::error::{Error, Result};
 use crate::gpu::diff::DiffKernel;
 use crate::gpu::metrics::MetricKernel;
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::{DrawStats, GpuContext, RenderTarget, SceneGpu, TextureReadback};
-use crate::methods::{Build, FrameInput, Method, MethodOptions, Registry};
-use crate::metrics::FrameMetrics;
+use crate::methods::{Build, FrameInput, Method, MethodEntry, MethodOptions, Registry};
+use crate::metrics::{FrameMetrics, Metric, MetricReduction};
 use crate::records::{
     near_transitions, transitions, BlockInfo, FrameRecord, TransitionPair, TransitionRecord,
 };
@@ -138,18 +143,103 @@ impl Default for MethodSetup {
     }
 }
 
-/// What the timing pass measured, per frame.
-struct TimingPass {
+/// The order of one timing round: which frames it covers and the order the methods were timed in.
+pub use crate::records::{BlockRounds, Round};
+
+/// One method of a block from its creation through the timing rounds: the method (kept for its quality pass),
+/// its own walk along the path, and what its timed frames measured.
+pub struct TimedMethod<'s> {
+    pub label: String,
+    entry: MethodEntry,
+    method: Box<dyn Method>,
+    driver: FrameDriver<'s>,
+    timer: Option<GpuTimer>,
     facts: Vec<FrameFacts>,
     cpu_ms: Vec<f64>,
     stats: Vec<DrawStats>,
-    /// GPU time per frame (None without timestamp queries).
+    /// The round each frame was timed in.
+    round: Vec<u32>,
+    /// GPU time per frame, read after the last round (None without timestamp queries).
     gpu_ms: Vec<Option<f64>>,
-    /// The method's own stage per frame (FSI's combination pass), when it has one.
-    stage_ms: Option<Vec<Option<f64>>>,
-    ms_per_frame: f64,
-    instance_bytes_listed_per_frame: f64,
-    instance_bytes_written_per_frame: f64,
+    /// Wall time of the method's timed segments, ms.
+    wall_ms: f64,
+    /// Instance bytes (listed, written) over its timed frames.
+    uploads: (u64, u64),
+    /// `--warmup` (the frames of the path rendered untimed first; [`WarmUpPlan`] adds transition frames).
+    warmup: u32,
+}
+
+impl TimedMethod<'_> {
+    /// Wall time per timed frame (render + wait), ms.
+    pub fn ms_per_frame(&self) -> f64 {
+        self.wall_ms / self.cpu_ms.len().max(1) as f64
+    }
+}
+
+/// The frames every method renders untimed before the rounds: the first `warmup` frames of the path (wrapping),
+/// then the first frame of each distinct transition of the path (`lod_from -> lod_to` pair) and the two frames
+/// after it, so that every pipeline and buffer a method uses in a transition is used once before timing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WarmUpPlan {
+    pub warmup: u32,
+    pub transition_frames: Vec<u32>,
+}
+
+impl WarmUpPlan {
+    /// Walks the path once on the CPU to find the transitions.
+    pub fn new(scene: &Scene, warmup: u32) -> WarmUpPlan {
+        let mut driver = FrameDriver::new(scene);
+        let mut seen: Vec<TransitionPair> = Vec::new();
+        let mut frames: Vec<u32> = Vec::new();
+        for f in 0..scene.frames {
+            let pair = driver.advance(f).pair;
+            if pair != TransitionPair::None && !seen.contains(&pair) {
+                seen.push(pair);
+                frames.extend((f..f + 3).filter(|&g| g < scene.frames));
+            }
+        }
+        frames.sort_unstable();
+        frames.dedup();
+        WarmUpPlan {
+            warmup,
+            transition_frames: frames,
+        }
+    }
+}
+
+/// The frames of round `r` of `rounds` over `frames` frames: consecutive segments of (nearly) equal length.
+pub fn round_frames(r: u32, rounds: u32, frames: u32) -> (u32, u32) {
+    let at = |i: u32| (i as u64 * frames as u64 / rounds.max(1) as u64) as u32;
+    (at(r), at(r + 1))
+}
+
+/// Round `r`'s order of `n` methods: a Fisher-Yates shuffle drawn from `rng`.
+pub fn shuffled_order(n: usize, rng: &mut crate::rng::SplitMix64) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..n).collect();
+    for i in (1..n).rev() {
+        let j = (rng.next_u64() % (i as u64 + 1)) as usize;
+        order.swap(i, j);
+    }
+    order
+}
+
+/// What the quality pass computes besides rmse, pop and lodpop, and how.
+#[derive(Debug, Clone, Default)]
+pub struct QualityOptions {
+    /// `--metrics`: `Metric::Flip` and `Metric::De2000` switch those metrics on.
+    pub metrics: Vec<Metric>,
+    /// `--metric-reduction`.
+    pub reduction: MetricReduction,
+}
+
+impl QualityOptions {
+    /// With de2000 (the GPU-oracle tests).
+    pub fn with_de2000() -> QualityOptions {
+        QualityOptions {
+            metrics: vec![Metric::De2000],
+            ..Default::default()
+        }
+    }
 }
 
 /// What the quality pass measured, per frame.
@@ -160,6 +250,9 @@ struct QualityPass {
     lodpop: Vec<f64>,
     /// Methods with a lag (FSI): lag_rmse per frame.
     lag: Option<Vec<f64>>,
+    /// The method's own stage per frame (FSI's combination pass), when it has one: timed in the quality pass,
+    /// so that its timestamps are never inside a timing-pass frame.
+    stage_ms: Option<Vec<Option<f64>>>,
     ms_per_frame: f64,
     metric_gpu_ms_median: Option<f64>,
 }
@@ -182,7 +275,8 @@ pub struct BlockRunner<'a> {
     reference: Box<dyn Method>,
     setup: MethodSetup,
     kernel: MetricKernel,
-    timer: Option<GpuTimer>,
+    /// `--metrics de2000`: the kernel computes CIEDE2000 (else de2000_mean is empty).
+    de2000: bool,
     /// Times the metric kernel alone in the quality pass (its own cost, reported in run.json).
     metric_timer: Option<GpuTimer>,
     readback: Option<(TextureReadback, TextureReadback)>,
@@ -202,14 +296,15 @@ const QUALITY_IN_FLIGHT: u32 = 2;
 pub type FrameImages<'i> = (&'i [u8], &'i [u8], &'i [(&'i str, Vec<u8>)]);
 
 impl<'a> BlockRunner<'a> {
-    /// `dump`: hand frames to `run_method`'s callback; `flip`: compute FLIP on every quality-pass frame.
+    /// `dump`: hand frames to the quality pass's callback.
     pub fn new(
         ctx: &'a GpuContext,
         scene: &'a Scene,
         setup: MethodSetup,
         dump: bool,
-        flip: bool,
+        quality: &QualityOptions,
     ) -> Result<Self> {
+        let flip = quality.metrics.contains(&Metric::Flip);
         let with_readback = dump || flip;
         ctx.check_viewport(scene.width, scene.height)?;
         let gpu = SceneGpu::new(ctx, scene)?;
@@ -231,8 +326,13 @@ impl<'a> BlockRunner<'a> {
         let lag_kernel =
             DiffKernel::new(ctx, "lag", &[(&method_target, &now_target)], scene.frames)?;
         let reference = Registry::builtin().create("reference", &build(&gpu, scene, &setup))?;
-        let kernel = MetricKernel::new(ctx, &method_target, &reference_target, scene.frames)?;
-        let timer = GpuTimer::new(ctx, scene.frames);
+        let kernel = MetricKernel::new(
+            ctx,
+            (&method_target, &reference_target),
+            scene.frames,
+            quality.metrics.contains(&Metric::De2000),
+            quality.reduction,
+        )?;
         let metric_timer = GpuTimer::new(ctx, scene.frames);
         let readback = with_readback.then(|| {
             (
@@ -255,7 +355,7 @@ impl<'a> BlockRunner<'a> {
             reference,
             setup,
             kernel,
-            timer,
+            de2000: quality.metrics.contains(&Metric::De2000),
             metric_timer,
             readback,
             flip,
@@ -269,168 +369,274 @@ impl<'a> BlockRunner<'a> {
         self.dump_transitions_only = on;
     }
 
-    /// Warm-up, timing pass and quality pass of `method_name`, then its frame records. `on_frames` is called
-    /// with the quality-pass images of every `dump_every`-th frame when the runner was built with read-back.
+    /// Warm-up, timing and quality pass of one method alone (one round): what a run of `--method NAME
+    /// --rounds 1` measures. `on_frames` is called with the quality-pass images of every `dump_every`-th frame
+    /// when the runner was built with read-back.
     pub fn run_method(
         &mut self,
-        method_name: &str,
+        label: &str,
         warmup: u32,
+        dump_every: u32,
+        progress: &ProgressBar,
+        on_frames: impl FnMut(u32, FrameImages<'_>) -> Result<()>,
+    ) -> Result<BlockOutput> {
+        let (mut timed, _) = self.time_methods(&[label.to_string()], warmup, 1, 0, progress)?;
+        let reference_ms = timed
+            .iter()
+            .find(|t| t.label == "reference")
+            .map(TimedMethod::ms_per_frame);
+        let method = timed
+            .drain(..)
+            .find(|t| t.label == label)
+            .ok_or_else(|| Error::Gpu(format!("method {label} was not timed")))?;
+        self.measure_quality(method, reference_ms, dump_every, progress, on_frames)
+    }
+
+    /// Creates the methods `labels` (a label `NAME#k` is another instance of NAME), warms each up
+    /// ([`WarmUpPlan`]), then times them in `rounds` interleaved rounds: round r times every method over the
+    /// frames [`round_frames`]`(r)`, in an order shuffled from `seed`, each method continuing its own walk along
+    /// the path. When no label is the reference, the reference is timed too (its time per frame is the
+    /// denominator of run.json's `quality_to_renders_ratio`) and returned last, labelled `reference`.
+    pub fn time_methods(
+        &self,
+        labels: &[String],
+        warmup: u32,
+        rounds: u32,
+        seed: u64,
+        progress: &ProgressBar,
+    ) -> Result<(Vec<TimedMethod<'a>>, BlockRounds)> {
+        let (scene, ctx) = (self.scene, self.ctx);
+        let frames = scene.frames;
+        let mut labels = labels.to_vec();
+        let timed_only: Vec<String> = if labels
+            .iter()
+            .any(|l| crate::methods::base_name(l) == "reference")
+        {
+            Vec::new()
+        } else {
+            labels.push("reference".into());
+            vec!["reference".into()]
+        };
+        let mut methods = labels
+            .iter()
+            .map(|label| {
+                let entry = *self.setup.registry.get(label)?;
+                Ok(TimedMethod {
+                    label: label.clone(),
+                    entry,
+                    method: (entry.create)(&build(&self.gpu, scene, &self.setup))?,
+                    driver: FrameDriver::new(scene),
+                    timer: GpuTimer::new(ctx, frames),
+                    facts: Vec::with_capacity(frames as usize),
+                    cpu_ms: Vec::with_capacity(frames as usize),
+                    stats: Vec::with_capacity(frames as usize),
+                    round: Vec::with_capacity(frames as usize),
+                    gpu_ms: Vec::new(),
+                    wall_ms: 0.0,
+                    uploads: (0, 0),
+                    warmup,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let plan = WarmUpPlan::new(scene, warmup);
+        for m in methods.iter_mut() {
+            self.warm_up(m, &plan, progress)?;
+            m.driver.reset();
+        }
+        let rounds = rounds.clamp(1, frames.max(1));
+        let mut rng = crate::rng::SplitMix64::new(seed);
+        let mut info = BlockRounds {
+            scene: scene.name().to_string(),
+            count: scene.count,
+            seed,
+            warmup_transition_frames: plan.transition_frames.clone(),
+            timed_only,
+            rounds: Vec::with_capacity(rounds as usize),
+        };
+        for r in 0..rounds {
+            let (lo, hi) = round_frames(r, rounds, frames);
+            let order = shuffled_order(methods.len(), &mut rng);
+            for &i in &order {
+                self.time_segment(&mut methods[i], r, lo..hi, progress)?;
+            }
+            info.rounds.push(Round {
+                round: r,
+                frames: [lo, hi],
+                order: order.iter().map(|&i| methods[i].label.clone()).collect(),
+            });
+        }
+        for m in methods.iter_mut() {
+            m.gpu_ms = match &m.timer {
+                Some(t) => t.read(ctx)?,
+                None => Vec::new(),
+            };
+        }
+        ctx.check_errors()?;
+        Ok((methods, info))
+    }
+
+    /// The quality pass of a timed method, then its frame records. `reference_ms`: the reference's timing-pass
+    /// time per frame (for `quality_to_renders_ratio`).
+    pub fn measure_quality(
+        &mut self,
+        mut timed: TimedMethod<'a>,
+        reference_ms: Option<f64>,
         dump_every: u32,
         progress: &ProgressBar,
         mut on_frames: impl FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<BlockOutput> {
         let scene = self.scene;
-        let entry = *self.setup.registry.get(method_name)?;
-        let mut method = (entry.create)(&build(&self.gpu, scene, &self.setup))?;
-        let mut driver = FrameDriver::new(scene);
-        self.warm_up(method.as_mut(), &mut driver, warmup, progress)?;
-        let timing = self.timing_pass(method.as_mut(), &mut driver, progress)?;
-        let t_instances: Vec<u32> = timing.facts.iter().map(|f| f.t_instances).collect();
+        let t_instances: Vec<u32> = timed.facts.iter().map(|f| f.t_instances).collect();
         let near = near_transitions(&t_instances);
         let quality = self.quality_pass(
-            method.as_mut(),
-            &mut driver,
+            timed.method.as_mut(),
+            &mut timed.driver,
             (dump_every, &near),
             progress,
             &mut on_frames,
         )?;
         self.ctx.check_errors()?;
-
+        let label = timed.label.as_str();
+        let de2000 = self.de2000;
         let rows = (0..scene.frames as usize)
             .map(|f| FrameRecord {
                 scene: scene.name().to_string(),
-                method: method_name.to_string(),
+                method: label.to_string(),
                 count: scene.count,
                 frame: f as u32,
-                gpu_ms: timing.gpu_ms.get(f).copied().flatten(),
-                cpu_ms: timing.cpu_ms[f],
-                triangles: timing.stats[f].triangles,
-                draw_calls: timing.stats[f].draw_calls,
-                t_instances: timing.facts[f].t_instances,
-                lod_mean: timing.facts[f].lod_mean,
+                gpu_ms: timed.gpu_ms.get(f).copied().flatten(),
+                cpu_ms: timed.cpu_ms[f],
+                triangles: timed.stats[f].triangles,
+                draw_calls: timed.stats[f].draw_calls,
+                t_instances: timed.facts[f].t_instances,
+                lod_mean: timed.facts[f].lod_mean,
                 rmse: quality.metrics[f].rmse,
                 pop: quality.metrics[f].pop,
                 lodpop: quality.lodpop[f],
-                de2000_mean: quality.metrics[f].de2000,
+                de2000_mean: de2000.then_some(quality.metrics[f].de2000),
                 flip_mean: quality.flip[f],
-                combine_gpu_ms: timing
+                combine_gpu_ms: quality
                     .stage_ms
                     .as_ref()
                     .and_then(|s| s.get(f).copied().flatten()),
                 lag_rmse: quality.lag.as_ref().map(|l| l[f]),
+                round: timed.round[f],
             })
             .collect::<Vec<_>>();
-        let pairs: Vec<TransitionPair> = timing.facts.iter().map(|f| f.pair).collect();
+        let pairs: Vec<TransitionPair> = timed.facts.iter().map(|f| f.pair).collect();
+        let frames = scene.frames as f64;
+        let timing_ms = timed.ms_per_frame();
         Ok(BlockOutput {
             transitions: transitions(&rows, &pairs),
             rows,
             info: BlockInfo {
                 scene: scene.name().to_string(),
-                method: method_name.to_string(),
-                method_options: (entry.options)(&self.setup.options),
+                method: label.to_string(),
+                method_options: (timed.entry.options)(&self.setup.options),
                 count: scene.count,
                 width: scene.width,
                 height: scene.height,
                 frames: scene.frames,
-                warmup,
-                timing_pass_ms_per_frame: timing.ms_per_frame,
+                warmup: timed.warmup,
+                timing_pass_ms_per_frame: timing_ms,
                 quality_pass_ms_per_frame: quality.ms_per_frame,
-                quality_to_timing_ratio: quality.ms_per_frame / timing.ms_per_frame,
+                quality_to_timing_ratio: quality.ms_per_frame / timing_ms,
+                quality_to_renders_ratio: reference_ms
+                    .map(|r| quality.ms_per_frame / (timing_ms + r)),
                 metric_gpu_ms_median: quality.metric_gpu_ms_median,
-                extra_target_bytes: method.extra_target_bytes(),
-                instance_bytes_listed_per_frame: timing.instance_bytes_listed_per_frame,
-                instance_bytes_written_per_frame: timing.instance_bytes_written_per_frame,
+                extra_target_bytes: timed.method.extra_target_bytes(),
+                instance_bytes_listed_per_frame: timed.uploads.0 as f64 / frames,
+                instance_bytes_written_per_frame: timed.uploads.1 as f64 / frames,
             },
         })
     }
 
-    /// The first `warmup` frames of the path (wrapping), untimed.
+    /// `plan`'s warm-up frames, untimed.
     fn warm_up(
         &self,
-        method: &mut dyn Method,
-        driver: &mut FrameDriver<'_>,
-        warmup: u32,
+        m: &mut TimedMethod<'_>,
+        plan: &WarmUpPlan,
         progress: &ProgressBar,
     ) -> Result<()> {
-        let (scene, ctx) = (self.scene, self.ctx);
-        for w in 0..warmup {
-            check_interrupt()?;
+        let scene = self.scene;
+        for w in 0..plan.warmup {
             let f = w % scene.frames;
             if f == 0 {
-                driver.reset();
+                m.driver.reset();
             }
-            driver.advance(f);
-            self.gpu.write_camera(&scene.camera(f));
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            method.encode(
-                &self.gpu,
-                &driver.input(f),
-                &mut encoder,
-                &self.timing_target,
-            );
-            ctx.queue.submit([encoder.finish()]);
-            ctx.wait_idle()?;
+            m.driver.advance(f);
+            self.render_untimed(m, f)?;
             progress.inc(1);
+        }
+        m.driver.reset();
+        let last = plan.transition_frames.last().copied();
+        for f in 0..last.map_or(0, |l| l + 1) {
+            m.driver.advance(f);
+            if plan.transition_frames.binary_search(&f).is_ok() {
+                self.render_untimed(m, f)?;
+            }
         }
         Ok(())
     }
 
-    fn timing_pass(
-        &self,
-        method: &mut dyn Method,
-        driver: &mut FrameDriver<'_>,
-        progress: &ProgressBar,
-    ) -> Result<TimingPass> {
-        let (scene, ctx) = (self.scene, self.ctx);
-        let frames = scene.frames;
-        driver.reset();
-        let n = frames as usize;
-        let (mut facts, mut cpu_ms, mut stats) = (
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
+    fn render_untimed(&self, m: &mut TimedMethod<'_>, f: u32) -> Result<()> {
+        check_interrupt()?;
+        let ctx = self.ctx;
+        self.gpu.write_camera(&self.scene.camera(f));
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        m.method.encode(
+            &self.gpu,
+            &m.driver.input(f),
+            &mut encoder,
+            &self.timing_target,
         );
+        ctx.queue.submit([encoder.finish()]);
+        ctx.wait_idle()
+    }
+
+    /// Times `m` over `frames` (the next frames of its walk) in round `round`: each frame submitted and waited
+    /// for, bracketed by the method's own timestamps, nothing else in its command buffer.
+    fn time_segment(
+        &self,
+        m: &mut TimedMethod<'_>,
+        round: u32,
+        frames: std::ops::Range<u32>,
+        progress: &ProgressBar,
+    ) -> Result<()> {
+        let (scene, ctx) = (self.scene, self.ctx);
         let uploads_before = self.gpu.uploads.get();
-        let pass_start = Instant::now();
-        for f in 0..frames {
+        let start = Instant::now();
+        for f in frames {
             check_interrupt()?;
-            facts.push(driver.advance(f));
+            m.facts.push(m.driver.advance(f));
             let t0 = Instant::now();
             self.gpu.write_camera(&scene.camera(f));
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            if let Some(t) = &self.timer {
+            if let Some(t) = &m.timer {
                 t.begin(&mut encoder, f);
             }
             let input = FrameInput {
                 timed: true,
-                ..driver.input(f)
+                ..m.driver.input(f)
             };
-            stats.push(method.encode(&self.gpu, &input, &mut encoder, &self.timing_target));
-            if let Some(t) = &self.timer {
+            let stats = m
+                .method
+                .encode(&self.gpu, &input, &mut encoder, &self.timing_target);
+            m.stats.push(stats);
+            if let Some(t) = &m.timer {
                 t.end(&mut encoder, f);
             }
             ctx.queue.submit([encoder.finish()]);
             ctx.wait_idle()?;
-            cpu_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+            m.cpu_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+            m.round.push(round);
             progress.inc(1);
         }
-        let ms_per_frame = pass_start.elapsed().as_secs_f64() * 1e3 / frames as f64;
-        let uploads_after = self.gpu.uploads.get();
-        let per_frame = |after: u64, before: u64| (after - before) as f64 / frames as f64;
-        let gpu_ms = match &self.timer {
-            Some(t) => t.read(ctx)?,
-            None => Vec::new(),
-        };
-        Ok(TimingPass {
-            facts,
-            cpu_ms,
-            stats,
-            gpu_ms,
-            stage_ms: method.stage_gpu_ms(ctx)?,
-            ms_per_frame,
-            instance_bytes_listed_per_frame: per_frame(uploads_after.0, uploads_before.0),
-            instance_bytes_written_per_frame: per_frame(uploads_after.1, uploads_before.1),
-        })
+        m.wall_ms += start.elapsed().as_secs_f64() * 1e3;
+        let after = self.gpu.uploads.get();
+        m.uploads.0 += after.0 - uploads_before.0;
+        m.uploads.1 += after.1 - uploads_before.1;
+        Ok(())
     }
 
     fn quality_pass(
@@ -597,6 +803,7 @@ impl<'a> BlockRunner<'a> {
             flip,
             lodpop,
             lag,
+            stage_ms: method.stage_gpu_ms(ctx)?,
             ms_per_frame,
             metric_gpu_ms_median,
         })

@@ -199,6 +199,27 @@ pub enum Metric {
     Flip,
 }
 
+/// How the metric kernel adds a row's 64 partial sums into the frame's totals (`--metric-reduction`).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum MetricReduction {
+    /// Each invocation adds its own sums with atomics (no barrier).
+    #[default]
+    Atomics,
+    /// The row's sums meet in workgroup memory behind a barrier; one invocation adds them.
+    Workgroup,
+}
+
 /// Mean FLIP error (LDR-FLIP, Andersson et al. 2020, via the `nv-flip` crate) of the method frame against the
 /// reference frame, at FLIP's default viewing condition (67 pixels per degree).
 pub fn flip_mean(method: &[u8], reference: &[u8], width: u32, height: u32) -> f64 {

@@ -29,15 +29,19 @@ pub struct FrameRecord {
     /// frame's LOD schedule at this frame's pose (docs/measurement.md, "lodpop"); 0 where the schedule did not
     /// change.
     pub lodpop: f64,
-    /// Mean CIEDE2000 over pixels between method and reference frame (sRGB D65 -> XYZ -> CIELAB).
-    pub de2000_mean: f64,
+    /// Mean CIEDE2000 over pixels between method and reference frame (sRGB D65 -> XYZ -> CIELAB), with
+    /// `--metrics de2000` (empty otherwise).
+    pub de2000_mean: Option<f64>,
     /// Mean FLIP error, with `--metrics ...,flip` (empty otherwise).
     pub flip_mean: Option<f64>,
-    /// GPU time of FSI's combination pass within gpu_ms (empty for other methods or without timestamps).
+    /// GPU time of FSI's combination pass and its copy into the frame's target, measured in the quality pass
+    /// (empty for other methods or without timestamps).
     pub combine_gpu_ms: Option<f64>,
     /// `fsi*` only: RMS of the method's frame minus the same combination with every LOD buffer drawn at this
     /// frame's pose (its one-frame lag; 0 for fsi-sameframe).
     pub lag_rmse: Option<f64>,
+    /// The timing round the frame was timed in (0-based; `--rounds`).
+    pub round: u32,
 }
 
 /// One row of summary.csv: one method on one scene block.
@@ -48,9 +52,9 @@ pub struct SummaryRecord {
     pub count: u32,
     pub frames: u32,
     pub gpu_ms_median: Option<f64>,
-    /// Seeded bootstrap 95 % interval of the median (see [`crate::stats::bootstrap_ci`]).
-    pub gpu_ms_median_ci95_lo: Option<f64>,
-    pub gpu_ms_median_ci95_hi: Option<f64>,
+    /// Medians over the frames with an instance in transition and over the frames without.
+    pub gpu_ms_median_transition: Option<f64>,
+    pub gpu_ms_median_steady: Option<f64>,
     pub gpu_ms_p5: Option<f64>,
     pub gpu_ms_p95: Option<f64>,
     pub cpu_ms_median: f64,
@@ -67,9 +71,9 @@ pub struct SummaryRecord {
     pub lodpop_max: f64,
     pub lodpop_p95: f64,
     pub lodpop_sum: f64,
-    /// Mean over frames of de2000_mean, and its largest frame.
-    pub de2000_mean: f64,
-    pub de2000_max: f64,
+    /// Mean over frames of de2000_mean, and its largest frame (empty without `--metrics de2000`).
+    pub de2000_mean: Option<f64>,
+    pub de2000_max: Option<f64>,
     /// Mean over frames of flip_mean (empty without `--metrics flip`).
     pub flip_mean: Option<f64>,
     pub extra_target_bytes: u64,
@@ -81,6 +85,18 @@ pub struct SummaryRecord {
     /// `fsi*` only: mean and largest lag_rmse.
     pub lag_rmse_mean: Option<f64>,
     pub lag_rmse_max: Option<f64>,
+    /// `--baseline`: this method's time over the baseline's, paired round by round ([`PairedRatios`]).
+    pub baseline: Option<String>,
+    pub rounds: u32,
+    pub ratio_to_baseline: Option<f64>,
+    pub ratio_to_baseline_ci95_lo: Option<f64>,
+    pub ratio_to_baseline_ci95_hi: Option<f64>,
+    pub ratio_to_baseline_transition: Option<f64>,
+    pub ratio_to_baseline_transition_ci95_lo: Option<f64>,
+    pub ratio_to_baseline_transition_ci95_hi: Option<f64>,
+    pub ratio_to_baseline_steady: Option<f64>,
+    pub ratio_to_baseline_steady_ci95_lo: Option<f64>,
+    pub ratio_to_baseline_steady_ci95_hi: Option<f64>,
 }
 
 impl SummaryRecord {
@@ -96,7 +112,13 @@ impl SummaryRecord {
         let cpu: Vec<f64> = rows.iter().map(|r| r.cpu_ms).collect();
         let pop: Vec<f64> = rows.iter().map(|r| r.pop).collect();
         let rmse: Vec<f64> = rows.iter().map(|r| r.rmse).collect();
-        let gpu_ci = bootstrap_ci(&gpu, seed, |v| percentile(v, 50.0));
+        let gpu_where = |transition: bool| {
+            rows.iter()
+                .filter(|r| (r.t_instances > 0) == transition)
+                .filter_map(|r| r.gpu_ms)
+                .collect::<Vec<_>>()
+        };
+        let de2000: Option<Vec<f64>> = rows.iter().map(|r| r.de2000_mean).collect();
         let rmse_ci = bootstrap_ci(&rmse, seed ^ 0x524D_5345, |v| Some(mean(v.iter().copied())))
             .unwrap_or((0.0, 0.0));
         Some(SummaryRecord {
@@ -105,8 +127,8 @@ impl SummaryRecord {
             count: first.count,
             frames: rows.len() as u32,
             gpu_ms_median: percentile(&gpu, 50.0),
-            gpu_ms_median_ci95_lo: gpu_ci.map(|c| c.0),
-            gpu_ms_median_ci95_hi: gpu_ci.map(|c| c.1),
+            gpu_ms_median_transition: percentile(&gpu_where(true), 50.0),
+            gpu_ms_median_steady: percentile(&gpu_where(false), 50.0),
             gpu_ms_p5: percentile(&gpu, 5.0),
             gpu_ms_p95: percentile(&gpu, 95.0),
             cpu_ms_median: percentile(&cpu, 50.0).unwrap_or(f64::NAN),
@@ -123,8 +145,8 @@ impl SummaryRecord {
             lodpop_p95: percentile(&rows.iter().map(|r| r.lodpop).collect::<Vec<_>>(), 95.0)
                 .unwrap_or(0.0),
             lodpop_sum: rows.iter().map(|r| r.lodpop).sum(),
-            de2000_mean: mean(rows.iter().map(|r| r.de2000_mean)),
-            de2000_max: rows.iter().map(|r| r.de2000_mean).fold(0.0, f64::max),
+            de2000_mean: de2000.as_ref().map(|v| mean(v.iter().copied())),
+            de2000_max: de2000.map(|v| v.into_iter().fold(0.0, f64::max)),
             flip_mean: rows
                 .iter()
                 .map(|r| r.flip_mean)
@@ -141,7 +163,137 @@ impl SummaryRecord {
             ),
             lag_rmse_mean: lag.as_ref().map(|v| mean(v.iter().copied())),
             lag_rmse_max: lag.map(|v| v.into_iter().fold(0.0, f64::max)),
+            baseline: None,
+            rounds: rows.iter().map(|r| r.round + 1).max().unwrap_or(0),
+            ratio_to_baseline: None,
+            ratio_to_baseline_ci95_lo: None,
+            ratio_to_baseline_ci95_hi: None,
+            ratio_to_baseline_transition: None,
+            ratio_to_baseline_transition_ci95_lo: None,
+            ratio_to_baseline_transition_ci95_hi: None,
+            ratio_to_baseline_steady: None,
+            ratio_to_baseline_steady_ci95_lo: None,
+            ratio_to_baseline_steady_ci95_hi: None,
         })
+    }
+
+    /// Fills the ratio columns from this block's rows and the baseline's (same scene, count, frames, rounds).
+    pub fn set_ratios(
+        &mut self,
+        baseline: &str,
+        rows: &[FrameRecord],
+        baseline_rows: &[FrameRecord],
+    ) {
+        let r = PairedRatios::new(rows, baseline_rows);
+        self.baseline = Some(baseline.to_string());
+        let split = |x: Option<Ratio>| {
+            (
+                x.map(|x| x.ratio),
+                x.and_then(|x| x.ci95.map(|c| c.0)),
+                x.and_then(|x| x.ci95.map(|c| c.1)),
+            )
+        };
+        (
+            self.ratio_to_baseline,
+            self.ratio_to_baseline_ci95_lo,
+            self.ratio_to_baseline_ci95_hi,
+        ) = split(r.all);
+        (
+            self.ratio_to_baseline_transition,
+            self.ratio_to_baseline_transition_ci95_lo,
+            self.ratio_to_baseline_transition_ci95_hi,
+        ) = split(r.transition);
+        (
+            self.ratio_to_baseline_steady,
+            self.ratio_to_baseline_steady_ci95_lo,
+            self.ratio_to_baseline_steady_ci95_hi,
+        ) = split(r.steady);
+    }
+}
+
+/// Which frames of a round a per-round median is taken over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameSet {
+    All,
+    /// Frames with an instance in transition.
+    Transition,
+    /// Frames without.
+    Steady,
+}
+
+impl FrameSet {
+    fn holds(self, r: &FrameRecord) -> bool {
+        match self {
+            FrameSet::All => true,
+            FrameSet::Transition => r.t_instances > 0,
+            FrameSet::Steady => r.t_instances == 0,
+        }
+    }
+}
+
+/// The time a ratio is taken of: gpu_ms when every frame of both blocks has one, else cpu_ms.
+fn frame_time(r: &FrameRecord, gpu: bool) -> f64 {
+    if gpu {
+        r.gpu_ms.unwrap_or(f64::NAN)
+    } else {
+        r.cpu_ms
+    }
+}
+
+/// Per round, the median frame time over the round's frames of `set` (None where the round has none).
+pub fn round_medians(rows: &[FrameRecord], set: FrameSet, gpu: bool) -> Vec<Option<f64>> {
+    let rounds = rows.iter().map(|r| r.round + 1).max().unwrap_or(0) as usize;
+    let mut per: Vec<Vec<f64>> = vec![Vec::new(); rounds];
+    for r in rows.iter().filter(|r| set.holds(r)) {
+        per[r.round as usize].push(frame_time(r, gpu));
+    }
+    per.iter().map(|v| percentile(v, 50.0)).collect()
+}
+
+/// A paired ratio: the geometric mean over rounds of (method's round median / baseline's round median), and
+/// its Student-t 95 % interval over rounds ([`crate::stats::paired_log_ratio`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ratio {
+    pub ratio: f64,
+    pub ci95: Option<(f64, f64)>,
+    /// Rounds that held frames of the set in both blocks.
+    pub rounds: usize,
+}
+
+/// A method's time over the baseline's: over all frames, over frames in transition, over steady frames.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairedRatios {
+    pub all: Option<Ratio>,
+    pub transition: Option<Ratio>,
+    pub steady: Option<Ratio>,
+}
+
+impl PairedRatios {
+    pub fn new(rows: &[FrameRecord], baseline: &[FrameRecord]) -> PairedRatios {
+        let gpu = rows.iter().chain(baseline).all(|r| r.gpu_ms.is_some());
+        let ratio = |set| {
+            let (m, b) = (
+                round_medians(rows, set, gpu),
+                round_medians(baseline, set, gpu),
+            );
+            let logs: Vec<f64> = m
+                .iter()
+                .zip(&b)
+                .filter_map(|(m, b)| Some((m.as_ref()? / b.as_ref()?).ln()))
+                .filter(|x| x.is_finite())
+                .collect();
+            let (mean, ci) = crate::stats::paired_log_ratio(&logs)?;
+            Some(Ratio {
+                ratio: mean.exp(),
+                ci95: ci.map(|(lo, hi)| (lo.exp(), hi.exp())),
+                rounds: logs.len(),
+            })
+        };
+        PairedRatios {
+            all: ratio(FrameSet::All),
+            transition: ratio(FrameSet::Transition),
+            steady: ratio(FrameSet::Steady),
+        }
     }
 }
 
@@ -304,6 +456,9 @@ pub struct BlockInfo {
     pub quality_pass_ms_per_frame: f64,
     /// quality_pass_ms_per_frame / timing_pass_ms_per_frame (2.0 is the floor: the reference doubles the work).
     pub quality_to_timing_ratio: f64,
+    /// quality_pass_ms_per_frame / (this method's + the reference's timing_pass_ms_per_frame): what the
+    /// quality pass costs over its two renders (1.0 would be a free metric).
+    pub quality_to_renders_ratio: Option<f64>,
     /// Median GPU time of the metric kernel alone per quality-pass frame (None without timestamps).
     pub metric_gpu_ms_median: Option<f64>,
     pub extra_target_bytes: u64,
@@ -311,6 +466,100 @@ pub struct BlockInfo {
     /// GPU (only the entries that changed since the previous upload into the same buffer range).
     pub instance_bytes_listed_per_frame: f64,
     pub instance_bytes_written_per_frame: f64,
+}
+
+/// The timing rounds of one scene block, as run.json records them (`timing_rounds`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct BlockRounds {
+    pub scene: String,
+    pub count: u32,
+    /// Seed of the rounds' shuffles (derived from `--seed` and the block's position).
+    pub seed: u64,
+    /// Frames rendered untimed after the `warmup` frames: each distinct transition's first frames.
+    pub warmup_transition_frames: Vec<u32>,
+    /// Methods timed in the rounds but not reported (the reference, timed for `quality_to_renders_ratio`).
+    pub timed_only: Vec<String>,
+    pub rounds: Vec<Round>,
+}
+
+/// One row of rounds.csv: one method's frames of one timing round, summarised, and paired with the baseline's
+/// same round: the data `ratio_to_baseline` and its interval are computed from.
+#[derive(Debug, Clone, Serialize, serde::Deserialize, PartialEq)]
+pub struct RoundRecord {
+    pub scene: String,
+    pub method: String,
+    pub count: u32,
+    pub round: u32,
+    /// 0-based place of the method in the round's order.
+    pub position: u32,
+    pub first_frame: u32,
+    pub end_frame: u32,
+    /// `gpu_ms` or `cpu_ms`: which frame time the medians are of.
+    pub time: String,
+    pub median_ms: Option<f64>,
+    pub median_ms_transition: Option<f64>,
+    pub median_ms_steady: Option<f64>,
+    pub baseline: Option<String>,
+    /// median_ms over the baseline's median_ms in the same round.
+    pub ratio_to_baseline: Option<f64>,
+}
+
+/// The rows of rounds.csv for one block: `blocks` each method's frame records (in any order).
+pub fn round_records(
+    blocks: &[Vec<FrameRecord>],
+    info: &BlockRounds,
+    baseline: Option<&str>,
+) -> Vec<RoundRecord> {
+    let all: Vec<&FrameRecord> = blocks.iter().flatten().collect();
+    let gpu = all.iter().all(|r| r.gpu_ms.is_some());
+    let medians = |rows: &[FrameRecord], set| round_medians(rows, set, gpu);
+    let base = baseline.and_then(|b| {
+        blocks
+            .iter()
+            .find(|rows| rows.first().is_some_and(|r| r.method == b))
+            .map(|rows| medians(rows, FrameSet::All))
+    });
+    let mut out = Vec::new();
+    for rows in blocks {
+        let Some(first) = rows.first() else { continue };
+        let (m, t, st) = (
+            medians(rows, FrameSet::All),
+            medians(rows, FrameSet::Transition),
+            medians(rows, FrameSet::Steady),
+        );
+        for round in &info.rounds {
+            let r = round.round as usize;
+            let at = |v: &[Option<f64>]| v.get(r).copied().flatten();
+            out.push(RoundRecord {
+                scene: first.scene.clone(),
+                method: first.method.clone(),
+                count: first.count,
+                round: round.round,
+                position: round
+                    .order
+                    .iter()
+                    .position(|l| *l == first.method)
+                    .unwrap_or(0) as u32,
+                first_frame: round.frames[0],
+                end_frame: round.frames[1],
+                time: if gpu { "gpu_ms" } else { "cpu_ms" }.into(),
+                median_ms: at(&m),
+                median_ms_transition: at(&t),
+                median_ms_steady: at(&st),
+                baseline: base.as_ref().and(baseline.map(str::to_string)),
+                ratio_to_baseline: base.as_ref().and_then(|b| Some(at(&m)? / at(b)?)),
+            });
+        }
+    }
+    out
+}
+
+/// One timing round: its frames `[first, end)` and the order the methods were timed in.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Round {
+    pub round: u32,
+    pub frames: [u32; 2],
+    pub order: Vec<String>,
 }
 
 #[cfg(test)]
@@ -332,11 +581,86 @@ pub(crate) mod tests {
             rmse,
             pop,
             lodpop: 0.0,
-            de2000_mean: rmse / 2.0,
+            de2000_mean: Some(rmse / 2.0),
             flip_mean: None,
             combine_gpu_ms: None,
             lag_rmse: None,
+            round: 0,
         }
+    }
+
+    /// Rows of `rounds` rounds of `per_round` frames, frame f in transition when `transition(f)`, timed
+    /// `time(round, f)`.
+    fn timed_rows(
+        rounds: u32,
+        per_round: u32,
+        transition: impl Fn(u32) -> bool,
+        time: impl Fn(u32, u32) -> f64,
+    ) -> Vec<FrameRecord> {
+        (0..rounds * per_round)
+            .map(|f| FrameRecord {
+                t_instances: transition(f) as u32,
+                round: f / per_round,
+                ..row(f, Some(time(f / per_round, f)), 0.0, 0.0)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn paired_ratios_cancel_drift_between_rounds() {
+        // The machine slows down round by round; the method costs 1.5x the baseline on transition frames and
+        // the same elsewhere. Paired by round, the drift cancels exactly.
+        let drift = |r: u32| 1.0 + 0.3 * r as f64;
+        let tr = |f: u32| f.is_multiple_of(4);
+        let base = timed_rows(6, 8, tr, |r, _| drift(r));
+        let method = timed_rows(6, 8, tr, |r, f| drift(r) * if tr(f) { 1.5 } else { 1.0 });
+        let p = PairedRatios::new(&method, &base);
+        let (all, t, s) = (p.all.unwrap(), p.transition.unwrap(), p.steady.unwrap());
+        assert!((t.ratio - 1.5).abs() < 1e-12 && (s.ratio - 1.0).abs() < 1e-12);
+        assert!(
+            (all.ratio - 1.0).abs() < 1e-12,
+            "the median frame is steady"
+        );
+        assert_eq!((all.rounds, t.rounds), (6, 6));
+        // No spread between rounds: the interval is the point.
+        let (lo, hi) = t.ci95.unwrap();
+        assert!((lo - 1.5).abs() < 1e-9 && (hi - 1.5).abs() < 1e-9);
+        // A method measured against itself is 1 with an interval around it.
+        let noisy = timed_rows(6, 8, tr, |r, f| {
+            drift(r) * (1.0 + 0.01 * ((f * 7) % 5) as f64)
+        });
+        let aa = PairedRatios::new(&noisy, &base).all.unwrap();
+        let (lo, hi) = aa.ci95.unwrap();
+        assert!(lo < aa.ratio && aa.ratio < hi, "{aa:?}");
+    }
+
+    #[test]
+    fn ratios_fall_back_to_cpu_time_and_skip_rounds_without_the_frames() {
+        // Only round 0 holds transition frames: a ratio but no interval.
+        let base: Vec<FrameRecord> = timed_rows(3, 4, |f| f < 2, |_, _| 1.0)
+            .into_iter()
+            .map(|r| FrameRecord {
+                gpu_ms: None,
+                cpu_ms: 2.0,
+                ..r
+            })
+            .collect();
+        let method: Vec<FrameRecord> = base
+            .iter()
+            .map(|r| FrameRecord {
+                cpu_ms: 3.0,
+                ..r.clone()
+            })
+            .collect();
+        let p = PairedRatios::new(&method, &base);
+        let t = p.transition.unwrap();
+        assert_eq!((t.ratio, t.ci95, t.rounds), (1.5, None, 1));
+        assert_eq!(p.all.unwrap().rounds, 3);
+        let mut s = SummaryRecord::from_frames(&method, 0, 1).unwrap();
+        s.set_ratios("discrete", &method, &base);
+        assert_eq!(s.rounds, 3);
+        assert_eq!(s.ratio_to_baseline, Some(1.5));
+        assert_eq!(s.baseline.as_deref(), Some("discrete"));
     }
 
     #[test]
@@ -381,7 +705,7 @@ pub(crate) mod tests {
             .collect();
         let s_no_gpu = SummaryRecord::from_frames(&no_gpu, 0, 7).unwrap();
         assert_eq!(s_no_gpu.gpu_ms_median, None);
-        assert_eq!(s_no_gpu.gpu_ms_median_ci95_lo, None);
+        assert_eq!(s_no_gpu.gpu_ms_median_steady, None);
         // The intervals hold the statistic, and are the same for the same seed.
         assert!(s.rmse_mean_ci95_lo <= s.rmse_mean && s.rmse_mean <= s.rmse_mean_ci95_hi);
         assert_eq!(s, SummaryRecord::from_frames(&rows, 0, 7).unwrap());

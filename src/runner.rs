@@ -3,13 +3,13 @@
 
 use crate::config::RunConfig;
 use crate::error::{Error, Result};
-use crate::export::csv::{write_summary, write_transitions, FramesWriter};
+use crate::export::csv::{write_rounds, write_summary, write_transitions, FramesWriter};
 use crate::export::manifest::{now_rfc3339, RunManifest, RunStatus};
 use crate::export::png::FrameDumper;
 use crate::gpu::GpuContext;
-use crate::measure::{BlockRunner, MethodSetup};
+use crate::measure::{BlockRunner, MethodSetup, QualityOptions};
 use crate::methods::Registry;
-use crate::records::{BlockInfo, SummaryRecord};
+use crate::records::{round_records, BlockInfo, FrameRecord, SummaryRecord};
 use crate::scene::SceneDef;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -51,6 +51,7 @@ pub fn prepare_output(dir: &Path) -> Result<()> {
         "frames.csv",
         "summary.csv",
         "transitions.csv",
+        "rounds.csv",
         "frames.csv.partial",
     ] {
         let p = dir.join(stale);
@@ -130,13 +131,20 @@ fn run_blocks(
     let mut summaries = Vec::new();
     let mut transitions = Vec::new();
 
+    // Per block: every method's warm-up, timed and quality frames, and the reference's warm-up and timed frames
+    // when it is timed without being reported.
+    let timed_only = !cfg
+        .methods
+        .iter()
+        .any(|m| crate::methods::base_name(m) == "reference") as u64;
     let total: u64 = defs
         .iter()
         .map(|d| {
             let pv = cfg.resolved(d.kind);
+            let (warmup, frames) = (pv.warmup as u64, pv.frames as u64);
             d.counts.len() as u64
-                * cfg.methods.len() as u64
-                * (pv.warmup as u64 + 2 * pv.frames as u64)
+                * (cfg.methods.len() as u64 * (warmup + 2 * frames)
+                    + timed_only * (warmup + frames))
         })
         .sum();
     let progress = ProgressBar::new(total);
@@ -147,6 +155,8 @@ fn run_blocks(
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
 
+    let mut rounds = Vec::new();
+    let mut block_index = 0u64;
     for def in defs {
         let warmup = cfg.resolved(def.kind).warmup;
         for &count in &def.counts {
@@ -156,25 +166,46 @@ fn run_blocks(
                 options: cfg.method_options,
                 seed: cfg.seed,
             };
-            let flip = cfg.metrics.contains(&crate::metrics::Metric::Flip);
-            let mut block = BlockRunner::new(&ctx, &scene, setup, dumper.is_some(), flip)?;
+            let quality = QualityOptions {
+                metrics: cfg.metrics.clone(),
+                reduction: cfg.metric_reduction,
+            };
+            let mut block = BlockRunner::new(&ctx, &scene, setup, dumper.is_some(), &quality)?;
             block.dump_transitions_only(cfg.dump_transitions);
-            for method in &cfg.methods {
-                progress.set_message(format!("{} n={} {}", def.name(), count, method));
-                let out = block.run_method(
-                    method,
-                    warmup,
+            progress.set_message(format!("{} n={} timing rounds", def.name(), count));
+            // Each block's shuffles have their own seed, derived from --seed and the block's position.
+            block_index += 1;
+            let rounds_seed = crate::rng::SplitMix64::new(cfg.seed ^ 0x524F_554E_4453)
+                .next_u64()
+                .wrapping_add(block_index);
+            let (timed, block_rounds) =
+                block.time_methods(&cfg.methods, warmup, cfg.rounds, rounds_seed, &progress)?;
+            let reference_ms = timed
+                .iter()
+                .find(|t| t.label == "reference")
+                .map(|t| t.ms_per_frame());
+            let mut block_rows: Vec<Vec<FrameRecord>> = Vec::new();
+            let mut extras = Vec::new();
+            for m in timed {
+                if block_rounds.timed_only.contains(&m.label) {
+                    continue;
+                }
+                let method = m.label.clone();
+                progress.set_message(format!("{} n={} {} quality", def.name(), count, method));
+                let out = block.measure_quality(
+                    m,
+                    reference_ms,
                     cfg.dump_every,
                     &progress,
-                    |f, (m, r, x)| match &dumper {
+                    |f, (mi, r, x)| match &dumper {
                         Some(d) => d.write(
                             scene.name(),
-                            method,
+                            &method,
                             count,
                             f,
                             scene.width,
                             scene.height,
-                            m,
+                            mi,
                             r,
                             x,
                         ),
@@ -183,28 +214,47 @@ fn run_blocks(
                 )?;
                 frames_csv.write_block(&out.rows)?;
                 transitions.extend(out.transitions);
-                // Each block's bootstrap has its own seed, derived from --seed and the block's position.
-                let block_seed = cfg.seed.wrapping_add(summaries.len() as u64 + 1);
-                let extra = out.info.extra_target_bytes;
-                if let Some(s) = SummaryRecord::from_frames(&out.rows, extra, block_seed) {
-                    summaries.push(s);
-                }
+                extras.push(out.info.extra_target_bytes);
+                block_rows.push(out.rows);
                 manifest.blocks.push(out.info);
                 manifest.write(out_dir)?;
             }
+            let baseline_rows = cfg.baseline.as_ref().and_then(|b| {
+                block_rows
+                    .iter()
+                    .find(|r| r.first().is_some_and(|r| &r.method == b))
+            });
+            for (rows, extra) in block_rows.iter().zip(extras) {
+                // Each block's bootstrap has its own seed, derived from --seed and the block's position.
+                let block_seed = cfg.seed.wrapping_add(summaries.len() as u64 + 1);
+                if let Some(mut s) = SummaryRecord::from_frames(rows, extra, block_seed) {
+                    if let (Some(b), Some(base)) = (&cfg.baseline, baseline_rows) {
+                        s.set_ratios(b, rows, base);
+                    }
+                    summaries.push(s);
+                }
+            }
+            rounds.extend(round_records(
+                &block_rows,
+                &block_rounds,
+                cfg.baseline.as_deref(),
+            ));
+            manifest.timing_rounds.push(block_rounds);
+            manifest.write(out_dir)?;
         }
     }
     progress.finish_and_clear();
     frames_csv.finish()?;
     write_summary(out_dir, &summaries)?;
     write_transitions(out_dir, &transitions)?;
+    write_rounds(out_dir, &rounds)?;
     Ok(summaries)
 }
 
 /// The table printed at the end of a run.
 pub fn summary_table(s: &RunSummary) -> String {
     let mut out = format!(
-        "{:<12} {:<15} {:>5} {:>6} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>10} {:>7}\n",
+        "{:<12} {:<15} {:>5} {:>6} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>10} {:>5} {}\n",
         "scene",
         "method",
         "count",
@@ -216,7 +266,8 @@ pub fn summary_table(s: &RunSummary) -> String {
         "rmse_max",
         "pop_max",
         "lodpop_max",
-        "q/t"
+        "q/r",
+        "ratio [95% CI]"
     );
     let fmt_opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.3}"));
     for r in &s.summaries {
@@ -224,9 +275,19 @@ pub fn summary_table(s: &RunSummary) -> String {
             .blocks
             .iter()
             .find(|b| b.scene == r.scene && b.method == r.method && b.count == r.count)
-            .map_or(f64::NAN, |b| b.quality_to_timing_ratio);
+            .and_then(|b| b.quality_to_renders_ratio)
+            .unwrap_or(f64::NAN);
+        let paired = match (
+            r.ratio_to_baseline,
+            r.ratio_to_baseline_ci95_lo,
+            r.ratio_to_baseline_ci95_hi,
+        ) {
+            (Some(x), Some(lo), Some(hi)) => format!("{x:.3} [{lo:.3}, {hi:.3}]"),
+            (Some(x), _, _) => format!("{x:.3}"),
+            _ => "-".into(),
+        };
         out.push_str(&format!(
-            "{:<12} {:<15} {:>5} {:>6} {:>9} {:>9.3} {:>10.0} {:>9.5} {:>9.5} {:>9.5} {:>10.5} {:>7.2}\n",
+            "{:<12} {:<15} {:>5} {:>6} {:>9} {:>9.3} {:>10.0} {:>9.5} {:>9.5} {:>9.5} {:>10.5} {:>5.2} {}\n",
             r.scene,
             r.method,
             r.count,
@@ -238,9 +299,15 @@ pub fn summary_table(s: &RunSummary) -> String {
             r.rmse_max,
             r.pop_max,
             r.lodpop_max,
-            ratio
+            ratio,
+            paired
         ));
     }
-    out.push_str("gpu_ms and cpu_ms are medians; q/t = quality-pass time per frame / timing-pass time per frame\n");
+    let baseline = s.summaries.iter().find_map(|r| r.baseline.clone());
+    out.push_str(&format!(
+        "gpu_ms and cpu_ms are medians; q/r = quality-pass time per frame / (method's + reference's timing-pass time \
+         per frame); ratio = time over {}'s, paired by timing round, geometric mean and 95 % t interval over rounds\n",
+        baseline.as_deref().unwrap_or("the baseline (none run)")
+    ));
     out
 }

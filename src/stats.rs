@@ -39,6 +39,39 @@ pub fn bootstrap_ci(
     Some((percentile(&stats, 2.5)?, percentile(&stats, 97.5)?))
 }
 
+/// Student's t quantile 0.975 for `df` degrees of freedom (exact table to 30, then 1.96 + 2.4 / df, within
+/// 0.002 of the exact value).
+pub fn t975(df: usize) -> f64 {
+    const T: [f64; 30] = [
+        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+        2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+        2.052, 2.048, 2.045, 2.042,
+    ];
+    match df {
+        0 => f64::INFINITY,
+        1..=30 => T[df - 1],
+        _ => 1.96 + 2.4 / df as f64,
+    }
+}
+
+/// Mean of per-round log ratios and its Student-t 95 % interval (None with fewer than two rounds): the rounds
+/// are the independent units (consecutive frames are not), and with the 10 or so rounds of a run a t interval
+/// keeps its coverage where a percentile bootstrap over rounds runs narrow (docs/measurement.md, "Paired
+/// ratios"). None for no rounds.
+pub fn paired_log_ratio(logs: &[f64]) -> Option<(f64, Option<(f64, f64)>)> {
+    let n = logs.len();
+    if n == 0 {
+        return None;
+    }
+    let m = logs.iter().sum::<f64>() / n as f64;
+    if n < 2 {
+        return Some((m, None));
+    }
+    let var = logs.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1) as f64;
+    let half = t975(n - 1) * (var / n as f64).sqrt();
+    Some((m, Some((m - half, m + half))))
+}
+
 /// Mean of `values`; 0 for none.
 pub fn mean(values: impl Iterator<Item = f64>) -> f64 {
     let (s, n) = values.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
@@ -52,6 +85,19 @@ pub fn mean(values: impl Iterator<Item = f64>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn t_interval_matches_a_hand_computation() {
+        // logs 0.1, 0.2, 0.3: mean 0.2, sd 0.1, half-width t(2) * 0.1 / sqrt(3).
+        let (m, ci) = paired_log_ratio(&[0.1, 0.2, 0.3]).unwrap();
+        let half = 4.303 * 0.1 / 3f64.sqrt();
+        let (lo, hi) = ci.unwrap();
+        assert!((m - 0.2).abs() < 1e-12 && (lo - (0.2 - half)).abs() < 1e-12);
+        assert!((hi - (0.2 + half)).abs() < 1e-12);
+        assert_eq!(paired_log_ratio(&[0.5]), Some((0.5, None)));
+        assert_eq!(paired_log_ratio(&[]), None);
+        assert!((t975(60) - 2.000).abs() < 0.002 && (t975(120) - 1.980).abs() < 0.002);
+    }
 
     #[test]
     fn percentile_interpolates_like_numpy() {

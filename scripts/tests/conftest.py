@@ -1,4 +1,5 @@
 """Fixtures shared by the tests of scripts/: small lodbench runs on whatever adapter the machine has."""
+import functools
 import os
 import subprocess
 from pathlib import Path
@@ -8,18 +9,17 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 
 
+@functools.lru_cache(maxsize=1)
 def lodbench_binary() -> Path:
+    """LODBENCH_BIN, or the binary `cargo test` builds (target/debug/lodbench, the README's test command builds it
+    just before pytest), brought up to date with `cargo test --no-run` (the same build, a no-op when fresh), so the
+    scripts are never tested against an older or a release binary."""
     if os.environ.get("LODBENCH_BIN"):
         return Path(os.environ["LODBENCH_BIN"])
     target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
     if not target.is_absolute():
         target = ROOT / target
-    # The newest of the two builds: the README's test command builds debug (cargo test) just before pytest, and a
-    # release build made since is newer still; an older one of either would test stale code.
-    built = [p for p in (target / "debug" / "lodbench", target / "release" / "lodbench") if p.is_file()]
-    if built:
-        return max(built, key=lambda p: p.stat().st_mtime)
-    subprocess.run(["cargo", "build", "--quiet"], cwd=ROOT, check=True)
+    subprocess.run(["cargo", "test", "--no-run", "--quiet"], cwd=ROOT, check=True, capture_output=True)
     return target / "debug" / "lodbench"
 
 
@@ -29,11 +29,11 @@ def lodbench(*args: str) -> None:
 
 @pytest.fixture(scope="session")
 def dump(tmp_path_factory) -> Path:
-    """bunny-sweep, discrete, dither and fsi (a method name containing `_f`), 60 frames at 160x120, every 5th frame
-    dumped."""
+    """bunny-sweep, discrete, dither and fsi (a method name containing `_f`), 60 frames at 160x120 with de2000, every
+    5th frame dumped."""
     out = tmp_path_factory.mktemp("dump") / "run"
     lodbench("run", "--scene", "bunny-sweep", "--method", "discrete,dither,fsi", "--width", "160", "--height", "120",
-             "--frames", "60", "--warmup", "0", "--switch-distances", "14,16,18", "--dump-frames",
+             "--frames", "60", "--warmup", "0", "--switch-distances", "14,16,18", "--metrics", "rmse,pop,de2000", "--dump-frames",
              "--dump-every", "5", "--out", str(out))
     return out
 

@@ -20,6 +20,7 @@ def test_fresh_dump_passes(dump):
     r = check(dump)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "0 differ" in r.stdout
+    assert "(0 with de2000_mean)" not in r.stdout, r.stdout
     # Not vacuous: some checked frames really differ from the reference.
     with open(dump / "frames.csv", newline="") as f:
         assert any(float(r["de2000_mean"]) > 0.01 for r in csv.DictReader(f))

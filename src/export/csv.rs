@@ -3,13 +3,14 @@
 //! an interrupted run keeps what it measured without leaving a file that looks complete.
 
 use crate::error::{Error, Result};
-use crate::records::{FrameRecord, SummaryRecord, TransitionRecord};
+use crate::records::{FrameRecord, RoundRecord, SummaryRecord, TransitionRecord};
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
 pub const FRAMES_CSV: &str = "frames.csv";
 pub const SUMMARY_CSV: &str = "summary.csv";
 pub const TRANSITIONS_CSV: &str = "transitions.csv";
+pub const ROUNDS_CSV: &str = "rounds.csv";
 pub const PARTIAL_SUFFIX: &str = ".partial";
 
 /// Appends frame rows to `frames.csv.partial`; `finish` renames it to `frames.csv`.
@@ -74,6 +75,11 @@ pub fn write_transitions(dir: &Path, rows: &[TransitionRecord]) -> Result<PathBu
     write_whole(dir, TRANSITIONS_CSV, rows)
 }
 
+/// Writes rounds.csv (whole or not at all).
+pub fn write_rounds(dir: &Path, rows: &[RoundRecord]) -> Result<PathBuf> {
+    write_whole(dir, ROUNDS_CSV, rows)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,7 +93,7 @@ mod tests {
         assert!(!dir.path().join(FRAMES_CSV).exists());
         let partial = std::fs::read_to_string(dir.path().join("frames.csv.partial")).unwrap();
         assert!(partial.starts_with(
-            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,t_instances,lod_mean,rmse,pop,lodpop,de2000_mean,flip_mean,combine_gpu_ms,lag_rmse\n"
+            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,t_instances,lod_mean,rmse,pop,lodpop,de2000_mean,flip_mean,combine_gpu_ms,lag_rmse,round\n"
         ));
         assert!(
             partial.contains("s,m,1,0,,2.0,100,1,0,0.0,0.5,0.0"),

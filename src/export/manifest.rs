@@ -3,7 +3,7 @@
 use crate::config::RunConfig;
 use crate::error::{Error, Result};
 use crate::gpu::{AdapterSummary, TimingSource};
-use crate::records::BlockInfo;
+use crate::records::{BlockInfo, BlockRounds};
 use crate::scene::SceneDescription;
 use serde::Serialize;
 use std::path::Path;
@@ -37,6 +37,8 @@ pub struct RunManifest {
     pub config: RunConfig,
     pub scenes: Vec<SceneDescription>,
     pub blocks: Vec<BlockInfo>,
+    /// Per scene block: the timing rounds' frames and method orders (`--rounds`, shuffled from `--seed`).
+    pub timing_rounds: Vec<BlockRounds>,
 }
 
 pub fn now_rfc3339() -> String {
@@ -60,6 +62,7 @@ impl RunManifest {
             config,
             scenes: Vec::new(),
             blocks: Vec::new(),
+            timing_rounds: Vec::new(),
         }
     }
 

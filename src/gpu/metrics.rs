@@ -4,7 +4,7 @@
 use crate::error::Result;
 use crate::gpu::context::GpuContext;
 use crate::gpu::targets::RenderTarget;
-use crate::metrics::FrameMetrics;
+use crate::metrics::{FrameMetrics, MetricReduction};
 
 pub const METRICS_WGSL: &str = include_str!("../../shaders/metrics.wgsl");
 
@@ -20,12 +20,14 @@ pub struct MetricKernel {
 }
 
 impl MetricKernel {
-    /// Compares `method` against `reference` (both the same size) over up to `frames` frames.
+    /// Compares `method` against `reference` (both the same size) over up to `frames` frames; `de2000`: also
+    /// the mean CIEDE2000 (else it reads 0); `reduction`: how a row's partial sums are added.
     pub fn new(
         ctx: &GpuContext,
-        method: &RenderTarget,
-        reference: &RenderTarget,
+        (method, reference): (&RenderTarget, &RenderTarget),
         frames: u32,
+        de2000: bool,
+        reduction: MetricReduction,
     ) -> Result<MetricKernel> {
         let device = &ctx.device;
         let (width, height) = (method.width, method.height);
@@ -39,7 +41,16 @@ impl MetricKernel {
             layout: None,
             module: &module,
             entry_point: Some("main"),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &[
+                    ("DE2000", de2000 as u32 as f64),
+                    (
+                        "WORKGROUP_REDUCE",
+                        (reduction == MetricReduction::Workgroup) as u32 as f64,
+                    ),
+                ],
+                ..Default::default()
+            },
             cache: None,
         });
         let prev_error = device.create_buffer(&wgpu::BufferDescriptor {

@@ -932,7 +932,8 @@ impl Method for Fsi {
         };
         gpu.queue
             .write_buffer(&self.combine_uniform, 0, bytemuck::bytes_of(&raw));
-        let timer = self.combine_timer.as_ref().filter(|_| input.timed);
+        // Timed in the quality pass only: the timing pass's frames hold nothing but the method's own work.
+        let timer = self.combine_timer.as_ref().filter(|_| !input.timed);
         if let Some(t) = timer {
             t.begin(encoder, f);
         }

@@ -127,17 +127,27 @@ impl Registry {
         self.entries.iter().map(|e| e.name).collect()
     }
 
-    /// The method called `name`, or an error listing the valid names.
+    /// The method called `name` (a run's label `NAME#k` names NAME), or an error listing the valid names.
     pub fn get(&self, name: &str) -> Result<&MethodEntry> {
+        let base = base_name(name);
         self.entries
             .iter()
-            .find(|e| e.name == name)
+            .find(|e| e.name == base)
             .ok_or_else(|| Error::unknown("method", name, &self.names()))
     }
 
     /// Builds the method called `name`.
     pub fn create(&self, name: &str, build: &Build<'_>) -> Result<Box<dyn Method>> {
         (self.get(name)?.create)(build)
+    }
+}
+
+/// The method a run's label names: `discrete#2` (the second `discrete` of `--method discrete,discrete`) is
+/// `discrete`; any other label is itself.
+pub fn base_name(label: &str) -> &str {
+    match label.rsplit_once('#') {
+        Some((base, k)) if !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()) => base,
+        _ => label,
     }
 }
 

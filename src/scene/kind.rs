@@ -13,6 +13,9 @@ pub enum Profile {
     Quick,
     /// What CI runs on a software adapter.
     Ci,
+    /// The test suite's regression set: 96x72, paths short enough to render every scene with every method in
+    /// about a minute on a software adapter, long enough to pass through each scene's transitions.
+    Regress,
     /// The papers' sizes: 800x600, 3,600 timed frames, the full instance counts.
     Paper,
 }
@@ -130,6 +133,12 @@ impl SceneKind {
                 frames: frames(30, 120, 2400),
                 warmup: 10,
             },
+            Profile::Regress => ProfileValues {
+                width: 96,
+                height: 72,
+                frames: frames(3, 40, 240),
+                warmup: 2,
+            },
             Profile::Paper => ProfileValues {
                 width: 800,
                 height: 600,
@@ -149,15 +158,19 @@ impl SceneKind {
             (BunnySweep, _) => vec![1],
             (BunnyGrid, Quick) => vec![50],
             (BunnyGrid, Ci) => vec![50, 250],
+            (BunnyGrid, Regress) => vec![50],
             (BunnyGrid, Paper) => PAPER_COUNTS.to_vec(),
             (Simple, Quick) => vec![36],
             (Simple, Ci) => vec![64],
+            (Simple, Regress) => vec![36],
             (Simple, Paper) => vec![1000],
             (Windmills, Quick) => vec![9],
             (Windmills, Ci) => vec![16],
+            (Windmills, Regress) => vec![9],
             (Windmills, Paper) => vec![4000],
             (Trees, Quick) => vec![4],
             (Trees, Ci) => vec![6],
+            (Trees, Regress) => vec![3],
             (Trees, Paper) => vec![4000],
         }
     }

@@ -1,48 +1,14 @@
 //! Integration tests that render on a real adapter (Mesa lavapipe in CI) at small sizes.
 
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    reason = "a test or bench fails by panicking"
-)]
+use crate::common::{col, read_csv, run_config};
 
-mod common;
-
-use common::{col, read_csv};
-
-use clap::Parser;
 use indicatif::ProgressBar;
-use lodbench::cli::{Cli, Command};
-use lodbench::config::RunConfig;
 use lodbench::gpu::GpuContext;
-use lodbench::measure::BlockRunner;
+use lodbench::measure::{BlockRunner, QualityOptions};
 use lodbench::metrics::SequenceMetrics;
 use lodbench::runner;
-use lodbench::scene::{SceneConfig, SceneDef, SceneKind};
+use lodbench::scene::SceneKind;
 use std::path::Path;
-
-fn run_config(args: &[&str]) -> RunConfig {
-    let mut argv = vec!["lodbench", "run"];
-    argv.extend_from_slice(args);
-    match Cli::try_parse_from(argv).expect("flags parse").command {
-        Command::Run(r) => RunConfig::from_args(&r).expect("valid config"),
-        _ => unreachable!(),
-    }
-}
-
-/// A scene built from `describe`-style flags (the scene flags `run` shares).
-fn scene_from(args: &[&str]) -> lodbench::scene::Scene {
-    let mut argv = vec!["lodbench", "describe", "--scene", "bunny-sweep"];
-    argv.extend_from_slice(args);
-    let d = match Cli::try_parse_from(argv).expect("flags parse").command {
-        Command::Describe(d) => d,
-        _ => unreachable!(),
-    };
-    let cfg = SceneConfig::from_args(&d.scene_args).unwrap();
-    SceneDef::new(SceneKind::BunnySweep, &cfg)
-        .unwrap()
-        .instantiate(1)
-}
 
 /// Issue 2's "done means", on the ci profile: the three files; reference rows score 0; discrete scores 0 while
 /// LOD0 is shown and > 0 after the first switch; its pop peaks on switch frames.
@@ -152,6 +118,8 @@ fn same_flags_same_metrics() {
             "120",
             "--frames",
             "120",
+            "--metrics",
+            "rmse,pop,de2000",
             "--out",
             out.to_str().unwrap(),
         ]);
@@ -179,7 +147,7 @@ fn same_flags_same_metrics() {
             );
         }
         if method.starts_with("fsi") {
-            let lag = |rows: &Vec<common::Row>| -> Vec<String> {
+            let lag = |rows: &Vec<crate::common::Row>| -> Vec<String> {
                 rows.iter()
                     .filter(|r| r["method"] == method)
                     .map(|r| r["lag_rmse"].clone())
@@ -198,7 +166,7 @@ const DE2000_TOLERANCE: f64 = 1e-5;
 /// `DE2000_TOLERANCE`.
 #[test]
 fn gpu_metrics_match_cpu_oracle() {
-    let scene = scene_from(&[
+    let scene = crate::common::sweep_scene(&[
         "--width",
         "160",
         "--height",
@@ -209,7 +177,14 @@ fn gpu_metrics_match_cpu_oracle() {
         "12,16,20",
     ]);
     let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
-    let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true, false).unwrap();
+    let mut block = BlockRunner::new(
+        &ctx,
+        &scene,
+        Default::default(),
+        true,
+        &QualityOptions::with_de2000(),
+    )
+    .unwrap();
     let mut oracle = SequenceMetrics::new();
     let mut cpu = Vec::new();
     let out = block
@@ -243,7 +218,7 @@ fn gpu_metrics_match_cpu_oracle() {
         .rows
         .iter()
         .zip(&cpu)
-        .map(|(row, c)| (row.de2000_mean - c.de2000).abs())
+        .map(|(row, c)| (row.de2000_mean.unwrap() - c.de2000).abs())
         .fold(0.0, f64::max);
     println!("largest |gpu - cpu| de2000_mean: {de_diff:e}");
     assert!(
@@ -262,7 +237,7 @@ fn gpu_metrics_match_cpu_oracle() {
 /// Re-bless with `LODBENCH_BLESS=1 cargo test --test render snapshot`.
 #[test]
 fn snapshot_reference_frame() {
-    let scene = scene_from(&[
+    let scene = crate::common::sweep_scene(&[
         "--width",
         "160",
         "--height",
@@ -273,7 +248,8 @@ fn snapshot_reference_frame() {
         "20,30,40",
     ]);
     let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
-    let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true, false).unwrap();
+    let mut block =
+        BlockRunner::new(&ctx, &scene, Default::default(), true, &Default::default()).unwrap();
     let mut frame0 = None;
     block
         .run_method("reference", 0, 1, &ProgressBar::hidden(), |f, (m, _, _)| {
@@ -388,8 +364,12 @@ fn flip_metric_on_request() {
         }
     }
     assert!(differing > 0);
-    let rows = run_with("default", "rmse,pop,de2000");
+    let rows = run_with("default", "rmse,pop");
     assert!(rows.iter().all(|r| r["flip_mean"].is_empty()));
+    assert!(
+        rows.iter().all(|r| r["de2000_mean"].is_empty()),
+        "de2000 only when asked"
+    );
 }
 
 /// An experiment file with a viewport sweep: one run per value, merged CSVs with a `viewport` column.
@@ -495,4 +475,152 @@ fn snapshot_scenes_every_method() {
         problems.join("\n")
     );
     assert!(bless || checked == SceneKind::ALL.len() * lodbench::methods::BUILTIN.len());
+}
+
+/// A run of `methods` on a short bunny-sweep with `rounds` timing rounds and `seed`: its folder.
+fn timing_run(
+    dir: &Path,
+    name: &str,
+    methods: &str,
+    rounds: &str,
+    seed: &str,
+) -> std::path::PathBuf {
+    let out = dir.join(name);
+    let cfg = run_config(&[
+        "--scene",
+        "bunny-sweep",
+        "--method",
+        methods,
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "24",
+        "--warmup",
+        "1",
+        "--switch-distances",
+        "14,16,18",
+        "--rounds",
+        rounds,
+        "--seed",
+        seed,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    runner::run(&cfg).unwrap();
+    out
+}
+
+fn timing_rounds(out: &Path) -> serde_json::Value {
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    run["timing_rounds"].clone()
+}
+
+/// The timing rounds are recorded in run.json, cover the path in order, hold every method once each (plus the
+/// reference, timed for quality_to_renders_ratio), and their order is drawn from --seed: the same seed gives the
+/// same orders, another seed other orders. frames.csv's `round` column agrees with run.json.
+#[test]
+fn timing_rounds_are_seeded_and_recorded() {
+    let dir = tempfile::tempdir().unwrap();
+    let methods = "discrete,alpha,dither";
+    let a = timing_run(dir.path(), "a", methods, "6", "1");
+    let b = timing_run(dir.path(), "b", methods, "6", "1");
+    let c = timing_run(dir.path(), "c", methods, "6", "2");
+    let (ra, rb, rc) = (timing_rounds(&a), timing_rounds(&b), timing_rounds(&c));
+    assert_eq!(ra, rb, "same seed, same rounds");
+    let orders = |r: &serde_json::Value| -> Vec<Vec<String>> {
+        r[0]["rounds"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| serde_json::from_value(x["order"].clone()).unwrap())
+            .collect()
+    };
+    assert_ne!(orders(&ra), orders(&rc), "another seed, other orders");
+    let rounds = ra[0]["rounds"].as_array().unwrap();
+    assert_eq!(rounds.len(), 6);
+    assert_eq!(ra[0]["timed_only"], serde_json::json!(["reference"]));
+    // The warm-up rendered the first frames of the path's transitions, which are frames in transition.
+    let warm: Vec<u32> = serde_json::from_value(ra[0]["warmup_transition_frames"].clone()).unwrap();
+    let t_frames: Vec<u32> = read_csv(&a.join("frames.csv"))
+        .iter()
+        .filter(|r| r["method"] == "discrete" && r["t_instances"] != "0")
+        .map(|r| r["frame"].parse().unwrap())
+        .collect();
+    assert!(
+        !warm.is_empty() && t_frames.contains(&warm[0]),
+        "{warm:?} {t_frames:?}"
+    );
+    let mut next = 0;
+    for r in rounds {
+        let frames: [u32; 2] = serde_json::from_value(r["frames"].clone()).unwrap();
+        assert_eq!(frames[0], next, "rounds cover the path in order");
+        next = frames[1];
+        let mut order: Vec<String> = serde_json::from_value(r["order"].clone()).unwrap();
+        order.sort();
+        assert_eq!(order, ["alpha", "discrete", "dither", "reference"]);
+    }
+    assert_eq!(next, 24);
+    // Not every round in the same order.
+    assert!(orders(&ra).windows(2).any(|w| w[0] != w[1]));
+    let frames = read_csv(&a.join("frames.csv"));
+    for row in frames.iter().filter(|r| r["method"] == "alpha") {
+        let (f, round): (u32, usize) =
+            (row["frame"].parse().unwrap(), row["round"].parse().unwrap());
+        let span: [u32; 2] = serde_json::from_value(rounds[round]["frames"].clone()).unwrap();
+        assert!(span[0] <= f && f < span[1], "frame {f} in round {round}");
+    }
+    // rounds.csv: a row per method and round, paired with the baseline (discrete, the default).
+    let per_round = read_csv(&a.join("rounds.csv"));
+    assert_eq!(per_round.len(), 3 * 6);
+    assert!(per_round.iter().all(|r| r["baseline"] == "discrete"));
+    let d: Vec<&crate::common::Row> = per_round
+        .iter()
+        .filter(|r| r["method"] == "discrete")
+        .collect();
+    assert!(d.iter().all(|r| r["ratio_to_baseline"] == "1.0"));
+}
+
+/// `--method discrete,discrete` runs discrete twice, as `discrete` and `discrete#2`: two blocks everywhere, the
+/// same images (an A/A comparison differs only in time), and a paired ratio of the second over the first.
+#[test]
+fn a_method_listed_twice_runs_twice() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = timing_run(dir.path(), "aa", "discrete,discrete", "4", "1");
+    let summary = read_csv(&out.join("summary.csv"));
+    let methods: Vec<&str> = summary.iter().map(|r| r["method"].as_str()).collect();
+    assert_eq!(methods, ["discrete", "discrete#2"]);
+    let frames = read_csv(&out.join("frames.csv"));
+    for name in ["rmse", "pop", "lodpop", "triangles"] {
+        assert_eq!(
+            col(&frames, "discrete", name),
+            col(&frames, "discrete#2", name),
+            "{name}"
+        );
+    }
+    assert_eq!(col(&frames, "discrete#2", "rmse").len(), 24);
+    let second = &summary[1];
+    assert_eq!(second["baseline"], "discrete");
+    assert_eq!(second["rounds"], "4");
+    let ratio: f64 = second["ratio_to_baseline"].parse().unwrap();
+    let lo: f64 = second["ratio_to_baseline_ci95_lo"].parse().unwrap();
+    let hi: f64 = second["ratio_to_baseline_ci95_hi"].parse().unwrap();
+    assert!(lo <= ratio && ratio <= hi && ratio > 0.0);
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    let blocks: Vec<&str> = run["blocks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["method"].as_str().unwrap())
+        .collect();
+    assert_eq!(blocks, ["discrete", "discrete#2"]);
+    assert!(
+        run["blocks"][0]["quality_to_renders_ratio"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
 }

@@ -3,18 +3,8 @@
 //! k = 0 instead of k = 0.5), written against the public method API only; the registry line is in
 //! `registry_with_lod_to`. The run then measures it like any built-in method.
 
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    reason = "a test or bench fails by panicking"
-)]
+use crate::common::read_csv;
 
-mod common;
-
-use common::read_csv;
-
-use clap::Parser;
-use lodbench::cli::{Cli, Command};
 use lodbench::config::RunConfig;
 use lodbench::gpu::{DrawStats, RenderTarget, SceneGpu};
 use lodbench::methods::{FrameInput, Method, MethodEntry, OpaqueInstances, Registry};
@@ -59,8 +49,6 @@ fn a_method_added_with_one_registry_line_runs_like_a_builtin() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
     let argv = [
-        "lodbench",
-        "run",
         "--scene",
         "bunny-sweep",
         "--method",
@@ -76,9 +64,7 @@ fn a_method_added_with_one_registry_line_runs_like_a_builtin() {
         "--out",
         out,
     ];
-    let Command::Run(args) = Cli::try_parse_from(argv).unwrap().command else {
-        unreachable!()
-    };
+    let args = crate::common::run_args(&argv);
     // The built-in registry does not know the name; the extended one does.
     let err = RunConfig::from_args(&args).unwrap_err().to_string();
     assert!(err.contains("lod-to"), "{err}");

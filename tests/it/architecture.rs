@@ -3,12 +3,6 @@
 //! others. Test modules (`#[cfg(test)]`) are left out: they may import anything. docs/ARCHITECTURE.md shows the
 //! listing; `cargo test --test architecture -- --nocapture` prints it.
 
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    reason = "a test or bench fails by panicking"
-)]
-
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use syn::visit::Visit;

@@ -3,29 +3,12 @@
 //! smooth method below discrete at every transition of a bunny sweep; (d) the GPU kernel against the CPU
 //! oracle on dumped frames, for lodpop and FSI's lag_rmse; and fsi-sameframe, which has no lag, at lag 0.
 
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    reason = "a test or bench fails by panicking"
-)]
+use crate::common::{col, read_csv, run_into, Rows};
 
-mod common;
-
-use common::{col, read_csv, Rows};
-
-use clap::Parser;
-use lodbench::cli::{Cli, Command};
-use lodbench::config::RunConfig;
 use std::path::Path;
 
 fn run(out: &Path, args: &[&str]) -> Rows {
-    let mut argv = vec!["lodbench", "run", "--out", out.to_str().unwrap()];
-    argv.extend_from_slice(args);
-    let Command::Run(r) = Cli::try_parse_from(argv).unwrap().command else {
-        unreachable!()
-    };
-    lodbench::runner::run(&RunConfig::from_args(&r).unwrap()).unwrap();
-    read_csv(&out.join("frames.csv"))
+    read_csv(&run_into(out, args).join("frames.csv"))
 }
 
 const METHODS: &str =

@@ -2,22 +2,14 @@
 //! checked pixel by pixel against a CPU implementation of seed 000 sections 3.4-3.5 and eq. 2 that reads the
 //! same two LOD buffers (colour, depth, id) back from the GPU.
 
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    reason = "a test or bench fails by panicking"
-)]
-
-use clap::Parser;
 use glam::{Mat4, Vec3, Vec4};
 use indicatif::ProgressBar;
-use lodbench::cli::{Cli, Command};
 use lodbench::gpu::GpuContext;
 use lodbench::gpu::{RenderTarget, SceneGpu, TextureReadback};
 use lodbench::measure::{BlockRunner, FrameDriver};
 use lodbench::methods::fsi::{reprojection, Fsi, FsiCheck, LodBufferImage, Variant};
 use lodbench::methods::{Method, MethodOptions};
-use lodbench::scene::{Motion, Scene, SceneConfig, SceneDef, SceneKind};
+use lodbench::scene::{Motion, Scene, SceneDef, SceneKind};
 use std::sync::Arc;
 
 const W: u32 = 160;
@@ -27,14 +19,7 @@ const GREEN: [f32; 3] = [0.04, 0.8, 0.04];
 const BLUE: [f32; 3] = [0.04, 0.04, 0.8];
 const YELLOW: [f32; 3] = [0.8, 0.8, 0.04];
 
-fn scene_cfg(scene: &str, args: &[&str]) -> SceneConfig {
-    let mut argv = vec!["lodbench", "describe", "--scene", scene];
-    argv.extend_from_slice(args);
-    match Cli::try_parse_from(argv).expect("flags parse").command {
-        Command::Describe(d) => SceneConfig::from_args(&d.scene_args).unwrap(),
-        _ => unreachable!(),
-    }
-}
+use crate::common::scene_config as scene_cfg;
 
 /// Static bunnies at the given distances along the camera's axis, LOD j+1 beyond `switches[j]`, each LOD in
 /// its own colour (red, green, blue, yellow) so that the LODs can be told apart in the images.
@@ -370,7 +355,8 @@ fn a_no_transition_frames_match_discrete_bit_for_bit() {
         let scene = SceneDef::new(SceneKind::BunnySweep, &cfg)
             .unwrap()
             .instantiate(1);
-        let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true, false).unwrap();
+        let mut block =
+            BlockRunner::new(&ctx, &scene, Default::default(), true, &Default::default()).unwrap();
         let mut frames = std::collections::HashMap::new();
         for method in ["discrete", "fsi"] {
             let out = block
@@ -568,7 +554,8 @@ fn e_static_transitions_toggle_out_of_phase() {
     // drop to the coarser one on the same frame.
     let distances = [9.6, 9.7, 9.8, 9.9, 19.4, 19.7, 38.5, 39.4];
     let scene = static_scene(&distances, [10.0, 20.0, 40.0], 6, "fixed");
-    let mut block = BlockRunner::new(&ctx, &scene, Default::default(), true, false).unwrap();
+    let mut block =
+        BlockRunner::new(&ctx, &scene, Default::default(), true, &Default::default()).unwrap();
     let out = block
         .run_method("fsi", 0, 1, &ProgressBar::hidden(), |_, _| Ok(()))
         .unwrap();

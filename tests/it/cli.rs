@@ -1,11 +1,5 @@
 //! Bad input ends in one clear `error:` line and a non-zero exit, never a panic.
 
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    reason = "a test or bench fails by panicking"
-)]
-
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -280,4 +274,32 @@ fn dump_transitions_dumps_the_frames_around_transitions() {
     // Without --dump-frames the flag is refused, with one error line.
     let out = lodbench(&["run", "--dump-transitions"], &[]);
     fails_with(&out, &["--dump-frames"]);
+}
+
+/// `lodbench describe ... | true`: the reader is gone before lodbench writes (it builds the scene's LOD
+/// chains first); lodbench stops quietly, no panic.
+#[test]
+fn a_closed_stdout_is_no_panic() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lodbench"))
+        .args(["describe", "--scene", "windmills", "--profile", "ci"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+/// `--baseline` must name a method of the run; `--rounds 0` is no run.
+#[test]
+fn bad_timing_flags_are_rejected() {
+    let out = lodbench(
+        &["run", "--method", "alpha,fsi", "--baseline", "dither"],
+        &[],
+    );
+    fails_with(&out, &["--baseline dither", "alpha, fsi"]);
+    let out = lodbench(&["run", "--rounds", "0"], &[]);
+    fails_with(&out, &["--rounds"]);
 }

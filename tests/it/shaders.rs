@@ -1,12 +1,6 @@
 //! Every WGSL file in shaders/ must parse and validate with naga (errors shown with source locations), and the
 //! entry points the Rust side names must exist.
 
-#![allow(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    reason = "a test or bench fails by panicking"
-)]
-
 use std::path::Path;
 
 fn validate(path: &Path) -> naga::Module {
