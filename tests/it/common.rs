@@ -2,11 +2,13 @@
 //! user would type, one way to run it, and one CSV reader.
 
 use clap::Parser;
+use glam::Vec3;
 use lodbench::cli::{Cli, Command, RunArgs};
 use lodbench::config::RunConfig;
-use lodbench::scene::{Scene, SceneConfig, SceneDef, SceneKind};
+use lodbench::scene::{Motion, Scene, SceneConfig, SceneDef, SceneKind};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The flags of `lodbench run ARGS`, parsed as the binary parses them.
 pub fn run_args(args: &[&str]) -> RunArgs {
@@ -78,4 +80,69 @@ pub fn col(rows: &Rows, method: &str, name: &str) -> Vec<f64> {
                 .unwrap_or_else(|_| panic!("{name}={}", r[name]))
         })
         .collect()
+}
+
+/// Mean absolute difference (of 255, over R, G, B) and the fraction of pixels off by more than 16 in any
+/// channel, between two RGBA8 images of the same size.
+pub fn image_difference(a: &[u8], b: &[u8]) -> (f64, f64) {
+    let mut sum = 0u64;
+    let mut bad = 0usize;
+    for (p, q) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        let worst = (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap_or(0);
+        sum += (0..3).map(|c| p[c].abs_diff(q[c]) as u64).sum::<u64>();
+        bad += (worst > 16) as usize;
+    }
+    let pixels = a.len() / 4;
+    (sum as f64 / (pixels * 3) as f64, bad as f64 / pixels as f64)
+}
+
+pub const W: u32 = 160;
+pub const H: u32 = 120;
+pub const RED: [f32; 3] = [0.8, 0.04, 0.04];
+pub const GREEN: [f32; 3] = [0.04, 0.8, 0.04];
+pub const BLUE: [f32; 3] = [0.04, 0.04, 0.8];
+pub const YELLOW: [f32; 3] = [0.8, 0.8, 0.04];
+
+/// Static bunnies at the given distances along the camera's axis, LOD j+1 beyond `switches[j]`, each LOD in
+/// its own colour (red, green, blue, yellow) so that the LODs can be told apart in the images.
+pub fn static_scene(distances: &[f32], switches: [f32; 3], frames: u32, camera: &str) -> Scene {
+    let s = format!("{},{},{}", switches[0], switches[1], switches[2]);
+    let (w, h, f) = (W.to_string(), H.to_string(), frames.to_string());
+    let cfg = scene_config(
+        "bunny-grid",
+        &[
+            "--width",
+            &w,
+            "--height",
+            &h,
+            "--frames",
+            &f,
+            "--switch-distances",
+            &s,
+            "--count",
+            "1",
+            "--camera",
+            camera,
+        ],
+    );
+    let def = SceneDef::new(SceneKind::BunnyGrid, &cfg).unwrap();
+    let mut scene = def.instantiate(distances.len() as u32);
+    for (inst, &d) in scene.instances.iter_mut().zip(distances) {
+        inst.position = Vec3::new(d, 0.0, 0.0);
+    }
+    scene.motion = Motion::Static;
+    scene.far = distances.iter().fold(0.0f32, |a, &b| a.max(b)) * 2.0;
+    let mut models = scene.models.to_vec();
+    models[0].lod_colors = vec![RED, GREEN, BLUE, YELLOW];
+    scene.models = Arc::from(models);
+    scene
+}
+
+/// A distance that fits the whole bunny in view (the grid's first position with default switches).
+pub fn near_distance() -> f32 {
+    let cfg = scene_config("bunny-grid", &["--count", "1"]);
+    let d = SceneDef::new(SceneKind::BunnyGrid, &cfg)
+        .unwrap()
+        .instantiate(1);
+    d.instances[0].position.x
 }

@@ -2,68 +2,16 @@
 //! checked pixel by pixel against a CPU implementation of seed 000 sections 3.4-3.5 and eq. 2 that reads the
 //! same two LOD buffers (colour, depth, id) back from the GPU.
 
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec4};
 use indicatif::ProgressBar;
 use lodbench::gpu::GpuContext;
 use lodbench::gpu::{RenderTarget, SceneGpu, TextureReadback};
 use lodbench::measure::{BlockRunner, FrameDriver};
 use lodbench::methods::fsi::{reprojection, Fsi, FsiCheck, LodBufferImage, Variant};
 use lodbench::methods::{Method, MethodOptions};
-use lodbench::scene::{Motion, Scene, SceneDef, SceneKind};
-use std::sync::Arc;
+use lodbench::scene::{Scene, SceneDef, SceneKind};
 
-const W: u32 = 160;
-const H: u32 = 120;
-const RED: [f32; 3] = [0.8, 0.04, 0.04];
-const GREEN: [f32; 3] = [0.04, 0.8, 0.04];
-const BLUE: [f32; 3] = [0.04, 0.04, 0.8];
-const YELLOW: [f32; 3] = [0.8, 0.8, 0.04];
-
-use crate::common::scene_config as scene_cfg;
-
-/// Static bunnies at the given distances along the camera's axis, LOD j+1 beyond `switches[j]`, each LOD in
-/// its own colour (red, green, blue, yellow) so that the LODs can be told apart in the images.
-fn static_scene(distances: &[f32], switches: [f32; 3], frames: u32, camera: &str) -> Scene {
-    let s = format!("{},{},{}", switches[0], switches[1], switches[2]);
-    let (w, h, f) = (W.to_string(), H.to_string(), frames.to_string());
-    let cfg = scene_cfg(
-        "bunny-grid",
-        &[
-            "--width",
-            &w,
-            "--height",
-            &h,
-            "--frames",
-            &f,
-            "--switch-distances",
-            &s,
-            "--count",
-            "1",
-            "--camera",
-            camera,
-        ],
-    );
-    let def = SceneDef::new(SceneKind::BunnyGrid, &cfg).unwrap();
-    let mut scene = def.instantiate(distances.len() as u32);
-    for (inst, &d) in scene.instances.iter_mut().zip(distances) {
-        inst.position = Vec3::new(d, 0.0, 0.0);
-    }
-    scene.motion = Motion::Static;
-    scene.far = distances.iter().fold(0.0f32, |a, &b| a.max(b)) * 2.0;
-    let mut models = scene.models.to_vec();
-    models[0].lod_colors = vec![RED, GREEN, BLUE, YELLOW];
-    scene.models = Arc::from(models);
-    scene
-}
-
-/// A distance that fits the whole bunny in view (the grid's first position with default switches).
-fn near_distance() -> f32 {
-    let cfg = scene_cfg("bunny-grid", &["--count", "1"]);
-    let d = SceneDef::new(SceneKind::BunnyGrid, &cfg)
-        .unwrap()
-        .instantiate(1);
-    d.instances[0].position.x
-}
+use crate::common::{near_distance, scene_config as scene_cfg, static_scene, H, W};
 
 struct Frame {
     out: Vec<u8>,

@@ -17,3 +17,4 @@ mod registry;
 mod regress;
 mod render;
 mod shaders;
+mod variants;

@@ -7,14 +7,18 @@
 //!   `tri_alternation_max` exactly (they are integer counts and ratios of them, computed on the CPU), and
 //!   `rmse_mean`, `de2000_mean` (the same [`tolerance`]).
 //!
-//! And on the same run, what makes a smooth method smooth: identical to `discrete` outside transitions, and
-//! below discrete's lodpop at every transition of bunny-sweep.
+//! And on the same run (which dumps the frames around transitions), what makes a smooth method smooth: identical
+//! to `discrete` outside transitions, below discrete's lodpop at every transition of bunny-sweep, and, in an image,
+//! each method's frame of bunny-sweep and simple where a transition is nearest its middle (k = 0.5) against a
+//! blessed PNG (`tests/snapshots/transitions/`).
 //!
 //! Re-bless after an intended change: `LODBENCH_BLESS=1 cargo test --test it regress::` (then commit
 //! results/baseline/regress/). The full ci profile is a user command (`lodbench run --profile ci`) and the
 //! `ci_profile` module's ignored test.
 
-use crate::common::{read_csv, run_into, Row};
+use crate::common::{image_difference, read_csv, run_into, scene_config, Row};
+use lodbench::measure::FrameDriver;
+use lodbench::scene::{SceneDef, SceneKind};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -69,7 +73,14 @@ fn regress_run() -> &'static PathBuf {
         let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("regress");
         run_into(
             &out,
-            &["--profile", "regress", "--metrics", "rmse,pop,de2000"],
+            &[
+                "--profile",
+                "regress",
+                "--metrics",
+                "rmse,pop,de2000",
+                "--dump-frames",
+                "--dump-transitions",
+            ],
         )
     })
 }
@@ -262,4 +273,85 @@ fn smooth_methods_match_discrete_outside_transitions_and_pop_less() {
             );
         }
     }
+}
+
+/// The frame of `scene` (regress profile) where an instance in transition is nearest k = 0.5 (the first such
+/// frame), from the schedule alone.
+fn mid_transition_frame(scene: &str) -> u32 {
+    let kind = SceneKind::from_name(scene).unwrap();
+    let cfg = scene_config(scene, &["--profile", "regress"]);
+    let def = SceneDef::new(kind, &cfg).unwrap();
+    let count = kind.profile_counts(lodbench::scene::Profile::Regress)[0];
+    let s = def.instantiate(count);
+    let mut driver = FrameDriver::new(&s);
+    let mut best = (f32::INFINITY, 0);
+    for f in 0..s.frames {
+        driver.advance(f);
+        for st in driver.states.iter().filter(|st| st.in_transition()) {
+            let d = (st.k - 0.5).abs();
+            if d < best.0 {
+                best = (d, f);
+            }
+        }
+    }
+    assert!(
+        best.0 < 0.1,
+        "{scene}: no frame near the middle of a transition"
+    );
+    best.1
+}
+
+/// Every method's frame of bunny-sweep and simple in the middle of a transition (k nearest 0.5), against
+/// `tests/snapshots/transitions/<scene>_<method>.png`, with the tolerance of the other snapshots (mean absolute
+/// difference at most 0.5 of 255, at most 0.5 % of pixels off by more than 16: another rasteriser's edge pixels
+/// pass, a changed blend, pattern or LOD does not). Not vacuous: at that frame every smooth method's image
+/// differs from discrete's. Re-bless with `LODBENCH_BLESS=1 cargo test --test it regress::`.
+#[test]
+fn mid_transition_frames_match_snapshots() {
+    let snaps = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots/transitions");
+    let bless = std::env::var_os("LODBENCH_BLESS").is_some();
+    std::fs::create_dir_all(&snaps).unwrap();
+    let mut problems = Vec::new();
+    for scene in ["bunny-sweep", "simple"] {
+        let frame = mid_transition_frame(scene);
+        let count = SceneKind::from_name(scene)
+            .unwrap()
+            .profile_counts(lodbench::scene::Profile::Regress)[0];
+        let load = |method: &str| {
+            let stem = format!("{scene}_{method}_c{count}_f{frame:05}_method.png");
+            let path = regress_run().join("frames").join(&stem);
+            image::open(&path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .to_rgba8()
+        };
+        let discrete = load("discrete");
+        for method in lodbench::methods::names() {
+            let actual = load(method);
+            if method != "reference" && method != "discrete" && actual == discrete {
+                problems.push(format!(
+                    "{scene} {method}: frame {frame} is discrete's, pixel for pixel"
+                ));
+            }
+            let snap = snaps.join(format!("{scene}_{method}.png"));
+            if bless {
+                actual.save(&snap).unwrap();
+                continue;
+            }
+            let expected = image::open(&snap)
+                .unwrap_or_else(|e| panic!("{}: {e} (bless with LODBENCH_BLESS=1)", snap.display()))
+                .to_rgba8();
+            let (mean, bad) = image_difference(actual.as_raw(), expected.as_raw());
+            if mean > 0.5 || bad > 0.005 {
+                problems.push(format!(
+                    "{scene} {method} frame {frame}: mean {mean:.3}, {:.3} % off by > 16",
+                    bad * 100.0
+                ));
+            }
+        }
+    }
+    assert!(
+        problems.is_empty(),
+        "mid-transition frames differ:\n{}",
+        problems.join("\n")
+    );
 }

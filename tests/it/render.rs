@@ -1,6 +1,6 @@
 //! Integration tests that render on a real adapter (Mesa lavapipe in CI) at small sizes.
 
-use crate::common::{col, read_csv, run_config};
+use crate::common::{col, image_difference, read_csv, run_config};
 
 use indicatif::ProgressBar;
 use lodbench::gpu::GpuContext;
@@ -393,20 +393,6 @@ fn experiment_sweep_runs_and_merges() {
     assert_eq!(viewports, vec!["64,48", "64,48", "96,72", "96,72"]);
     assert_eq!(read_csv(&out.join("frames.csv")).len(), 2 * 2 * 4);
     assert!(out.join("experiment.json").is_file());
-}
-
-/// Mean absolute difference (of 255, over R, G, B) and the fraction of pixels off by more than 16 in any
-/// channel, between two RGBA8 images of the same size.
-fn image_difference(a: &[u8], b: &[u8]) -> (f64, f64) {
-    let mut sum = 0u64;
-    let mut bad = 0usize;
-    for (p, q) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
-        let worst = (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap_or(0);
-        sum += (0..3).map(|c| p[c].abs_diff(q[c]) as u64).sum::<u64>();
-        bad += (worst > 16) as usize;
-    }
-    let pixels = a.len() / 4;
-    (sum as f64 / (pixels * 3) as f64, bad as f64 / pixels as f64)
 }
 
 /// One frame of every scene at 96x72 per method against a blessed PNG (tests/snapshots/scenes/), with the
