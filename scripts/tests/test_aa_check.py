@@ -22,6 +22,19 @@ def aa_run(tmp_path_factory) -> Path:
     return out
 
 
+def rewrite(path: Path, keep=lambda row: True, change=lambda row: None) -> None:
+    """Rewrites the CSV at `path` with the rows `keep` keeps, each passed through `change` first."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    for r in rows:
+        change(r)
+    rows = [r for r in rows if keep(r)]
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+
+
 def run(*folders: Path) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, str(SCRIPT), *map(str, folders)], capture_output=True, text=True)
 
@@ -36,15 +49,12 @@ def test_fresh_aa_run_agrees(aa_run):
 def test_tampered_interval_is_caught(aa_run, tmp_path):
     copy = tmp_path / "tampered"
     shutil.copytree(aa_run, copy)
-    path = copy / "summary.csv"
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
-    second = next(r for r in rows if r["method"] == "discrete#2")
-    second["ratio_to_baseline_ci95_hi"] = str(float(second["ratio_to_baseline_ci95_hi"]) * 1.01)
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+
+    def widen(row):
+        if row["method"] == "discrete#2":
+            row["ratio_to_baseline_ci95_hi"] = str(float(row["ratio_to_baseline_ci95_hi"]) * 1.01)
+
+    rewrite(copy / "summary.csv", change=widen)
     r = run(copy)
     assert r.returncode == 1 and "discrete#2" in r.stderr, r.stdout + r.stderr
 
@@ -53,12 +63,6 @@ def test_a_run_without_aa_blocks_is_an_error(aa_run, tmp_path):
     copy = tmp_path / "single"
     shutil.copytree(aa_run, copy)
     for name in ("summary.csv", "rounds.csv", "frames.csv"):
-        path = copy / name
-        with open(path, newline="") as f:
-            rows = [r for r in csv.DictReader(f) if r["method"] != "discrete#2"]
-        with open(path, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0]))
-            w.writeheader()
-            w.writerows(rows)
+        rewrite(copy / name, keep=lambda row: row["method"] != "discrete#2")
     r = run(copy)
     assert r.returncode == 2 and "itself" in r.stderr, r.stdout + r.stderr

@@ -146,3 +146,27 @@ pub fn near_distance() -> f32 {
         .instantiate(1);
     d.instances[0].position.x
 }
+
+/// `actual` against the blessed PNG `snap` with the snapshots' tolerance (mean absolute difference at most 0.5 of
+/// 255 over R, G, B; at most 0.5 % of pixels off by more than 16 in a channel: another rasteriser's edge pixels
+/// pass, a changed shading, blend, pattern or LOD does not). With `LODBENCH_BLESS` set it writes `snap` instead.
+/// Returns what is wrong (a uniform frame fails too), or None.
+pub fn snapshot_problem(actual: &image::RgbaImage, snap: &Path) -> Option<String> {
+    if std::env::var_os("LODBENCH_BLESS").is_some() {
+        std::fs::create_dir_all(snap.parent().expect("a folder")).expect("snapshot folder");
+        actual.save(snap).expect("snapshot written");
+        return None;
+    }
+    let expected = image::open(snap)
+        .unwrap_or_else(|e| panic!("{}: {e} (bless with LODBENCH_BLESS=1)", snap.display()))
+        .to_rgba8();
+    let uniform = actual.pixels().all(|p| p == actual.get_pixel(0, 0));
+    let (mean, bad) = image_difference(actual.as_raw(), expected.as_raw());
+    (uniform || mean > 0.5 || bad > 0.005).then(|| {
+        format!(
+            "mean {mean:.3}, {:.3} % off by > 16{}",
+            bad * 100.0,
+            if uniform { ", uniform frame" } else { "" }
+        )
+    })
+}

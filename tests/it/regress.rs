@@ -16,7 +16,7 @@
 //! results/baseline/regress/). The full ci profile is a user command (`lodbench run --profile ci`) and the
 //! `ci_profile` module's ignored test.
 
-use crate::common::{image_difference, read_csv, run_into, scene_config, Row};
+use crate::common::{read_csv, run_into, scene_config, snapshot_problem, Row};
 use lodbench::measure::FrameDriver;
 use lodbench::scene::{SceneDef, SceneKind};
 use std::collections::HashMap;
@@ -309,8 +309,6 @@ fn mid_transition_frame(scene: &str) -> u32 {
 #[test]
 fn mid_transition_frames_match_snapshots() {
     let snaps = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots/transitions");
-    let bless = std::env::var_os("LODBENCH_BLESS").is_some();
-    std::fs::create_dir_all(&snaps).unwrap();
     let mut problems = Vec::new();
     for scene in ["bunny-sweep", "simple"] {
         let frame = mid_transition_frame(scene);
@@ -333,19 +331,8 @@ fn mid_transition_frames_match_snapshots() {
                 ));
             }
             let snap = snaps.join(format!("{scene}_{method}.png"));
-            if bless {
-                actual.save(&snap).unwrap();
-                continue;
-            }
-            let expected = image::open(&snap)
-                .unwrap_or_else(|e| panic!("{}: {e} (bless with LODBENCH_BLESS=1)", snap.display()))
-                .to_rgba8();
-            let (mean, bad) = image_difference(actual.as_raw(), expected.as_raw());
-            if mean > 0.5 || bad > 0.005 {
-                problems.push(format!(
-                    "{scene} {method} frame {frame}: mean {mean:.3}, {:.3} % off by > 16",
-                    bad * 100.0
-                ));
+            if let Some(p) = snapshot_problem(&actual, &snap) {
+                problems.push(format!("{scene} {method} frame {frame}: {p}"));
             }
         }
     }

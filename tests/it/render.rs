@@ -1,6 +1,6 @@
 //! Integration tests that render on a real adapter (Mesa lavapipe in CI) at small sizes.
 
-use crate::common::{col, image_difference, read_csv, run_config};
+use crate::common::{col, read_csv, run_config, snapshot_problem};
 
 use indicatif::ProgressBar;
 use lodbench::gpu::GpuContext;
@@ -424,7 +424,6 @@ fn snapshot_scenes_every_method() {
     runner::run(&cfg).expect("every scene and method renders");
     let snaps = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots/scenes");
     let bless = std::env::var_os("LODBENCH_BLESS").is_some();
-    std::fs::create_dir_all(&snaps).unwrap();
     let mut problems = Vec::new();
     let mut checked = 0;
     for scene in SceneKind::names() {
@@ -436,21 +435,8 @@ fn snapshot_scenes_every_method() {
                 .unwrap_or_else(|e| panic!("{}: {e}", frame.display()))
                 .to_rgba8();
             let snap = snaps.join(format!("{scene}_{method}.png"));
-            if bless {
-                actual.save(&snap).unwrap();
-                continue;
-            }
-            let expected = image::open(&snap)
-                .unwrap_or_else(|e| panic!("{}: {e} (bless with LODBENCH_BLESS=1)", snap.display()))
-                .to_rgba8();
-            let uniform = actual.pixels().all(|p| p == actual.get_pixel(0, 0));
-            let (mean, bad) = image_difference(actual.as_raw(), expected.as_raw());
-            if uniform || mean > 0.5 || bad > 0.005 {
-                problems.push(format!(
-                    "{scene} {method}: mean {mean:.3}, {:.3} % off by > 16{}",
-                    bad * 100.0,
-                    if uniform { ", uniform frame" } else { "" }
-                ));
+            if let Some(p) = snapshot_problem(&actual, &snap) {
+                problems.push(format!("{scene} {method}: {p}"));
             }
             checked += 1;
         }
