@@ -94,34 +94,35 @@ fn linear(b: u8) -> f32 {
     }
 }
 
-/// alpha-2pass: the translucent LOD shows only its nearest surface, once. At k = 0.25 the opaque LOD0 is drawn
-/// and LOD1 over it with alpha 0.5; where both LODs cover a pixel, the frame is either LOD0's pixel (LOD1's
-/// nearest surface lies behind LOD0's there) or the 50/50 mix of the two LODs' pixels in linear light (one
-/// layer of LOD1 blended once), within 2 levels of 8-bit rounding and MSAA edges; where LOD1 covers the background,
-/// one blend of it over the background. A pixel with LOD1 blended twice (two of its surfaces over LOD0) would be
-/// neither. What this view cannot show: plain `alpha` differs here on only a handful of pixels (printed), since
-/// the opaque LOD0 hides LOD1's further surfaces wherever the two LODs overlap, so this test would not notice
-/// alpha-2pass degrading into alpha.
+/// alpha-2pass: the translucent LOD shows only its nearest surface, once. Between LOD2 and LOD3 at k = 0.75 the
+/// coarse LOD3 is opaque and LOD2 is drawn over it with alpha 0.5. Where LOD2 covers a pixel, the frame must be
+/// either LOD3's pixel (LOD2's nearest surface lies behind LOD3's there) or one 50/50 mix of the two LODs'
+/// pixels in linear light (LOD2's nearest surface blended once), within 2 levels of 8-bit rounding and MSAA
+/// edges. Plain `alpha` blends every surface of LOD2 that lies in front of LOD3, so where LOD2 has two layers
+/// over the coarse LOD (it keeps detail LOD3 has lost) its pixels are neither: at this view about 1 % of them
+/// (123 of 11,956 on lavapipe), against none for alpha-2pass. The test asserts at most 0.1 % for alpha-2pass
+/// and at least 0.5 % for alpha, so it fails if alpha-2pass degrades into alpha.
 #[test]
 fn alpha_2pass_blends_only_the_nearest_surface() {
     let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
     let d = near_distance();
-    // k = (d - 0.95 s) / (0.1 s) = 0.25 at s = d / 0.975.
-    let (mid, lod0, lod1) = scenes(d, d / 0.975);
+    // LOD3 beyond the third switch s; k = (d - 0.95 s) / (0.1 s) = 0.75 at s = d / 1.025.
+    let scene = |s: f32| static_scene(&[d], [0.3 * d, 0.6 * d, s], 2, "fixed");
+    let (mid, lod3, lod2) = (scene(d / 1.025), scene(0.8 * d), scene(2.0 * d));
     let (f, t) = (
-        render(&ctx, &lod0, "discrete"),
-        render(&ctx, &lod1, "discrete"),
+        render(&ctx, &lod3, "discrete"),
+        render(&ctx, &lod2, "discrete"),
     );
     let background = f[..4].to_vec();
-    let check = |method: &str| -> (usize, usize, usize) {
+    // (pixels where LOD2 covers and differs from LOD3, of them neither LOD3's nor one blend)
+    let check = |method: &str| -> (usize, usize) {
         let m = render(&ctx, &mid, method);
-        let (mut own, mut mixed, mut other, mut both) = (0, 0, 0, 0);
+        let (mut covered, mut other) = (0, 0);
         for ((p, a), b) in pixels(&m).zip(pixels(&f)).zip(pixels(&t)) {
-            // Pixels LOD1 covers where it differs from LOD0 (LOD0 there, or the background).
             if b == background.as_slice() || a == b {
                 continue;
             }
-            both += 1;
+            covered += 1;
             let near = |x: &[u8]| (0..3).all(|c| p[c].abs_diff(x[c]) <= 2);
             let mix: Vec<u8> = (0..3)
                 .map(|c| {
@@ -134,31 +135,22 @@ fn alpha_2pass_blends_only_the_nearest_surface() {
                     (s * 255.0).round() as u8
                 })
                 .collect();
-            if near(a) {
-                own += 1;
-            } else if near(&mix) {
-                mixed += 1;
-            } else {
-                other += 1;
-            }
+            other += (!near(a) && !near(&mix)) as usize;
         }
         assert!(
-            both > 1000,
-            "{method}: the LODs overlap in only {both} pixels"
+            covered > 1000,
+            "{method}: LOD2 covers only {covered} pixels"
         );
-        (own, mixed, other)
+        (covered, other)
     };
-    let (own, mixed, other) = check("alpha-2pass");
-    println!("alpha-2pass: LOD0 {own}, one blend {mixed}, other {other}");
-    println!("alpha: {:?}", check("alpha"));
+    let (covered, other) = check("alpha-2pass");
     assert!(
-        mixed * 10 > own + mixed,
-        "alpha-2pass blended LOD1 in only {mixed} of {} overlapping pixels",
-        own + mixed + other
+        other * 1000 <= covered,
+        "alpha-2pass: {other} of {covered} pixels are neither LOD3's nor one blend of LOD2 over it"
     );
+    let (covered, other) = check("alpha");
     assert!(
-        other * 200 <= own + mixed + other,
-        "alpha-2pass: {other} of {} overlapping pixels are neither LOD0's nor one blend of LOD1 over it",
-        own + mixed + other
+        other * 200 >= covered,
+        "alpha blended LOD2 more than once on only {other} of {covered} pixels: the view no longer tells the two apart"
     );
 }
