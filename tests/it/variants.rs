@@ -154,3 +154,42 @@ fn alpha_2pass_blends_only_the_nearest_surface() {
         "alpha blended LOD2 more than once on only {other} of {covered} pixels: the view no longer tells the two apart"
     );
 }
+
+/// Pixels whose dominant colour (LOD0 red against LOD1 green) flips between two frames.
+fn flips(a: &[u8], b: &[u8]) -> usize {
+    pixels(a)
+        .zip(pixels(b))
+        .filter(|(p, q)| (p[0] > p[1]) != (q[0] > q[1]) && p[..3] != q[..3])
+        .count()
+}
+
+/// alpha-zwrite's compare switch (Blow): across the swap at k = 0.5 the roles swap (LOD0 opaque and LOD1
+/// translucent before, the reverse after) and the translucent draw's depth test goes from less-equal to less, so
+/// pixels where the two LODs lie at equal depth (the triangles simplification kept) show the same LOD on both
+/// sides. Rendered at k = 0.45 and 0.55 with the bunny and the camera unmoved (only the switch distance
+/// changes), alpha-zwrite's frames must not change dominant colour (LOD0 red against LOD1 green) on more than 10
+/// pixels; plain alpha, which has no such switch, flips about 1,500 (lavapipe), and so does alpha-zwrite with the
+/// compare left at less-equal after the swap (tried: 1,496, the same pixels as alpha). Both counts are asserted,
+/// so the test fails when the switch goes.
+#[test]
+fn alpha_zwrite_keeps_equal_depth_pixels_across_the_swap() {
+    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let d = near_distance();
+    // k = (d - 0.95 s) / (0.1 s) at switch distance s: s = d / (0.95 + 0.1 k).
+    let at = |k: f32| static_scene(&[d], [d / (0.95 + 0.1 * k), 3.0 * d, 4.0 * d], 2, "fixed");
+    let flips_across = |method: &str| {
+        flips(
+            &render(&ctx, &at(0.45), method),
+            &render(&ctx, &at(0.55), method),
+        )
+    };
+    let (zwrite, alpha) = (flips_across("alpha-zwrite"), flips_across("alpha"));
+    assert!(
+        zwrite <= 10,
+        "alpha-zwrite: {zwrite} pixels change LOD across the swap"
+    );
+    assert!(
+        alpha >= 500,
+        "alpha changes LOD on only {alpha} pixels across the swap: the view no longer shows the equal-depth pixels"
+    );
+}
