@@ -176,6 +176,20 @@ impl TimedMethod<'_> {
     }
 }
 
+/// The timing-round time per frame of the (first) reference among `timed`, listed or timed only: the denominator
+/// of `quality_to_renders_ratio`.
+pub fn reference_ms_per_frame(timed: &[TimedMethod<'_>]) -> Option<f64> {
+    timed
+        .iter()
+        .find(|t| is_reference(&t.label))
+        .map(TimedMethod::ms_per_frame)
+}
+
+/// Whether a run's label names the reference (`reference`, `reference#2`, ...).
+pub fn is_reference(label: &str) -> bool {
+    crate::methods::base_name(label) == "reference"
+}
+
 /// The frames every method renders untimed before the rounds: the first `warmup` frames of the path (wrapping),
 /// then the first frame of each distinct transition of the path (`lod_from -> lod_to` pair) and the two frames
 /// after it, so that every pipeline and buffer a method uses in a transition is used once before timing.
@@ -381,10 +395,7 @@ impl<'a> BlockRunner<'a> {
         on_frames: impl FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<BlockOutput> {
         let (mut timed, _) = self.time_methods(&[label.to_string()], warmup, 1, 0, progress)?;
-        let reference_ms = timed
-            .iter()
-            .find(|t| t.label == "reference")
-            .map(TimedMethod::ms_per_frame);
+        let reference_ms = reference_ms_per_frame(&timed);
         let method = timed
             .drain(..)
             .find(|t| t.label == label)
@@ -408,10 +419,7 @@ impl<'a> BlockRunner<'a> {
         let (scene, ctx) = (self.scene, self.ctx);
         let frames = scene.frames;
         let mut labels = labels.to_vec();
-        let timed_only: Vec<String> = if labels
-            .iter()
-            .any(|l| crate::methods::base_name(l) == "reference")
-        {
+        let timed_only: Vec<String> = if labels.iter().any(|l| is_reference(l)) {
             Vec::new()
         } else {
             labels.push("reference".into());

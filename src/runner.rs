@@ -7,7 +7,9 @@ use crate::export::csv::{write_rounds, write_summary, write_transitions, FramesW
 use crate::export::manifest::{now_rfc3339, RunManifest, RunStatus};
 use crate::export::png::FrameDumper;
 use crate::gpu::GpuContext;
-use crate::measure::{BlockRunner, MethodSetup, QualityOptions};
+use crate::measure::{
+    is_reference, reference_ms_per_frame, BlockRunner, MethodSetup, QualityOptions,
+};
 use crate::methods::Registry;
 use crate::records::{round_records, BlockInfo, FrameRecord, SummaryRecord};
 use crate::scene::SceneDef;
@@ -133,10 +135,7 @@ fn run_blocks(
 
     // Per block: every method's warm-up, timed and quality frames, and the reference's warm-up and timed frames
     // when it is timed without being reported.
-    let timed_only = !cfg
-        .methods
-        .iter()
-        .any(|m| crate::methods::base_name(m) == "reference") as u64;
+    let timed_only = !cfg.methods.iter().any(|m| is_reference(m)) as u64;
     let total: u64 = defs
         .iter()
         .map(|d| {
@@ -180,10 +179,7 @@ fn run_blocks(
                 .wrapping_add(block_index);
             let (timed, block_rounds) =
                 block.time_methods(&cfg.methods, warmup, cfg.rounds, rounds_seed, &progress)?;
-            let reference_ms = timed
-                .iter()
-                .find(|t| t.label == "reference")
-                .map(|t| t.ms_per_frame());
+            let reference_ms = reference_ms_per_frame(&timed);
             let mut block_rows: Vec<Vec<FrameRecord>> = Vec::new();
             let mut extras = Vec::new();
             for m in timed {
