@@ -4,6 +4,18 @@ use std::process::Command;
 fn main() {
     println!("cargo:rerun-if-changed=.git/HEAD");
     println!("cargo:rerun-if-changed=.git/index");
+    // An edited source makes the build dirty: without these, `--dirty` was computed only when HEAD or the index
+    // changed, and a run from an edited tree recorded the clean parent commit.
+    for path in [
+        "src",
+        "shaders",
+        "scenes",
+        "Cargo.toml",
+        "Cargo.lock",
+        "build.rs",
+    ] {
+        println!("cargo:rerun-if-changed={path}");
+    }
     let commit = Command::new("git")
         .args(["describe", "--always", "--dirty", "--abbrev=12"])
         .output()

@@ -250,7 +250,9 @@ fn fs_fsi_t(in: VsOut, @builtin(front_facing) front: bool) -> FsiOut {
     }
     var out: FsiOut;
     out.color = vec4<f32>(shade(in, front), 1.0);
-    // params is interpolated: a constant can come out a hair below the integer.
-    out.id = u32(round(in.params.w));
+    // params is interpolated: a constant can come out a hair below the integer. Back faces write the next id
+    // (src/methods/fsi.rs, `back_id`), so the combination never averages an object's inside with its front.
+    let id = u32(round(in.params.w));
+    out.id = select(id + 1u, id, front);
     return out;
 }

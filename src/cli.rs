@@ -6,7 +6,7 @@
 
 use crate::methods::MethodOptions;
 use crate::metrics::{Metric, MetricReduction};
-use crate::scene::{CameraMode, Profile};
+use crate::scene::{CameraMode, Profile, SweepStart};
 use crate::schedule::FadeMode;
 use clap::{Args, Parser, Subcommand};
 use serde::Deserialize;
@@ -79,12 +79,21 @@ pub struct SceneArgs {
     /// Timed frames (also the length of the quality pass; for bunny-sweep the whole path out and back).
     #[arg(long)]
     pub frames: Option<u32>,
-    /// OBJ file that replaces the Stanford bunny in the bunny scenes.
+    /// Mesh file (.obj, .gltf or .glb) that replaces the Stanford bunny in the bunny scenes.
     #[arg(long)]
     pub mesh: Option<PathBuf>,
-    /// Screen-space error, in pixels, at which each LOD is switched in.
-    #[arg(long, default_value_t = 1.0)]
-    pub pixel_error: f32,
+    /// Screen-space error, in pixels at the viewport's height, at which each LOD is switched in. A smaller value
+    /// moves every switch farther from the camera, a larger one nearer. Default: for the bunny scenes one pixel
+    /// at the paper's 600-pixel height (height / 600), so every profile has the paper's switch distances and
+    /// path; 1 for the other scenes.
+    #[arg(long)]
+    pub pixel_error: Option<f32>,
+    /// Where the bunny scenes' path starts: `fit` (where the model's bounding sphere fits the view, so the camera
+    /// is never inside the model; switches nearer than that are not reached) or `close-up` (just before the
+    /// first switch, even inside the bounding sphere; `--pixel-error` 1 by default). Default: the profile's
+    /// (`close-up` for regress, `fit` otherwise).
+    #[arg(long, value_enum)]
+    pub sweep_start: Option<SweepStart>,
     /// Explicit switch distances for LOD1, LOD2, ... (world units), overriding --pixel-error.
     #[arg(long, value_delimiter = ',')]
     pub switch_distances: Option<Vec<f32>>,
@@ -238,7 +247,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(set.scene_args.count, vec![50]);
-        assert_eq!(set.scene_args.pixel_error, 2.0);
+        assert_eq!(set.scene_args.pixel_error, Some(2.0));
         assert_eq!(
             set.method_options.dither.noise,
             crate::noise::NoisePattern::Bayer4

@@ -27,11 +27,12 @@ impl SceneConfig {
         if a.frames == Some(0) {
             return Err(Error::Config("--frames must be at least 1".into()));
         }
-        if !(a.pixel_error.is_finite() && a.pixel_error > 0.0) {
-            return Err(Error::Config(format!(
-                "--pixel-error {} must be a positive number",
-                a.pixel_error
-            )));
+        if let Some(p) = a.pixel_error {
+            if !(p.is_finite() && p > 0.0) {
+                return Err(Error::Config(format!(
+                    "--pixel-error {p} must be a positive number"
+                )));
+            }
         }
         if !(a.fov.is_finite() && a.fov > 1.0 && a.fov < 170.0) {
             return Err(Error::Config(format!(
@@ -68,6 +69,7 @@ impl SceneConfig {
             frames: a.frames,
             mesh: a.mesh.clone(),
             pixel_error: a.pixel_error,
+            sweep_start: a.sweep_start,
             switch_distances: a.switch_distances.clone(),
             counts: if a.count.is_empty() {
                 None

@@ -188,16 +188,29 @@ fn describe(args: &DescribeArgs) -> lodbench::Result<()> {
         );
         for l in &m.lods {
             outln!(
-                "  {:>4} {:>10} {:>9} {:>14.6} {:>16}",
+                "  {:>4} {:>10} {:>9} {:>14.6} {:>16}{}",
                 l.info.lod,
                 l.info.triangles,
                 l.info.vertices,
                 l.info.error_abs,
                 l.switch_distance
-                    .map_or("-".to_string(), |s| format!("{s:.3}"))
+                    .map_or("-".to_string(), |s| format!("{s:.3}")),
+                l.note.map_or(String::new(), |n| format!("  ({n})"))
             );
         }
     }
+    outln!("pixel error: {}", d.pixel_error);
+    if let Some(p) = &d.path {
+        outln!(
+            "path: from {:.3} to {:.3} (the bounding sphere fits the view from {:.3})",
+            p.near,
+            p.far,
+            p.fit
+        );
+    }
     outln!("motion: {}", serde_json::to_string(&d.motion)?);
+    for n in &d.notes {
+        outln!("note: {n}");
+    }
     Ok(())
 }

@@ -1,8 +1,12 @@
-//! Validated triangle meshes and OBJ loading (tobj).
+//! Validated triangle meshes, and loading them from OBJ (tobj) and glTF 2.0 (.gltf / .glb, the gltf crate).
 
 use crate::error::{Error, Result};
-use glam::Vec3;
+use glam::{Mat3, Mat4, Vec3};
+use std::borrow::Cow;
 use std::path::Path;
+
+/// The mesh file formats [`Mesh::load`] reads, as its error messages list them.
+const MESH_FORMATS: &str = "lodbench reads .obj, .gltf and .glb";
 
 /// An indexed triangle mesh with per-vertex normals. Construct it with [`Mesh::new`] (or the loaders), which
 /// checks what the GPU and the LOD generator rely on: indices in range, finite coordinates, whole triangles,
@@ -173,21 +177,61 @@ impl Mesh {
         (c, r)
     }
 
+    /// Loads a mesh file, choosing the reader by the extension (any case): `.obj` [`Mesh::load_obj`],
+    /// `.gltf` and `.glb` [`Mesh::load_gltf`]. A missing path, a directory and any other extension are errors
+    /// that name the file.
+    pub fn load(path: &Path) -> Result<Mesh> {
+        let name = path.display().to_string();
+        check_mesh_file(path, &name)?;
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("obj") => Mesh::load_obj(path),
+            Some("gltf" | "glb") => Mesh::load_gltf(path),
+            Some(other) => Err(mesh_error(
+                &name,
+                format!("unsupported extension '.{other}' ({MESH_FORMATS})"),
+            )),
+            None => Err(mesh_error(
+                &name,
+                format!("has no file extension ({MESH_FORMATS})"),
+            )),
+        }
+    }
+
     /// Loads an OBJ file (all its objects, faces triangulated); normals are taken from the file when every
     /// vertex has one, computed otherwise.
     pub fn load_obj(path: &Path) -> Result<Mesh> {
         let name = path.display().to_string();
-        if !path.is_file() {
-            return Err(Error::Mesh {
-                path: name,
-                problem: "file not found".into(),
-            });
-        }
-        let bytes = std::fs::read(path).map_err(|e| Error::Mesh {
-            path: name.clone(),
-            problem: format!("cannot be read ({e})"),
-        })?;
+        let bytes = read_mesh_file(path, &name)?;
         Mesh::parse_obj(&name, &bytes)
+    }
+
+    /// Loads a glTF 2.0 file, JSON (`.gltf`) or binary (`.glb`; the content decides, not the extension).
+    ///
+    /// The geometry taken is every triangle primitive of every mesh instance in the default scene (scene 0
+    /// when the file names no default; every mesh, untransformed, when the file has no scenes), merged into
+    /// one mesh with each node's world transform applied: positions by the matrix, normals by its inverse
+    /// transpose and renormalised; a node whose transform mirrors (negative determinant) gets its triangles'
+    /// winding reversed, as glTF specifies. A mesh used by two nodes is merged twice.
+    ///
+    /// - Primitive modes: TRIANGLES is taken as is, TRIANGLE_STRIP and TRIANGLE_FAN are triangulated (the
+    ///   spec's vertex orders), POINTS and the LINE modes are skipped. A primitive without indices uses its
+    ///   vertices in order.
+    /// - Normals: the file's when every merged primitive has float NORMALs (and no node transform is
+    ///   singular), otherwise all are computed as [`Mesh::new`] does, as for OBJ files.
+    /// - Not read: sparse accessors (an error says so), quantized positions (float VEC3 only, an error),
+    ///   morph targets and skins (the base, unskinned geometry is used), materials, UVs and images (never
+    ///   decoded). Files that require an extension the gltf crate does not support (Draco, meshopt
+    ///   compression, KHR_mesh_quantization) fail as not readable.
+    /// - Buffers: the GLB binary chunk, base64 `data:` URIs, or files named by relative (percent-encoded)
+    ///   URIs, read from the .gltf file's folder; only buffers the merged primitives use are read.
+    pub fn load_gltf(path: &Path) -> Result<Mesh> {
+        let name = path.display().to_string();
+        let bytes = read_mesh_file(path, &name)?;
+        let dir = path.parent().unwrap_or(Path::new(""));
+        parse_gltf(&name, &bytes, dir).map_err(|problem| mesh_error(&name, problem))
     }
 
     /// Parses OBJ text held in memory; `name` is used in error messages.
@@ -235,6 +279,432 @@ impl Mesh {
             None
         };
         Mesh::new(name, positions, normals, indices)
+    }
+}
+
+fn mesh_error(name: &str, problem: impl Into<String>) -> Error {
+    Error::Mesh {
+        path: name.to_string(),
+        problem: problem.into(),
+    }
+}
+
+/// `Ok` for a path that names a file: errors say "file not found" or "is a directory" otherwise.
+fn check_mesh_file(path: &Path, name: &str) -> Result<()> {
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            Err(mesh_error(name, "file not found"))
+        }
+        Err(e) => Err(mesh_error(name, format!("cannot be read ({e})"))),
+        Ok(m) if m.is_dir() => Err(mesh_error(name, "is a directory")),
+        Ok(m) if !m.is_file() => Err(mesh_error(name, "is not a regular file")),
+        Ok(_) => Ok(()),
+    }
+}
+
+fn read_mesh_file(path: &Path, name: &str) -> Result<Vec<u8>> {
+    check_mesh_file(path, name)?;
+    std::fs::read(path).map_err(|e| mesh_error(name, format!("cannot be read ({e})")))
+}
+
+/// One primitive placed in the scene: its mesh index, primitive index and world transform.
+struct Placed<'a> {
+    primitive: gltf::Primitive<'a>,
+    mesh: usize,
+    world: Mat4,
+}
+
+/// Reads the glTF (JSON or GLB) in `bytes`; external buffers are looked up in `dir`. Errors are the problem
+/// text of an [`Error::Mesh`].
+fn parse_gltf(name: &str, bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice(bytes).map_err(|e| format!("not a readable glTF file ({e})"))?;
+    let (placed, scene) = placed_triangle_primitives(&document)?;
+    if placed.is_empty() {
+        return Err(match scene {
+            Some(s) => format!("has no triangle primitives in scene {s}"),
+            None => "has no triangle primitives".to_string(),
+        });
+    }
+    let mut needed = vec![false; document.buffers().len()];
+    for p in &placed {
+        let accessors = [
+            p.primitive.get(&gltf::Semantic::Positions),
+            float_normals(&p.primitive),
+            p.primitive.indices(),
+        ];
+        for view in accessors.iter().flatten().filter_map(|a| a.view()) {
+            if let Some(n) = needed.get_mut(view.buffer().index()) {
+                *n = true;
+            }
+        }
+    }
+    let buffers = load_buffers(&document, blob.as_deref(), &needed, dir)?;
+    merge_primitives(name, &placed, &buffers)
+}
+
+/// The triangle-mode primitives of the scene's node trees with their world transforms, in document order,
+/// and the scene's index (`None` when the file has no scenes and every mesh is taken untransformed).
+fn placed_triangle_primitives(
+    document: &gltf::Document,
+) -> Result<(Vec<Placed<'_>>, Option<usize>), String> {
+    fn add<'a>(placed: &mut Vec<Placed<'a>>, mesh: gltf::Mesh<'a>, world: Mat4) {
+        use gltf::mesh::Mode;
+        for primitive in mesh.primitives() {
+            if matches!(
+                primitive.mode(),
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                placed.push(Placed {
+                    primitive,
+                    mesh: mesh.index(),
+                    world,
+                });
+            }
+        }
+    }
+    let mut placed = Vec::new();
+    let Some(scene) = document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+    else {
+        for mesh in document.meshes() {
+            add(&mut placed, mesh, Mat4::IDENTITY);
+        }
+        return Ok((placed, None));
+    };
+    // Depth first with an explicit stack (no recursion depth limit); a node reached twice would mean a cycle
+    // or a shared child, which glTF forbids, and is refused so a bad file cannot loop.
+    let mut seen = vec![false; document.nodes().len()];
+    let mut stack: Vec<(gltf::Node<'_>, Mat4)> =
+        scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+    stack.reverse();
+    while let Some((node, parent)) = stack.pop() {
+        match seen.get_mut(node.index()) {
+            Some(s) if !*s => *s = true,
+            _ => {
+                return Err(format!(
+                    "node {} is reached twice from scene {} (glTF node hierarchies must be trees)",
+                    node.index(),
+                    scene.index()
+                ))
+            }
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(mesh) = node.mesh() {
+            add(&mut placed, mesh, world);
+        }
+        let first_child = stack.len();
+        stack.extend(node.children().map(|c| (c, world)));
+        stack[first_child..].reverse();
+    }
+    Ok((placed, Some(scene.index())))
+}
+
+/// The primitive's NORMAL accessor when it holds float 3-vectors (others are treated as absent).
+fn float_normals<'a>(p: &gltf::Primitive<'a>) -> Option<gltf::Accessor<'a>> {
+    p.get(&gltf::Semantic::Normals).filter(|a| {
+        a.data_type() == gltf::accessor::DataType::F32
+            && a.dimensions() == gltf::accessor::Dimensions::Vec3
+    })
+}
+
+/// The bytes of each buffer marked in `needed` (`None` for the others).
+fn load_buffers<'b>(
+    document: &gltf::Document,
+    blob: Option<&'b [u8]>,
+    needed: &[bool],
+    dir: &Path,
+) -> Result<Vec<Option<Cow<'b, [u8]>>>, String> {
+    let mut out = Vec::new();
+    for buffer in document.buffers() {
+        let i = buffer.index();
+        if !needed.get(i).copied().unwrap_or(false) {
+            out.push(None);
+            continue;
+        }
+        let data: Cow<'b, [u8]> = match buffer.source() {
+            gltf::buffer::Source::Bin => Cow::Borrowed(blob.ok_or_else(|| {
+                format!("buffer {i} refers to the GLB binary chunk, which the file does not have")
+            })?),
+            gltf::buffer::Source::Uri(uri) => Cow::Owned(read_buffer_uri(i, uri, dir)?),
+        };
+        if data.len() < buffer.length() {
+            return Err(format!(
+                "buffer {i} holds {} bytes but declares byteLength {}",
+                data.len(),
+                buffer.length()
+            ));
+        }
+        out.push(Some(data));
+    }
+    Ok(out)
+}
+
+/// A buffer's bytes from a `data:` URI or a file relative to `dir`.
+fn read_buffer_uri(i: usize, uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (header, payload) = rest
+            .split_once(',')
+            .ok_or_else(|| format!("buffer {i} has a data: URI without a ','"))?;
+        let bytes = if header.ends_with(";base64") {
+            decode_base64(payload)
+        } else {
+            percent_decode(payload)
+        };
+        return bytes.ok_or_else(|| format!("buffer {i} has a data: URI that does not decode"));
+    }
+    let scheme = uri.split_once(':').map(|(s, _)| s);
+    if scheme.is_some_and(|s| {
+        s.len() > 1
+            && s.starts_with(|c: char| c.is_ascii_alphabetic())
+            && s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'))
+    }) {
+        return Err(format!(
+            "buffer {i} has URI '{uri}': lodbench reads only data: URIs and relative file paths"
+        ));
+    }
+    let relative = percent_decode(uri)
+        .and_then(|b| String::from_utf8(b).ok())
+        .ok_or_else(|| format!("buffer {i} has URI '{uri}', which is not a valid file path"))?;
+    let file = dir.join(relative);
+    std::fs::read(&file).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::NotFound {
+            format!("buffer {i} file {} not found", file.display())
+        } else {
+            format!("buffer {i} file {} cannot be read ({e})", file.display())
+        }
+    })
+}
+
+/// Standard or URL-safe base64, padding optional; `None` for any other character.
+fn decode_base64(text: &str) -> Option<Vec<u8>> {
+    let text = text.trim_end_matches('=');
+    let mut out = Vec::with_capacity(text.len() / 4 * 3 + 2);
+    let (mut acc, mut bits) = (0u32, 0u32);
+    for c in text.bytes() {
+        let v = match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' | b'-' => 62,
+            b'/' | b'_' => 63,
+            _ => return None,
+        };
+        acc = (acc << 6) | u32::from(v);
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+            acc &= (1 << bits) - 1;
+        }
+    }
+    // One character left over (6 bits) cannot end a base64 text.
+    (bits < 6).then_some(out)
+}
+
+/// Decodes `%XX` escapes; `None` for a `%` not followed by two hex digits.
+fn percent_decode(text: &str) -> Option<Vec<u8>> {
+    let b = text.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' {
+            let hex = b.get(i + 1..i + 3)?;
+            if !hex.iter().all(u8::is_ascii_hexdigit) {
+                return None;
+            }
+            out.push(u8::from_str_radix(std::str::from_utf8(hex).ok()?, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    Some(out)
+}
+
+/// Checks that the crate's accessor reader can read `a` without panicking or coming up short: no sparse
+/// part, a buffer view, a stride that holds an element, and every element inside the view and the view inside
+/// its buffer's bytes.
+fn check_accessor(a: &gltf::Accessor, buffers: &[Option<Cow<[u8]>>]) -> Result<(), String> {
+    let i = a.index();
+    if a.sparse().is_some() {
+        return Err(format!(
+            "accessor {i} is sparse, which lodbench does not read"
+        ));
+    }
+    let view = a
+        .view()
+        .ok_or_else(|| format!("accessor {i} has no buffer view"))?;
+    let elem = a.size();
+    let stride = view.stride().unwrap_or(elem);
+    if stride < elem {
+        return Err(format!(
+            "buffer view {} has stride {stride}, less than accessor {i}'s {elem}-byte elements",
+            view.index()
+        ));
+    }
+    let end = a
+        .count()
+        .checked_sub(1)
+        .and_then(|n| n.checked_mul(stride))
+        .and_then(|n| n.checked_add(elem))
+        .and_then(|n| n.checked_add(a.offset()));
+    if end.is_none_or(|end| end > view.length()) {
+        return Err(format!(
+            "accessor {i} ({} elements) does not fit in buffer view {}",
+            a.count(),
+            view.index()
+        ));
+    }
+    let buffer = view.buffer().index();
+    let have = buffers
+        .get(buffer)
+        .and_then(Option::as_ref)
+        .map_or(0, |d| d.len());
+    if view
+        .offset()
+        .checked_add(view.length())
+        .is_none_or(|end| end > have)
+    {
+        return Err(format!(
+            "buffer view {} reaches past the end of buffer {buffer} ({have} bytes)",
+            view.index()
+        ));
+    }
+    Ok(())
+}
+
+/// Merges the placed primitives into one validated mesh (see [`Mesh::load_gltf`]).
+fn merge_primitives(
+    name: &str,
+    placed: &[Placed<'_>],
+    buffers: &[Option<Cow<[u8]>>],
+) -> Result<Mesh, String> {
+    use gltf::accessor::{DataType, Dimensions};
+    let mut positions: Vec<[f32; 3]> = Vec::new();
+    let mut normals: Vec<[f32; 3]> = Vec::new();
+    let mut indices: Vec<u32> = Vec::new();
+    let mut all_have_normals = true;
+    for p in placed {
+        let prim = &p.primitive;
+        let what = format!("mesh {} primitive {}", p.mesh, prim.index());
+        let pos = prim
+            .get(&gltf::Semantic::Positions)
+            .ok_or_else(|| format!("{what} has no POSITION attribute"))?;
+        if pos.data_type() != DataType::F32 || pos.dimensions() != Dimensions::Vec3 {
+            return Err(format!(
+                "{what} has {:?} {:?} positions; lodbench reads float VEC3 positions only",
+                pos.data_type(),
+                pos.dimensions()
+            ));
+        }
+        check_accessor(&pos, buffers)?;
+        let normal_accessor = float_normals(prim);
+        if let Some(n) = &normal_accessor {
+            check_accessor(n, buffers)?;
+            if n.count() != pos.count() {
+                return Err(format!(
+                    "{what} has {} normals for {} positions",
+                    n.count(),
+                    pos.count()
+                ));
+            }
+        }
+        if let Some(ix) = prim.indices() {
+            if !matches!(ix.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+                || ix.dimensions() != Dimensions::Scalar
+            {
+                return Err(format!(
+                    "{what} has {:?} {:?} indices; glTF indices are unsigned integer scalars",
+                    ix.data_type(),
+                    ix.dimensions()
+                ));
+            }
+            check_accessor(&ix, buffers)?;
+        }
+
+        let reader = prim.reader(|b| buffers.get(b.index()).and_then(|d| d.as_deref()));
+        let unread = || format!("{what}: the accessors cannot be read");
+        let local: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(unread)?
+            .map(Vec3::from)
+            .collect();
+        let count =
+            u32::try_from(local.len()).map_err(|_| format!("{what} has too many vertices"))?;
+        let order: Vec<u32> = match reader.read_indices() {
+            Some(ix) => ix.into_u32().collect(),
+            None if prim.indices().is_some() => return Err(unread()),
+            None => (0..count).collect(),
+        };
+        if let Some(&bad) = order.iter().find(|&&ix| ix >= count) {
+            return Err(format!(
+                "{what} uses vertex index {bad} but has {count} vertices"
+            ));
+        }
+        let mut tris = triangulate(prim.mode(), &order)
+            .ok_or_else(|| format!("{what} has {} indices, not a multiple of 3", order.len()))?;
+
+        let linear = Mat3::from_mat4(p.world);
+        let det = linear.determinant();
+        if det < 0.0 {
+            for t in tris.chunks_exact_mut(3) {
+                t.swap(1, 2);
+            }
+        }
+        let base = u32::try_from(positions.len())
+            .ok()
+            .filter(|b| b.checked_add(count).is_some())
+            .ok_or_else(|| "has more vertices than 32-bit indices can address".to_string())?;
+        positions.extend(
+            local
+                .iter()
+                .map(|&v| p.world.transform_point3(v).to_array()),
+        );
+        indices.extend(tris.iter().map(|&ix| base + ix));
+
+        let normal_matrix = linear.inverse().transpose();
+        match normal_accessor {
+            Some(_) if all_have_normals && det != 0.0 && normal_matrix.is_finite() => {
+                let read: Vec<[f32; 3]> = reader.read_normals().ok_or_else(unread)?.collect();
+                normals.extend(read.into_iter().map(|n| {
+                    let n = normal_matrix * Vec3::from(n);
+                    n.try_normalize().unwrap_or(n).to_array()
+                }));
+            }
+            _ => all_have_normals = false,
+        }
+    }
+    let normals = all_have_normals.then_some(normals);
+    Mesh::new(name, positions, normals, indices).map_err(|e| match e {
+        Error::Mesh { problem, .. } => problem,
+        other => other.to_string(),
+    })
+}
+
+/// The triangle list of a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN primitive's vertex order (glTF 2.0
+/// section 3.7.2.1); `None` for a TRIANGLES list whose length is not a multiple of 3.
+fn triangulate(mode: gltf::mesh::Mode, order: &[u32]) -> Option<Vec<u32>> {
+    use gltf::mesh::Mode;
+    let n = order.len();
+    match mode {
+        Mode::TriangleStrip => Some(
+            (0..n.saturating_sub(2))
+                .flat_map(|i| {
+                    let odd = i % 2;
+                    [order[i], order[i + 1 + odd], order[i + 2 - odd]]
+                })
+                .collect(),
+        ),
+        Mode::TriangleFan => Some(
+            (1..n.saturating_sub(1))
+                .flat_map(|i| [order[i], order[i + 1], order[0]])
+                .collect(),
+        ),
+        _ => n.is_multiple_of(3).then(|| order.to_vec()),
     }
 }
 
@@ -327,6 +797,393 @@ mod tests {
         std::fs::write(&nan, "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n").unwrap();
         let msg = Mesh::load_obj(&nan).unwrap_err().to_string();
         assert!(msg.contains("nan.obj"), "{msg}");
+    }
+
+    #[test]
+    fn load_obj_reports_a_directory() {
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("meshes.obj");
+        std::fs::create_dir(&sub).unwrap();
+        for msg in [
+            Mesh::load_obj(&sub).unwrap_err().to_string(),
+            Mesh::load(&sub).unwrap_err().to_string(),
+            Mesh::load_gltf(&sub).unwrap_err().to_string(),
+        ] {
+            assert!(
+                msg.contains("meshes.obj") && msg.contains("is a directory"),
+                "{msg}"
+            );
+        }
+    }
+
+    // ---- glTF ----
+
+    fn fixture(file: &str) -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(file)
+    }
+
+    /// tests/data/tetra.gltf as JSON, to edit and write back.
+    fn fixture_json() -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(fixture("tetra.gltf")).unwrap()).unwrap()
+    }
+
+    /// The fixture's 120-byte buffer (4 positions, 4 normals, 12 u16 indices).
+    fn fixture_buffer() -> Vec<u8> {
+        let json = fixture_json();
+        let uri = json["buffers"][0]["uri"].as_str().unwrap();
+        decode_base64(uri.split_once(',').unwrap().1).unwrap()
+    }
+
+    fn encode_base64(bytes: &[u8]) -> String {
+        const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let mut out = String::new();
+        for c in bytes.chunks(3) {
+            let n = c
+                .iter()
+                .enumerate()
+                .fold(0u32, |n, (i, &b)| n | u32::from(b) << (16 - 8 * i));
+            for i in 0..=c.len() {
+                out.push(A[(n >> (18 - 6 * i) & 63) as usize] as char);
+            }
+        }
+        while !out.len().is_multiple_of(4) {
+            out.push('=');
+        }
+        out
+    }
+
+    fn with_buffer(mut json: serde_json::Value, bytes: &[u8]) -> serde_json::Value {
+        json["buffers"][0]["uri"] = format!(
+            "data:application/octet-stream;base64,{}",
+            encode_base64(bytes)
+        )
+        .into();
+        json
+    }
+
+    fn write_json(dir: &Path, file: &str, json: &serde_json::Value) -> std::path::PathBuf {
+        let path = dir.join(file);
+        std::fs::write(&path, serde_json::to_string(json).unwrap()).unwrap();
+        path
+    }
+
+    fn load_json(json: &serde_json::Value) -> Result<Mesh> {
+        let dir = tempfile::tempdir().unwrap();
+        Mesh::load(&write_json(dir.path(), "edited.gltf", json))
+    }
+
+    fn assert_bounds(m: &Mesh, lo: [f32; 3], hi: [f32; 3]) {
+        let (l, h) = m.bounds();
+        assert!(
+            l.abs_diff_eq(Vec3::from(lo), 1e-6) && h.abs_diff_eq(Vec3::from(hi), 1e-6),
+            "bounds {l} {h}"
+        );
+    }
+
+    fn assert_near(a: [f32; 3], b: Vec3) {
+        assert!(Vec3::from(a).abs_diff_eq(b, 1e-6), "{a:?} vs {b}");
+    }
+
+    #[test]
+    fn base64_and_percent_decoding() {
+        assert_eq!(decode_base64("aGVsbG8=").unwrap(), b"hello");
+        assert_eq!(decode_base64("aGVsbG8").unwrap(), b"hello");
+        assert_eq!(decode_base64("aGk_-w").unwrap(), [b'h', b'i', 0x3f, 0xfb]);
+        assert!(decode_base64("aGVs*G8=").is_none());
+        assert!(decode_base64("aGVsb").is_none());
+        let all: Vec<u8> = (0..=255).collect();
+        assert_eq!(decode_base64(&encode_base64(&all)).unwrap(), all);
+        assert_eq!(percent_decode("a%20b%2Fc").unwrap(), b"a b/c");
+        assert!(percent_decode("a%2").is_none());
+        assert!(percent_decode("a%zz").is_none());
+    }
+
+    #[test]
+    fn gltf_fixture_merges_both_nodes_with_transforms() {
+        let m = Mesh::load(&fixture("tetra.gltf")).unwrap();
+        // Two instances of the 4-vertex tetrahedron (node "moved" at x + 2); the POINTS primitive is skipped.
+        assert_eq!(m.vertex_count(), 8);
+        assert_eq!(m.triangle_count(), 8);
+        assert_bounds(&m, [0.0, 0.0, 0.0], [3.0, 1.0, 1.0]);
+        for i in 0..4 {
+            assert_near(
+                m.positions[i + 4],
+                Vec3::from(m.positions[i]) + Vec3::new(2.0, 0.0, 0.0),
+            );
+            assert_eq!(m.normals[i + 4], m.normals[i]);
+        }
+        assert_eq!(&m.indices[..3], &[0, 2, 1]);
+        assert_eq!(&m.indices[12..15], &[4, 6, 5]);
+        // The file's normals, not computed ones (those would be +x at vertex 2).
+        assert_near(m.normals[1], Vec3::new(3.0, -1.0, -1.0).normalize());
+    }
+
+    #[test]
+    fn glb_fixture_equals_gltf_fixture() {
+        let glb = Mesh::load(&fixture("tetra.glb")).unwrap();
+        assert_eq!(glb.vertex_count(), 8);
+        assert_eq!(glb, Mesh::load(&fixture("tetra.gltf")).unwrap());
+    }
+
+    #[test]
+    fn load_dispatches_on_extension_in_any_case() {
+        let dir = tempfile::tempdir().unwrap();
+        let upper = dir.path().join("TETRA.GLTF");
+        std::fs::copy(fixture("tetra.gltf"), &upper).unwrap();
+        let mixed = dir.path().join("tetra.Glb");
+        std::fs::copy(fixture("tetra.glb"), &mixed).unwrap();
+        let obj = dir.path().join("tri.OBJ");
+        std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        assert_eq!(Mesh::load(&upper).unwrap().triangle_count(), 8);
+        assert_eq!(Mesh::load(&mixed).unwrap().triangle_count(), 8);
+        assert_eq!(Mesh::load(&obj).unwrap().triangle_count(), 1);
+        // glTF content behind a .obj name goes to the OBJ reader.
+        let wrong = dir.path().join("tetra.obj");
+        std::fs::copy(fixture("tetra.gltf"), &wrong).unwrap();
+        assert!(Mesh::load(&wrong).is_err());
+    }
+
+    #[test]
+    fn load_reports_missing_file_and_unsupported_extension() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = dir.path().join("missing.glb");
+        let msg = Mesh::load(&missing).unwrap_err().to_string();
+        assert!(
+            msg.contains("missing.glb") && msg.contains("file not found"),
+            "{msg}"
+        );
+        let msg = Mesh::load_gltf(&missing).unwrap_err().to_string();
+        assert!(
+            msg.contains("missing.glb") && msg.contains("file not found"),
+            "{msg}"
+        );
+
+        let xyz = dir.path().join("cloud.XYZ");
+        std::fs::write(&xyz, "1 2 3\n").unwrap();
+        let msg = Mesh::load(&xyz).unwrap_err().to_string();
+        assert!(
+            msg.contains("cloud.XYZ")
+                && msg
+                    .contains("unsupported extension '.xyz' (lodbench reads .obj, .gltf and .glb)"),
+            "{msg}"
+        );
+        let bare = dir.path().join("mesh");
+        std::fs::write(&bare, "v 0 0 0\n").unwrap();
+        let msg = Mesh::load(&bare).unwrap_err().to_string();
+        assert!(msg.contains("has no file extension"), "{msg}");
+    }
+
+    #[test]
+    fn truncated_glb_and_garbage_gltf_are_not_readable() {
+        let dir = tempfile::tempdir().unwrap();
+        let glb = std::fs::read(fixture("tetra.glb")).unwrap();
+        let cut = dir.path().join("cut.glb");
+        // Every truncation (the GLB header's length no longer matches) is refused by the glTF parser, none
+        // panics, and each message names the file.
+        for len in 0..glb.len() {
+            std::fs::write(&cut, &glb[..len]).unwrap();
+            let msg = Mesh::load(&cut).unwrap_err().to_string();
+            assert!(
+                msg.contains("cut.glb") && msg.contains("not a readable glTF file ("),
+                "{len}: {msg}"
+            );
+        }
+        for (file, text) in [("garbage.gltf", "solid cube\n"), ("empty.gltf", "{}")] {
+            let path = dir.path().join(file);
+            std::fs::write(&path, text).unwrap();
+            let msg = Mesh::load(&path).unwrap_err().to_string();
+            assert!(
+                msg.contains(file) && msg.contains("not a readable glTF file ("),
+                "{msg}"
+            );
+        }
+    }
+
+    #[test]
+    fn gltf_nan_position_is_reported() {
+        let mut bytes = fixture_buffer();
+        bytes[12..16].copy_from_slice(&f32::NAN.to_le_bytes()); // x of vertex 2 (position 1)
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_json(dir.path(), "nan.gltf", &with_buffer(fixture_json(), &bytes));
+        let msg = Mesh::load(&path).unwrap_err().to_string();
+        assert!(
+            msg.contains("nan.gltf") && msg.contains("vertex 2 has a non-finite coordinate"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn gltf_separate_bin_is_read_from_the_files_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("model");
+        std::fs::create_dir(&sub).unwrap();
+        let mut json = fixture_json();
+        json["buffers"][0]["uri"] = "tetra%20data.bin".into();
+        let path = write_json(&sub, "tetra.gltf", &json);
+        std::fs::write(sub.join("tetra data.bin"), fixture_buffer()).unwrap();
+        assert_eq!(
+            Mesh::load(&path).unwrap(),
+            Mesh::load(&fixture("tetra.gltf")).unwrap()
+        );
+
+        std::fs::remove_file(sub.join("tetra data.bin")).unwrap();
+        let msg = Mesh::load(&path).unwrap_err().to_string();
+        assert!(
+            msg.contains("tetra.gltf")
+                && msg.contains("buffer 0 file")
+                && msg.contains("tetra data.bin not found"),
+            "{msg}"
+        );
+        json["buffers"][0]["uri"] = "https://example.com/tetra.bin".into();
+        let msg = load_json(&json).unwrap_err().to_string();
+        assert!(
+            msg.contains("reads only data: URIs and relative file paths"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn gltf_takes_the_default_scene_else_scene_0_else_every_mesh() {
+        let mut json = fixture_json();
+        json["scenes"] = serde_json::json!([{"nodes": [0]}, {"nodes": [1]}]);
+        json["scene"] = 1.into();
+        let m = load_json(&json).unwrap();
+        assert_eq!(m.vertex_count(), 4);
+        assert_bounds(&m, [2.0, 0.0, 0.0], [3.0, 1.0, 1.0]);
+
+        json["scenes"] = serde_json::json!([{"nodes": [1]}, {"nodes": [0]}]);
+        json.as_object_mut().unwrap().remove("scene");
+        let m = load_json(&json).unwrap();
+        assert_eq!(m.vertex_count(), 4);
+        assert_bounds(&m, [2.0, 0.0, 0.0], [3.0, 1.0, 1.0]);
+
+        json.as_object_mut().unwrap().remove("scenes");
+        let m = load_json(&json).unwrap();
+        assert_eq!(m.vertex_count(), 4);
+        assert_bounds(&m, [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    }
+
+    #[test]
+    fn gltf_without_triangle_primitives_is_an_error() {
+        let mut json = fixture_json();
+        json["meshes"][0]["primitives"][0]["mode"] = 1.into(); // LINES; primitive 1 is POINTS
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_json(dir.path(), "lines.gltf", &json);
+        let msg = Mesh::load(&path).unwrap_err().to_string();
+        assert!(
+            msg.contains("lines.gltf") && msg.contains("has no triangle primitives in scene 0"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn gltf_strips_fans_and_unindexed_triangles() {
+        let mut json = fixture_json();
+        json["meshes"][0]["primitives"][0]
+            .as_object_mut()
+            .unwrap()
+            .remove("indices");
+        json["meshes"][0]["primitives"][0]["mode"] = 5.into();
+        let m = load_json(&json).unwrap();
+        assert_eq!(&m.indices[..6], &[0, 1, 2, 1, 3, 2]);
+        assert_eq!(m.triangle_count(), 4);
+
+        json["meshes"][0]["primitives"][0]["mode"] = 6.into();
+        let m = load_json(&json).unwrap();
+        assert_eq!(&m.indices[..6], &[1, 2, 0, 2, 3, 0]);
+
+        json["meshes"][0]["primitives"][0]["mode"] = 4.into();
+        json["accessors"][0]["count"] = 3.into();
+        json["accessors"][1]["count"] = 3.into();
+        let m = load_json(&json).unwrap();
+        assert_eq!(m.indices, [0, 1, 2, 3, 4, 5]);
+    }
+
+    #[test]
+    fn gltf_node_transform_maps_normals_by_inverse_transpose_and_mirrors_winding() {
+        let mut json = fixture_json();
+        json["nodes"][1]["scale"] = serde_json::json!([2.0, 1.0, -1.0]);
+        let m = load_json(&json).unwrap();
+        assert_bounds(&m, [0.0, 0.0, -1.0], [4.0, 1.0, 1.0]);
+        assert_near(m.positions[5], Vec3::new(4.0, 0.0, 0.0));
+        assert_near(m.normals[5], Vec3::new(1.5, -1.0, 1.0).normalize());
+        // The mirrored copy's triangles still face outwards.
+        let centre = Vec3::new(2.5, 0.25, -0.25);
+        for t in m.indices[12..].chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3::from(m.positions[i as usize]));
+            let outward = (b - a).cross(c - a).dot((a + b + c) / 3.0 - centre);
+            assert!(outward > 0.0, "{t:?}");
+        }
+    }
+
+    #[test]
+    fn gltf_normals_are_computed_unless_every_primitive_has_them() {
+        let mut json = fixture_json();
+        let mut bare = json["meshes"][0].clone();
+        bare["primitives"][0]["attributes"]
+            .as_object_mut()
+            .unwrap()
+            .remove("NORMAL");
+        json["meshes"] = serde_json::json!([json["meshes"][0], bare]);
+        json["nodes"][1]["mesh"] = 1.into();
+        let m = load_json(&json).unwrap();
+        assert_eq!(m.vertex_count(), 8);
+        assert_eq!(m.normals, vertex_normals(&m.positions, &m.indices));
+        assert_near(m.normals[1], Vec3::X);
+    }
+
+    #[test]
+    fn gltf_structural_problems_are_errors() {
+        let mut bad_index = fixture_buffer();
+        bad_index[96..98].copy_from_slice(&9u16.to_le_bytes());
+        let cases: Vec<(serde_json::Value, &str)> = vec![
+            (
+                with_buffer(fixture_json(), &bad_index),
+                "mesh 0 primitive 0 uses vertex index 9 but has 4 vertices",
+            ),
+            (
+                {
+                    let mut j = fixture_json();
+                    j["accessors"][0]["count"] = 5.into();
+                    j
+                },
+                "accessor 0 (5 elements) does not fit in buffer view 0",
+            ),
+            (
+                {
+                    let mut j = fixture_json();
+                    j["nodes"][1]["children"] = serde_json::json!([0]);
+                    j
+                },
+                "node 0 is reached twice from scene 0",
+            ),
+            (
+                {
+                    let mut j = fixture_json();
+                    j["buffers"][0]["byteLength"] = 200.into();
+                    j
+                },
+                "buffer 0 holds 120 bytes but declares byteLength 200",
+            ),
+            (
+                {
+                    let mut j = fixture_json();
+                    j["accessors"][0]["sparse"] = serde_json::json!({
+                        "count": 1,
+                        "indices": {"bufferView": 2, "componentType": 5123},
+                        "values": {"bufferView": 0}
+                    });
+                    j
+                },
+                "accessor 0 is sparse",
+            ),
+        ];
+        for (json, want) in cases {
+            let msg = load_json(&json).unwrap_err().to_string();
+            assert!(msg.contains("edited.gltf") && msg.contains(want), "{msg}");
+        }
     }
 
     #[test]

@@ -78,6 +78,9 @@ pub fn run_with(cfg: &RunConfig, registry: &Registry) -> Result<RunSummary> {
         .iter()
         .map(|&s| SceneDef::new(s, &cfg.scene))
         .collect::<Result<Vec<_>>>()?;
+    for note in defs.iter().flat_map(|d| d.notes()) {
+        eprintln!("note: {note}");
+    }
     let out_dir = cfg.out.clone().unwrap_or_else(|| {
         default_out_dir(&cfg.scenes.iter().map(|s| s.name()).collect::<Vec<_>>())
     });

@@ -1,22 +1,104 @@
-//! `alpha-2pass`: the double-pass variant of unpopping blending (seed 003 section 11). Each translucent LOD
-//! contributes only its nearest surface, so its own back faces never show through: a depth-only pass writes the
-//! object's nearest depth, then a colour pass draws it again with a depth-equal test and blending.
+//! `alpha-2pass` and `alpha-linear`: the double pass of seed 003 section 11. Each translucent LOD contributes
+//! only its nearest surface, so its own back faces never show through: a depth-only pass writes the object's
+//! nearest depth, then a colour pass draws it again with a depth-equal test and blending.
+//!
+//! The two differ in their weights ([`Weights`]):
+//! - `alpha-2pass` keeps Giegl's unpopping schedule (seed 000 Fig. 2): one LOD of a t-instance is opaque (drawn
+//!   with the rest of the scene), the other translucent over it with alpha 2k or 2(1 - k), one double pass per
+//!   t-instance.
+//! - `alpha-linear` is seed 003's own blending (section 8, eq. 2, and the `DrawTransparentModelDoublePass`
+//!   listing): during a transition both LODs are translucent, the outgoing one (`lod_from`) with weight 1 - k,
+//!   then the incoming one (`lod_to`) with weight k, each with its own double pass (depth cleared, depth only,
+//!   then colour with depth read-only and `colour = w src + (1 - w) dst`): 4 draw calls per t-instance. A LOD
+//!   whose weight is 0 is not drawn (the paper: "when the transparency of the old model reaches zero, the old
+//!   model is not drawn"). The listing's blend is over the frame, so what lies behind the object shows through
+//!   with weight k (1 - k) (a quarter at k = 0.5): seed 003's "translucent ghost" at close range. The paper
+//!   does not say which LOD is drawn first; here the outgoing one, so at k = 0 and k = 1 the frame is exactly
+//!   one LOD.
 //!
 //! The paper clears the whole depth buffer before each translucent model, which would let it draw over nearer
 //! objects that should hide it. Here the object's depth passes go to a depth buffer of the method's own
 //! (`object_depth`, cleared per t-instance), and the colour pass reads the scene's depth buffer (the opaque
 //! pass's) as a texture and drops fragments behind it: occlusion by the rest of the scene stays intact, and,
-//! as in `alpha`, the object's own opaque LOD hides the parts of the translucent one that lie behind it. Cost: two
-//! render passes per t-instance.
+//! in `alpha-2pass`, as in `alpha`, the object's own opaque LOD hides the parts of the translucent one that lie
+//! behind it (`alpha-linear` has no opaque LOD in transition, so the scene depth holds only the other
+//! objects). Cost: two render passes per translucent draw.
 
 use super::alpha::OVER;
-use super::common::{FrameInput, Method, UnpopLists};
+use super::common::{back_to_front, instance_raw, FrameInput, Method, UnpopLists};
 use crate::formats::DEPTH_FORMAT;
-use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
+use crate::gpu::{DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
+use crate::schedule::InstanceState;
+
+/// How a t-instance's two LODs are weighted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Weights {
+    /// Giegl's unpopping (`alpha-2pass`): one LOD opaque, the other translucent with alpha 2k or 2(1 - k).
+    Unpop,
+    /// Seed 003's eq. 2 (`alpha-linear`): both translucent, `lod_from` with 1 - k, then `lod_to` with k.
+    Linear,
+}
+
+/// The translucent draws of a t-instance under `weights` (LOD, weight), in drawing order; empty for an
+/// n-instance. Unpop's opaque LOD is not among them.
+pub fn translucent_draws(weights: Weights, s: &InstanceState) -> Vec<(u32, f32)> {
+    if !s.in_transition() {
+        return Vec::new();
+    }
+    match weights {
+        Weights::Unpop => super::common::unpop(s).translucent.into_iter().collect(),
+        Weights::Linear => [(s.lod_from, 1.0 - s.k), (s.lod_to, s.k)]
+            .into_iter()
+            .filter(|&(_, w)| w > 0.0)
+            .collect(),
+    }
+}
+
+/// `alpha-linear`'s draw lists: the n-instances opaque, then each t-instance's two translucent LODs
+/// (outgoing, incoming), t-instances back to front. Kept between frames.
+#[derive(Default)]
+struct LinearLists {
+    opaque: DrawList,
+    translucent: DrawList,
+    order: Vec<usize>,
+}
+
+impl LinearLists {
+    /// Fills, builds and uploads both lists, opaque first; returns the first instance of the translucent list.
+    fn prepare(&mut self, gpu: &SceneGpu, input: &FrameInput<'_>, buffer: &InstanceBuffer) -> u32 {
+        self.opaque.clear();
+        self.translucent.clear();
+        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
+            if !s.in_transition() {
+                let raw = instance_raw(input, i, s.k, 1.0, s.lod_from);
+                self.opaque.push(0, inst.model, s.lod_from, raw);
+            }
+        }
+        back_to_front(input.distances, &mut self.order, |i| {
+            input.states[i].in_transition()
+        });
+        for &i in &self.order {
+            let s = &input.states[i];
+            let model = input.scene.instances[i].model;
+            for (lod, w) in translucent_draws(Weights::Linear, s) {
+                self.translucent
+                    .push(0, model, lod, instance_raw(input, i, s.k, w, lod));
+            }
+        }
+        self.opaque.build();
+        self.translucent.build_in_order();
+        let n_opaque = self.opaque.instances.len() as u32;
+        gpu.upload_at(buffer, 0, &self.opaque);
+        gpu.upload_at(buffer, n_opaque, &self.translucent);
+        n_opaque
+    }
+}
 
 pub struct AlphaTwoPass {
+    weights: Weights,
     lists: UnpopLists,
+    linear: LinearLists,
     buffer: InstanceBuffer,
     depth_only: wgpu::RenderPipeline,
     colour: wgpu::RenderPipeline,
@@ -28,7 +110,7 @@ pub struct AlphaTwoPass {
 }
 
 impl AlphaTwoPass {
-    pub fn new(gpu: &SceneGpu, scene: &Scene) -> Self {
+    pub fn new(gpu: &SceneGpu, scene: &Scene, weights: Weights) -> Self {
         let scene_depth_layout =
             gpu.device
                 .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -59,7 +141,9 @@ impl AlphaTwoPass {
             view_formats: &[],
         });
         AlphaTwoPass {
+            weights,
             lists: UnpopLists::default(),
+            linear: LinearLists::default(),
             buffer: gpu
                 .create_instance_buffer("alpha-2pass instances", 2 * scene.instances.len() as u32),
             depth_only: gpu.mesh_pipeline(&MeshPipeline {
@@ -127,18 +211,23 @@ impl Method for AlphaTwoPass {
     ) -> DrawStats {
         let group = self.scene_depth_group(gpu, target);
         // Translucent neighbours of one bucket share a draw; each of its instances gets its own pair of passes.
-        let n_opaque = self.lists.prepare(gpu, input, &self.buffer, |_| 0);
+        let (n_opaque, opaque, translucent) = match self.weights {
+            Weights::Unpop => (
+                self.lists.prepare(gpu, input, &self.buffer, |_| 0),
+                &self.lists.opaque,
+                &self.lists.translucent,
+            ),
+            Weights::Linear => (
+                self.linear.prepare(gpu, input, &self.buffer),
+                &self.linear.opaque,
+                &self.linear.translucent,
+            ),
+        };
         let mut stats = {
             let mut pass = gpu.begin_clear_pass(encoder, target, "alpha-2pass opaque");
-            gpu.draw(
-                &mut pass,
-                &self.buffer,
-                0,
-                &self.lists.opaque,
-                &[&gpu.opaque_pipeline],
-            )
+            gpu.draw(&mut pass, &self.buffer, 0, opaque, &[&gpu.opaque_pipeline])
         };
-        for d in &self.lists.translucent.draws {
+        for d in &translucent.draws {
             for j in 0..d.instance_count {
                 let at = n_opaque + d.first_instance + j;
                 {
@@ -187,5 +276,50 @@ impl Method for AlphaTwoPass {
             }
         }
         stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn st(from: u32, to: u32, k: f32) -> InstanceState {
+        InstanceState {
+            lod_from: from,
+            lod_to: to,
+            k,
+        }
+    }
+
+    #[test]
+    fn linear_weights_are_one_minus_k_then_k() {
+        assert!(translucent_draws(Weights::Linear, &st(2, 2, 0.0)).is_empty());
+        assert_eq!(
+            translucent_draws(Weights::Linear, &st(1, 2, 0.25)),
+            vec![(1, 0.75), (2, 0.25)]
+        );
+        // Coarsening and refining alike: the outgoing LOD first.
+        assert_eq!(
+            translucent_draws(Weights::Linear, &st(2, 1, 0.5)),
+            vec![(2, 0.5), (1, 0.5)]
+        );
+        // A LOD of weight 0 is not drawn.
+        assert_eq!(
+            translucent_draws(Weights::Linear, &st(0, 1, 0.0)),
+            vec![(0, 1.0)]
+        );
+    }
+
+    #[test]
+    fn unpop_weights_keep_one_lod_opaque() {
+        // Only the translucent LOD is listed; the opaque one goes with the rest of the scene.
+        assert_eq!(
+            translucent_draws(Weights::Unpop, &st(1, 2, 0.25)),
+            vec![(2, 0.5)]
+        );
+        assert_eq!(
+            translucent_draws(Weights::Unpop, &st(1, 2, 0.75)),
+            vec![(1, 0.5)]
+        );
     }
 }

@@ -22,12 +22,17 @@
 //! then merges the two buffers into the frame (sections 3.4-3.5, eq. 2).
 //!
 //! Choices the paper leaves open, made here:
-//! - t-instances are drawn with back faces culled (n-instances are drawn like in every other method, two-sided).
-//!   Where eq. 1 discards a front fragment, a two-sided draw would show the object's own inside there with the
-//!   same id, and case 3 would average it with the other LOD's front: dark speckle all over the object. With
-//!   culling, what lies behind the object shows through, and case 2 picks the other LOD's front by depth.
+//! - t-instances are drawn two-sided, like everything else, and their back faces write an id of their own
+//!   (front faces `2 i + 1`, back faces `2 i + 2` for instance i: [`front_id`], [`back_id`]). Where eq. 1
+//!   discards a front fragment, the object's own inside shows there; with the front's id, case 3 would average
+//!   it with the other LOD's front (dark speckle all over the object); with an id of its own, case 2 picks the
+//!   other LOD's front by depth, as it would pick it over anything behind the object. Where both buffers show
+//!   the inside (the camera near or inside the bounds of a mesh with holes, or inside an open one), both hold
+//!   the back id and case 3 averages them, as the two-sided reference shows that inside. (Culling back faces,
+//!   the earlier choice, left background there: with the camera inside the bunny, on all 19,200 pixels the
+//!   reference covers at 160x120; `tests/it/fidelity.rs`.)
 //! - Formats: colour Rgba8UnormSrgb (4 B), depth Depth32Float (4 B, the depth attachment itself, read as a
-//!   texture by the combination pass), id R16Uint (2 B; R32Uint when a scene has 65,535 instances or more):
+//!   texture by the combination pass), id R16Uint (2 B; R32Uint when a scene has 32,767 instances or more, as ids go to twice the count):
 //!   10 bytes per pixel per buffer against the paper's 7 (24-bit colour, 16-bit float depth, 16-bit float id),
 //!   20 MiB for two 1024x1024 buffers against its 14 MB. wgpu has no 24-bit colour or 16-bit float depth
 //!   attachment; Depth16Unorm would lose precision the depth test of case 2 needs.
@@ -178,9 +183,19 @@ pub fn reprojection(new: &Camera, old: &Camera) -> Mat4 {
     Mat4::from_cols_array(&m.to_cols_array().map(|x| x as f32))
 }
 
-/// The id format for `instances` instances (id 0 is reserved for n-instances).
+/// The id a t-instance's front faces write (its back faces write one more, [`back_id`]); 0 is the n-instances'.
+pub fn front_id(instance: usize) -> u32 {
+    2 * instance as u32 + 1
+}
+
+/// The id a t-instance's back faces write: [`front_id`] + 1.
+pub fn back_id(instance: usize) -> u32 {
+    front_id(instance) + 1
+}
+
+/// The id format for `instances` instances: ids up to [`back_id`] of the last one.
 pub fn id_format(instances: usize) -> wgpu::TextureFormat {
-    if instances < u16::MAX as usize {
+    if 2 * instances < u16::MAX as usize {
         wgpu::TextureFormat::R16Uint
     } else {
         wgpu::TextureFormat::R32Uint
@@ -428,7 +443,7 @@ impl Fsi {
             })
         };
         let n_pipeline = pipeline("fsi n-instances", "fs_fsi_n", None);
-        let t_pipeline = pipeline("fsi t-instances", "fs_fsi_t", Some(wgpu::Face::Back));
+        let t_pipeline = pipeline("fsi t-instances", "fs_fsi_t", None);
 
         let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
             binding,
@@ -621,7 +636,7 @@ impl Fsi {
                         self.repeats_per_unit[inst.model as usize],
                         tau_with_margin(s, lod, self.margin[i]),
                         lod as f32,
-                        (i + 1) as f32,
+                        front_id(i) as f32,
                     ],
                 }
             } else {

@@ -14,7 +14,8 @@ pub enum Profile {
     /// What CI runs on a software adapter.
     Ci,
     /// The test suite's regression set: 96x72, paths short enough to render every scene with every method in
-    /// about a minute on a software adapter, long enough to pass through each scene's transitions.
+    /// about a minute on a software adapter, long enough to pass through each scene's transitions; the bunny
+    /// scenes as a close-up (`--sweep-start close-up`), where their LOD differences are visible at 96x72.
     Regress,
     /// The papers' sizes: 800x600, 3,600 timed frames, the full instance counts.
     Paper,
@@ -37,6 +38,20 @@ pub enum CameraMode {
     Dolly,
 }
 
+/// `--sweep-start`: where the bunny scenes' path starts (bunny-sweep's bunny, bunny-grid's first bunny).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum SweepStart {
+    /// Where the model's bounding sphere fits the view: the camera is never inside the model, and switches
+    /// nearer than that are not reached (the run says which).
+    Fit,
+    /// A close-up: just before the first switch's band (0.9 of its near edge), even where that puts the camera
+    /// inside the model's bounding sphere (the run says so), and `--pixel-error` 1 at the viewport by default.
+    /// At small viewports this is the only way to see the bunny's LOD differences: at 96x72 even LOD3's error is
+    /// under a pixel wherever the whole bunny is in view. The regress profile's default.
+    CloseUp,
+}
+
 /// What a profile sets for one scene.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ProfileValues {
@@ -44,6 +59,8 @@ pub struct ProfileValues {
     pub height: u32,
     pub frames: u32,
     pub warmup: u32,
+    /// Where the bunny scenes' path starts unless `--sweep-start` says.
+    pub sweep_start: SweepStart,
 }
 
 /// The paper's counts for bunny-grid (seed 003 section 6).
@@ -126,24 +143,28 @@ impl SceneKind {
                 height: 240,
                 frames: frames(20, 60, 600),
                 warmup: 5,
+                sweep_start: SweepStart::Fit,
             },
             Profile::Ci => ProfileValues {
                 width: 320,
                 height: 240,
                 frames: frames(30, 120, 2400),
                 warmup: 10,
+                sweep_start: SweepStart::Fit,
             },
             Profile::Regress => ProfileValues {
                 width: 96,
                 height: 72,
                 frames: frames(3, 40, 240),
                 warmup: 2,
+                sweep_start: SweepStart::CloseUp,
             },
             Profile::Paper => ProfileValues {
                 width: 800,
                 height: 600,
                 frames: 3600,
                 warmup: 120,
+                sweep_start: SweepStart::Fit,
             },
         }
     }

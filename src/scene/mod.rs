@@ -17,7 +17,7 @@ use std::sync::Arc;
 
 pub mod kind;
 
-pub use kind::{CameraMode, Profile, ProfileValues, SceneKind, PAPER_COUNTS};
+pub use kind::{CameraMode, Profile, ProfileValues, SceneKind, SweepStart, PAPER_COUNTS};
 
 /// Scene-defining settings after the profile is applied (built from the flags by `crate::config`).
 #[derive(Debug, Clone, Serialize)]
@@ -29,7 +29,10 @@ pub struct SceneConfig {
     pub height: Option<u32>,
     pub frames: Option<u32>,
     pub mesh: Option<std::path::PathBuf>,
-    pub pixel_error: f32,
+    /// `--pixel-error`; None = the scene's default ([`SceneConfig::pixel_error`]).
+    pub pixel_error: Option<f32>,
+    /// `--sweep-start`; None = the profile's.
+    pub sweep_start: Option<SweepStart>,
     pub switch_distances: Option<Vec<f32>>,
     pub counts: Option<Vec<u32>>,
     pub fov_deg: f32,
@@ -45,6 +48,22 @@ impl SceneConfig {
             height: self.height.unwrap_or(p.height),
             frames: self.frames.unwrap_or(p.frames),
             warmup: p.warmup,
+            sweep_start: self.sweep_start.unwrap_or(p.sweep_start),
+        }
+    }
+
+    /// The screen-space error (pixels) the switch distances of `kind` are made for, at viewport height `height`:
+    /// `--pixel-error`, or by default one pixel at [`PAPER_HEIGHT`] for the bunny scenes (seed 003 ran them at
+    /// 800x600; this keeps their switch distances and path the same at every viewport size, so a smaller
+    /// profile is the same experiment at a lower resolution), except for a close-up path (1 pixel at this
+    /// viewport), and 1 for the procedural scenes (whose camera flights start beyond the last switch at any
+    /// size).
+    pub fn pixel_error(&self, kind: SceneKind, height: u32) -> f32 {
+        let close_up = self.resolved(kind).sweep_start == SweepStart::CloseUp;
+        match self.pixel_error {
+            Some(p) => p,
+            None if kind.is_bunny() && !close_up => height as f32 / PAPER_HEIGHT as f32,
+            None => 1.0,
         }
     }
 
@@ -56,6 +75,10 @@ impl SceneConfig {
         }
     }
 }
+
+/// Viewport height of seed 003's experiments (800x600): the bunny scenes' default `--pixel-error` is one pixel
+/// at this height.
+pub const PAPER_HEIGHT: u32 = 600;
 
 /// Seed of the procedural scenes' models and layouts (tree shapes, instance jitter and yaw): fixed, so a
 /// scene is the same picture whatever `--seed` drives (the methods' noise).
@@ -169,6 +192,71 @@ pub struct SceneDef {
     pub mesh_source: String,
     /// Milliseconds spent building the models' LOD chains (once per scene, never per instance).
     pub lod_generation_ms: f64,
+    /// The bunny scenes' path (sweep or grid); None for the procedural scenes.
+    pub path: Option<BunnyPath>,
+}
+
+/// Where the bunny scenes' bunnies are: bunny-sweep's bunny moves from `near` to `far` and back, bunny-grid's
+/// bunnies stand between them (eq. 1 of seed 003). Distances from the camera to the bounding-sphere centre.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct BunnyPath {
+    pub near: f32,
+    pub far: f32,
+    /// Nearest distance at which the model's bounding sphere fits the view (the narrower of the two fovs):
+    /// `near` is never less, so the camera is never inside the model.
+    pub fit: f32,
+    /// How many switches, from LOD1 on, lie nearer than `near` (their band starts nearer): the path never
+    /// reaches them, and every frame shows LOD `unreached` or coarser.
+    pub unreached: usize,
+    pub start: SweepStart,
+}
+
+impl BunnyPath {
+    /// The path for `m` at this viewport: it starts at `fit`, or, when `fit` lies inside a switch's transition
+    /// band, just past that band (so frame 0 is never in a transition), and ends past the last band with a
+    /// margin so the coarsest LOD is seen for a while (at least a quarter beyond the start).
+    ///
+    /// A close-up (`SweepStart::CloseUp`) starts at `fit` when the first band lies beyond it, else at 0.9 of
+    /// the first band's near edge, and reaches every switch.
+    pub fn new(
+        m: &Model,
+        schedule: &ScheduleParams,
+        start: SweepStart,
+        width: u32,
+        height: u32,
+        fov_y: f32,
+    ) -> Self {
+        let (b, h) = (schedule.band, schedule.hysteresis);
+        let aspect = width as f32 / height as f32;
+        let half_fov = (fov_y * 0.5).min(((fov_y * 0.5).tan() * aspect).atan());
+        let fit = m.radius / half_fov.sin();
+        let first_band = m.switches.first().map(|s| s * (1.0 - h) * (1.0 - b));
+        let (near, unreached) = match (start, first_band) {
+            (SweepStart::CloseUp, Some(fb)) if fit >= fb * 0.95 => (fb * 0.9, 0),
+            (SweepStart::CloseUp, _) => (fit, 0),
+            (SweepStart::Fit, _) => {
+                let unreached = m
+                    .switches
+                    .iter()
+                    .take_while(|&&s| s * (1.0 - h) * (1.0 - b) < fit)
+                    .count();
+                let near = match unreached {
+                    0 => fit,
+                    n => fit.max(m.switches[n - 1] * (1.0 + h) * (1.0 + b) * 1.01),
+                };
+                (near, unreached)
+            }
+        };
+        let last = m.switches.last().copied().unwrap_or(m.radius);
+        let far = (last * (1.0 + h) * (1.0 + b) * 1.15).max(near * 1.25);
+        BunnyPath {
+            near,
+            far,
+            fit,
+            unreached,
+            start,
+        }
+    }
 }
 
 impl SceneDef {
@@ -179,14 +267,28 @@ impl SceneDef {
             return procedural_def(kind, cfg, pv.frames, pv.width, pv.height, fov_y);
         }
         let started = std::time::Instant::now();
-        let (mesh, mesh_source) = match &cfg.mesh {
-            Some(p) => (Mesh::load_obj(p)?, p.display().to_string()),
+        const BUILT_IN: &str = "scenes/bunny.obj (built in)";
+        let (mesh, mesh_source, file) = match &cfg.mesh {
+            Some(p) => (
+                Mesh::load(p)?,
+                p.display().to_string(),
+                p.display().to_string(),
+            ),
             None => (
-                Mesh::parse_obj("scenes/bunny.obj (built in)", BUNNY_OBJ)?,
+                Mesh::parse_obj(BUILT_IN, BUNNY_OBJ)?,
                 "scenes/bunny.obj (npm bunny@1.0.1, built in)".to_string(),
+                BUILT_IN.to_string(),
             ),
         };
-        let model = bunny_model(&mesh, cfg, pv.height, fov_y)?;
+        let model = bunny_model(&file, &mesh, cfg, pv.height, fov_y)?;
+        let path = BunnyPath::new(
+            &model,
+            &cfg.schedule,
+            pv.sweep_start,
+            pv.width,
+            pv.height,
+            fov_y,
+        );
         let lod_generation_ms = started.elapsed().as_secs_f64() * 1e3;
         Ok(SceneDef {
             kind,
@@ -200,7 +302,44 @@ impl SceneDef {
             camera_mode: cfg.camera,
             mesh_source,
             lod_generation_ms,
+            path: Some(path),
         })
+    }
+
+    /// What a user should know before trusting the scene: switches the bunny path never reaches. One line each
+    /// scene (empty when there is nothing to say).
+    pub fn notes(&self) -> Vec<String> {
+        let (Some(path), Some(m)) = (self.path, self.models.first()) else {
+            return Vec::new();
+        };
+        if path.near < m.radius {
+            return vec![format!(
+                "{}: a close-up (--sweep-start close-up): the path starts at {:.4}, inside the model's bounding \
+                 sphere (radius {:.4}), so the camera may be inside the model",
+                self.name(),
+                path.near,
+                m.radius
+            )];
+        }
+        if path.unreached == 0 {
+            return Vec::new();
+        }
+        let lods: Vec<String> = m.switches[..path.unreached]
+            .iter()
+            .enumerate()
+            .map(|(j, s)| format!("LOD{} at {s:.4}", j + 1))
+            .collect();
+        let start = match self.kind {
+            SceneKind::BunnyGrid => "the first bunny",
+            _ => "the sweep's start",
+        };
+        vec![format!(
+            "{}: the switch to {} lies nearer than {start} ({:.4}, where the model's bounding sphere fits the \
+             view): not reached by the sweep; a smaller --pixel-error moves the switches farther",
+            self.name(),
+            lods.join(", "),
+            path.near
+        )]
     }
 
     pub fn instantiate(&self, count: u32) -> Scene {
@@ -208,20 +347,17 @@ impl SceneDef {
             return self.instantiate_field(count);
         }
         let m = &self.models[0];
-        let b = self.schedule.band;
-        let h = self.schedule.hysteresis;
-        let last = *m.switches.last().unwrap_or(&m.radius);
-        // Nearest distance at which the whole bounding sphere is in view (the narrower of the two fovs).
-        let aspect = self.width as f32 / self.height as f32;
-        let half_fov = (self.fov_y * 0.5).min(((self.fov_y * 0.5).tan() * aspect).atan());
-        let fit = m.radius / half_fov.sin();
-        let first_band = m.switches.first().map(|s| s * (1.0 - h) * (1.0 - b));
-        let near_d = match first_band {
-            Some(fb) if fit >= fb * 0.95 => fb * 0.9,
-            _ => fit,
-        };
-        // Past the last band, with a margin so the coarsest LOD is seen for a while.
-        let far_d = last * (1.0 + h) * (1.0 + b) * 1.15;
+        let path = self.path.unwrap_or_else(|| {
+            BunnyPath::new(
+                m,
+                &self.schedule,
+                SweepStart::Fit,
+                self.width,
+                self.height,
+                self.fov_y,
+            )
+        });
+        let (near_d, far_d) = (path.near, path.far);
         let yaw = BUNNY_YAW;
         let (instances, motion, far_plane) = match self.kind {
             SceneKind::BunnyGrid => {
@@ -378,7 +514,7 @@ fn procedural_def(
         }
         (None, SceneKind::Simple) => (vec![12.0 * radius], "scene"),
         (None, _) => (
-            lod::switch_distances(&chain, scale, cfg.pixel_error, height, fov_y),
+            lod::switch_distances(&chain, scale, cfg.pixel_error(kind, height), height, fov_y),
             "pixel-error",
         ),
     };
@@ -407,20 +543,43 @@ fn procedural_def(
         camera_mode: cfg.camera,
         mesh_source: source.to_string(),
         lod_generation_ms,
+        path: None,
     })
 }
 
 /// Yaw of the bunny instances: the classic three-quarter view, face to the right.
 pub const BUNNY_YAW: f32 = 1.0;
 
-fn bunny_model(mesh: &Mesh, cfg: &SceneConfig, height: u32, fov_y: f32) -> Result<Model> {
-    let chain = LodChain::build("bunny", mesh, &DEFAULT_TARGETS)?;
+/// The bunny scenes' model from `mesh`, read from `file` (named in error messages).
+fn bunny_model(
+    file: &str,
+    mesh: &Mesh,
+    cfg: &SceneConfig,
+    height: u32,
+    fov_y: f32,
+) -> Result<Model> {
+    let bad = |problem: String| Error::Mesh {
+        path: file.to_string(),
+        problem,
+    };
+    let area: f64 = mesh
+        .indices
+        .chunks_exact(3)
+        .map(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3::from(mesh.positions[i as usize]));
+            f64::from((b - a).cross(c - a).length())
+        })
+        .sum();
+    if area.is_nan() || area <= 0.0 {
+        return Err(bad(format!(
+            "all {} triangles are degenerate (zero area)",
+            mesh.triangle_count()
+        )));
+    }
+    let chain = LodChain::build(file, mesh, &DEFAULT_TARGETS)?;
     let (center, radius) = chain.lods[0].mesh.bounding_sphere();
     if !(radius.is_finite() && radius > 0.0) {
-        return Err(Error::Mesh {
-            path: "bunny".into(),
-            problem: "has zero extent".into(),
-        });
+        return Err(bad("has zero extent".into()));
     }
     let scale = 1.0;
     let (switches, switch_source) = match &cfg.switch_distances {
@@ -435,7 +594,13 @@ fn bunny_model(mesh: &Mesh, cfg: &SceneConfig, height: u32, fov_y: f32) -> Resul
             (s.clone(), "override")
         }
         None => (
-            lod::switch_distances(&chain, scale, cfg.pixel_error, height, fov_y),
+            lod::switch_distances(
+                &chain,
+                scale,
+                cfg.pixel_error(SceneKind::BunnySweep, height),
+                height,
+                fov_y,
+            ),
             "pixel-error",
         ),
     };
@@ -611,6 +776,12 @@ pub struct SceneDescription {
     pub lod_generation_ms: f64,
     /// Milliseconds to place the instances of the first count (once per block).
     pub instance_build_ms: f64,
+    /// The bunny scenes' path (None for the procedural scenes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub path: Option<BunnyPath>,
+    /// [`SceneDef::notes`]: what the run warns about this scene.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -627,7 +798,13 @@ pub struct LodDescription {
     pub info: LodInfo,
     /// Distance beyond which this LOD is selected (None for LOD0).
     pub switch_distance: Option<f32>,
+    /// "not reached by the sweep" for a bunny-scene switch nearer than the path's start ([`BunnyPath`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<&'static str>,
 }
+
+/// [`LodDescription::note`] of a switch the bunny path never reaches.
+pub const NOT_REACHED: &str = "not reached by the sweep";
 
 impl SceneDef {
     pub fn describe(&self, cfg: &SceneConfig) -> SceneDescription {
@@ -643,7 +820,7 @@ impl SceneDef {
             frames: self.frames,
             instance_counts: self.counts.clone(),
             mesh: self.mesh_source.clone(),
-            pixel_error: cfg.pixel_error,
+            pixel_error: cfg.pixel_error(self.kind, self.height),
             schedule: self.schedule,
             models: self
                 .models
@@ -658,6 +835,10 @@ impl SceneDef {
                         .into_iter()
                         .map(|info| LodDescription {
                             switch_distance: info.lod.checked_sub(1).map(|j| m.switches[j]),
+                            note: match (info.lod, self.path) {
+                                (1.., Some(p)) if info.lod <= p.unreached => Some(NOT_REACHED),
+                                _ => None,
+                            },
                             info,
                         })
                         .collect(),
@@ -667,6 +848,8 @@ impl SceneDef {
             camera: self.camera_mode,
             lod_generation_ms: self.lod_generation_ms,
             instance_build_ms,
+            path: self.path,
+            notes: self.notes(),
         }
     }
 }

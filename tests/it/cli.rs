@@ -79,6 +79,116 @@ fn bad_meshes_name_the_file_and_the_problem() {
     let empty = write(dir.path(), "empty.obj", "# nothing\n");
     let out = lodbench(&["run", "--scene", "bunny-sweep", "--mesh", &empty], &[]);
     fails_with(&out, &["empty.obj", "no triangles"]);
+
+    // Every triangle degenerate (three points on a line, twice): named by file, not by model.
+    let flat = write(
+        dir.path(),
+        "flat.obj",
+        "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\n",
+    );
+    let out = lodbench(
+        &["describe", "--scene", "bunny-sweep", "--mesh", &flat],
+        &[],
+    );
+    fails_with(&out, &["flat.obj", "all 2 triangles are degenerate"]);
+
+    let folder = dir.path().to_str().unwrap();
+    let out = lodbench(&["run", "--scene", "bunny-sweep", "--mesh", folder], &[]);
+    fails_with(&out, &[folder, "is a directory"]);
+
+    let garbage = write(dir.path(), "garbage.glb", "glTF but not really");
+    let out = lodbench(&["run", "--scene", "bunny-sweep", "--mesh", &garbage], &[]);
+    fails_with(&out, &["garbage.glb", "not a readable glTF file"]);
+
+    let text = write(dir.path(), "mesh.ply", "ply\n");
+    let out = lodbench(&["run", "--scene", "bunny-sweep", "--mesh", &text], &[]);
+    fails_with(&out, &["mesh.ply", "unsupported extension '.ply'"]);
+}
+
+/// The built-in bunny written as a binary glTF (one mesh, one node translated by (5, 0, 0), positions and
+/// indices only): the smallest GLB the spec allows, made here so the test needs no generator.
+fn bunny_glb() -> Vec<u8> {
+    let m = lodbench::mesh::Mesh::parse_obj("bunny", lodbench::scene::BUNNY_OBJ).unwrap();
+    let mut bin: Vec<u8> = m
+        .positions
+        .iter()
+        .flatten()
+        .flat_map(|c| c.to_le_bytes())
+        .collect();
+    let pos_len = bin.len();
+    bin.extend(m.indices.iter().flat_map(|i| i.to_le_bytes()));
+    let (lo, hi) = m.bounds();
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"translation":[5,0,0]}}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],"buffers":[{{"byteLength":{}}}],"bufferViews":[{{"buffer":0,"byteLength":{pos_len}}},{{"buffer":0,"byteOffset":{pos_len},"byteLength":{}}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":{},"type":"VEC3","min":[{},{},{}],"max":[{},{},{}]}},{{"bufferView":1,"componentType":5125,"count":{},"type":"SCALAR"}}]}}"#,
+        bin.len(),
+        bin.len() - pos_len,
+        m.vertex_count(),
+        lo.x,
+        lo.y,
+        lo.z,
+        hi.x,
+        hi.y,
+        hi.z,
+        m.indices.len()
+    );
+    let mut json = json.into_bytes();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut glb = Vec::new();
+    glb.extend(b"glTF");
+    glb.extend(2u32.to_le_bytes());
+    glb.extend((total as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(json);
+    glb.extend((bin.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(bin);
+    glb
+}
+
+/// `--mesh` takes glTF: the bunny as a .glb gives the scene the OBJ gives (same LODs, switch distances and
+/// path; the node's translation moves the mesh, not its bounding sphere's size), and the committed fixtures of
+/// tests/data/ load.
+#[test]
+fn gltf_mesh_gives_the_scene_the_obj_gives() {
+    let dir = tempfile::tempdir().unwrap();
+    let glb = dir.path().join("bunny.glb");
+    std::fs::write(&glb, bunny_glb()).unwrap();
+    let describe = |mesh: Option<&str>| -> serde_json::Value {
+        let mut args = vec![
+            "describe",
+            "--scene",
+            "bunny-sweep",
+            "--profile",
+            "ci",
+            "--json",
+        ];
+        if let Some(m) = mesh {
+            args.extend_from_slice(&["--mesh", m]);
+        }
+        let out = lodbench(&args, &[]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let (from_glb, built_in) = (describe(Some(glb.to_str().unwrap())), describe(None));
+    assert_eq!(from_glb["models"], built_in["models"]);
+    assert_eq!(from_glb["path"], built_in["path"]);
+    assert!(from_glb["mesh"].as_str().unwrap().ends_with("bunny.glb"));
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    for f in ["tetra.gltf", "tetra.glb"] {
+        let m = lodbench::mesh::Mesh::load(&data.join(f)).unwrap();
+        assert_eq!((m.vertex_count(), m.triangle_count()), (8, 8), "{f}");
+    }
 }
 
 #[test]

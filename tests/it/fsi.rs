@@ -442,8 +442,12 @@ fn d_reprojection_follows_equation_2() {
 /// into the pixel, found from eq. 2's lookup by moving it by the miss. A near bunny in transition (k = 0.25) in
 /// front of a far one that the camera orbits: the near bunny moves a few pixels a frame across the view, so
 /// eq. 2 back-projects the background it uncovers onto where it stood a frame ago (section 4.2's
-/// disocclusion), and the background seen through eq. 1's holes onto another part of it. Every pixel matches
-/// the CPU model; the search moves lookups and finds no fragment for some pixels.
+/// disocclusion), and what is seen through eq. 1's holes (the bunny's own inside, drawn two-sided) onto another
+/// part of it. Every pixel matches the CPU model; the search moves lookups (lavapipe: 747 at frame 3, 432 at
+/// frame 4) and finds no fragment for some pixels. Since t-instances are two-sided the holes show the inside
+/// rather than the background, whose depth misleads eq. 2 less: the search moved over 1,000 lookups a frame and
+/// found the older LOD0 for over 3/4 of the holes plain eq. 2 fills with it when the holes showed background;
+/// now 1,219 of 1,689 (the test asks 2/3).
 #[test]
 fn f_forward_check_finds_the_fragment_that_moved_here() {
     let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
@@ -470,7 +474,7 @@ fn f_forward_check_finds_the_fragment_that_moved_here() {
             })
             .count();
         assert!(
-            searched > 1000,
+            searched > 300,
             "frame {last}: the search moved {searched} lookups"
         );
         if last == 3 {
@@ -479,7 +483,7 @@ fn f_forward_check_finds_the_fragment_that_moved_here() {
                 count(&with, Case::OlderCloser),
                 count(&without, Case::OlderCloser),
             );
-            assert!(b > 1000 && a > b * 3 / 4, "{with:?} against {without:?}");
+            assert!(b > 1000 && a > b * 2 / 3, "{with:?} against {without:?}");
         }
         // The buffers are the same; only the combination differs.
         assert!(plain.newer.color == checked.newer.color && plain.older.id == checked.older.id);

@@ -25,7 +25,7 @@ fn no_schedule_change_no_lodpop() {
         dir.path(),
         &[
             "--scene", "bunny-grid", "--count", "2", "--camera", "orbit", "--frames", "24", "--width",
-            "96", "--height", "72", "--method", METHODS,
+            "96", "--height", "72", "--sweep-start", "close-up", "--method", METHODS,
         ],
     );
     for m in METHODS.split(',') {
@@ -48,6 +48,9 @@ fn sweep(dir: &Path) -> Rows {
             "160",
             "--height",
             "120",
+            // Close up, where the bunny's LOD differences are visible at 160x120 (--sweep-start's help).
+            "--sweep-start",
+            "close-up",
             "--method",
             METHODS,
         ],

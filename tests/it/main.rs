@@ -11,6 +11,7 @@ mod architecture;
 mod ci_profile;
 mod cli;
 mod common;
+mod fidelity;
 mod fsi;
 mod lodpop;
 mod registry;
