@@ -40,6 +40,10 @@ from matplotlib.lines import Line2D  # noqa: E402
 import numpy as np  # noqa: E402
 from PIL import Image  # noqa: E402
 
+# Eleven methods and more: matplotlib's ten default colours would give two methods one colour.
+plt.rcParams["axes.prop_cycle"] = matplotlib.cycler(
+    color=list(plt.get_cmap("tab10").colors) + ["black", "gold", "navy", "lime"])
+
 
 def read_csv(path: Path):
     with open(path, newline="") as f:
