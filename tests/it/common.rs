@@ -207,3 +207,36 @@ pub fn subdivided_bunny_obj(levels: u32, amplitude: f32) -> String {
     }
     obj
 }
+
+/// Frame `frame` of `method` on `scene`, from its quality pass (RGBA8, sRGB-encoded bytes).
+pub fn render_frame(
+    ctx: &lodbench::gpu::GpuContext,
+    scene: &Scene,
+    method: &str,
+    frame: u32,
+) -> Vec<u8> {
+    let mut block = lodbench::measure::BlockRunner::new(
+        ctx,
+        scene,
+        Default::default(),
+        true,
+        &Default::default(),
+    )
+    .unwrap();
+    let mut out = None;
+    block
+        .run_method(
+            method,
+            0,
+            1,
+            &indicatif::ProgressBar::hidden(),
+            |f, (m, _, _)| {
+                if f == frame {
+                    out = Some(m.to_vec());
+                }
+                Ok(())
+            },
+        )
+        .unwrap();
+    out.expect("the frame was rendered")
+}

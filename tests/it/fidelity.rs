@@ -1,10 +1,10 @@
 //! Fidelity to a user's own mesh: the bunny scenes' path never puts the camera inside the model, switches it
 //! cannot reach are said, and FSI's t-instances do not vanish when the camera is near or inside a model.
 
-use crate::common::{read_csv, run_into, scene_config, static_scene, subdivided_bunny_obj};
-use indicatif::ProgressBar;
+use crate::common::{
+    read_csv, render_frame, run_into, scene_config, static_scene, subdivided_bunny_obj,
+};
 use lodbench::gpu::GpuContext;
-use lodbench::measure::BlockRunner;
 use lodbench::scene::{SceneDef, SceneKind, NOT_REACHED};
 
 /// The bunny split to 14,696 triangles with a scan's fine noise: its LODs lose so little that the switch to
@@ -82,21 +82,10 @@ fn fsi_t_instances_show_the_inside_like_the_reference() {
     let d = probe.models[0].radius * 0.02;
     let mut scene = static_scene(&[d], [d, 2.0 * d, 3.0 * d], 3, "fixed");
     scene.far = 4.0 * probe.models[0].radius;
-    let frame = |method: &str| {
-        let mut block =
-            BlockRunner::new(&ctx, &scene, Default::default(), true, &Default::default()).unwrap();
-        let mut out = None;
-        block
-            .run_method(method, 0, 1, &ProgressBar::hidden(), |f, (m, _, _)| {
-                if f == 2 {
-                    out = Some(m.to_vec());
-                }
-                Ok(())
-            })
-            .unwrap();
-        out.unwrap()
-    };
-    let (reference, fsi) = (frame("reference"), frame("fsi"));
+    let (reference, fsi) = (
+        render_frame(&ctx, &scene, "reference", 2),
+        render_frame(&ctx, &scene, "fsi", 2),
+    );
     let bg = |p: &[u8]| p[..3] == [60, 63, 69];
     let covered = reference.chunks_exact(4).filter(|p| !bg(p)).count();
     let lost = reference

@@ -2,26 +2,13 @@
 //! (LOD0 red, LOD1 green), rendered at a fixed k in the middle of a transition and compared pixel by pixel with
 //! the same bunny drawn steadily at each of the two LODs.
 
-use crate::common::{near_distance, static_scene};
-use indicatif::ProgressBar;
+use crate::common::{near_distance, render_frame, static_scene};
 use lodbench::gpu::GpuContext;
-use lodbench::measure::BlockRunner;
 use lodbench::scene::Scene;
 
 /// Frame 1 of `method` on `scene` (RGBA8, sRGB-encoded bytes).
 fn render(ctx: &GpuContext, scene: &Scene, method: &str) -> Vec<u8> {
-    let mut block =
-        BlockRunner::new(ctx, scene, Default::default(), true, &Default::default()).unwrap();
-    let mut frame = None;
-    block
-        .run_method(method, 0, 1, &ProgressBar::hidden(), |f, (m, _, _)| {
-            if f == 1 {
-                frame = Some(m.to_vec());
-            }
-            Ok(())
-        })
-        .unwrap();
-    frame.unwrap()
+    render_frame(ctx, scene, method, 1)
 }
 
 /// The bunny at distance `d` with LOD1 switched in at `s` (the band is s +- 5 %, k = 0.5 at s), and the same
