@@ -11,6 +11,7 @@
     )
 )]
 
+pub mod blocks;
 pub mod cli;
 pub mod config;
 pub mod defaults;
