@@ -975,10 +975,57 @@ mod tests {
 
     #[test]
     fn switch_distance_halves_with_double_pixel_error() {
-        let a = SceneDef::new(SceneKind::BunnySweep, &cfg(&[])).unwrap();
+        let a = SceneDef::new(SceneKind::BunnySweep, &cfg(&["--pixel-error", "1"])).unwrap();
         let b = SceneDef::new(SceneKind::BunnySweep, &cfg(&["--pixel-error", "2"])).unwrap();
         for (x, y) in a.models[0].switches.iter().zip(&b.models[0].switches) {
             assert!((x / y - 2.0).abs() < 1e-3);
         }
+    }
+
+    /// The bunny scenes' default pixel error is one pixel at 800x600, so the switch distances are the same at
+    /// every viewport height; a close-up keeps one pixel of its own viewport.
+    #[test]
+    fn bunny_switches_are_the_papers_at_every_profile() {
+        let at = |extra: &[&str]| {
+            SceneDef::new(SceneKind::BunnySweep, &cfg(extra))
+                .unwrap()
+                .models[0]
+                .switches
+                .clone()
+        };
+        let paper = at(&["--profile", "paper"]);
+        for profile in ["quick", "ci", "regress"] {
+            let s = at(&["--profile", profile, "--sweep-start", "fit"]);
+            for (x, y) in s.iter().zip(&paper) {
+                assert!(
+                    (x / y - 1.0).abs() < 1e-5,
+                    "{profile}: {s:?} against {paper:?}"
+                );
+            }
+        }
+        // The regress profile's close-up: 1 pixel at 72 pixels, so 600 / 72 times nearer.
+        let close = at(&["--profile", "regress"]);
+        assert!((paper[0] / close[0] - 600.0 / 72.0).abs() < 1e-3);
+    }
+
+    /// The fit path never starts nearer than where the bounding sphere fits the view, and says which switches
+    /// it does not reach; the close-up starts before the first switch.
+    #[test]
+    fn the_fit_path_starts_outside_the_bounding_sphere() {
+        let def = SceneDef::new(SceneKind::BunnySweep, &cfg(&["--pixel-error", "5"])).unwrap();
+        let p = def.path.unwrap();
+        let m = &def.models[0];
+        assert!(p.near >= p.fit && p.fit > m.radius);
+        assert!(p.unreached > 0 && m.switches[p.unreached - 1] < p.near);
+        assert_eq!(def.notes().len(), 1);
+        let d = def.describe(&cfg(&["--pixel-error", "5"]));
+        assert_eq!(d.models[0].lods[1].note, Some(NOT_REACHED));
+        let close = SceneDef::new(
+            SceneKind::BunnySweep,
+            &cfg(&["--pixel-error", "5", "--sweep-start", "close-up"]),
+        )
+        .unwrap();
+        let c = close.path.unwrap();
+        assert!(c.near < m.switches[0] && c.unreached == 0);
     }
 }
