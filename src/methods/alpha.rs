@@ -4,7 +4,7 @@
 //! by instance distance, depth test on (less-equal, so a translucent surface coinciding with the opaque one
 //! still blends), depth writes off.
 
-use super::common::{FrameInput, Method, UnpopLists};
+use super::common::{BlendLists, FrameInput, Method};
 use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
@@ -12,7 +12,7 @@ use crate::scene::Scene;
 pub const OVER: wgpu::BlendState = wgpu::BlendState::ALPHA_BLENDING;
 
 pub struct Alpha {
-    lists: UnpopLists,
+    lists: BlendLists,
     buffer: InstanceBuffer,
     translucent_pipeline: wgpu::RenderPipeline,
 }
@@ -20,7 +20,7 @@ pub struct Alpha {
 impl Alpha {
     pub fn new(gpu: &SceneGpu, scene: &Scene) -> Self {
         Alpha {
-            lists: UnpopLists::default(),
+            lists: BlendLists::default(),
             buffer: gpu.create_instance_buffer("alpha instances", 2 * scene.instances.len() as u32),
             translucent_pipeline: gpu.mesh_pipeline(&MeshPipeline {
                 label: "alpha translucent",

@@ -25,9 +25,9 @@
 //! objects). Cost: two render passes per translucent draw.
 
 use super::alpha::OVER;
-use super::common::{back_to_front, instance_raw, FrameInput, Method, UnpopLists};
+use super::common::{BlendLists, FrameInput, Method};
 use crate::formats::DEPTH_FORMAT;
-use crate::gpu::{DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
+use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 use crate::schedule::InstanceState;
 
@@ -40,65 +40,32 @@ pub enum Weights {
     Linear,
 }
 
-/// The translucent draws of a t-instance under `weights` (LOD, weight), in drawing order; empty for an
+/// The translucent draws of a t-instance under `weights` (LOD, weight), in drawing order; none for an
 /// n-instance. Unpop's opaque LOD is not among them.
-pub fn translucent_draws(weights: Weights, s: &InstanceState) -> Vec<(u32, f32)> {
+pub fn translucent_draws(weights: Weights, s: &InstanceState) -> [Option<(u32, f32)>; 2] {
     if !s.in_transition() {
-        return Vec::new();
+        return [None, None];
     }
     match weights {
-        Weights::Unpop => super::common::unpop(s).translucent.into_iter().collect(),
-        Weights::Linear => [(s.lod_from, 1.0 - s.k), (s.lod_to, s.k)]
-            .into_iter()
-            .filter(|&(_, w)| w > 0.0)
-            .collect(),
+        Weights::Unpop => [super::common::unpop(s).translucent, None],
+        Weights::Linear => {
+            [(s.lod_from, 1.0 - s.k), (s.lod_to, s.k)].map(|(lod, w)| (w > 0.0).then_some((lod, w)))
+        }
     }
 }
 
-/// `alpha-linear`'s draw lists: the n-instances opaque, then each t-instance's two translucent LODs
-/// (outgoing, incoming), t-instances back to front. Kept between frames.
-#[derive(Default)]
-struct LinearLists {
-    opaque: DrawList,
-    translucent: DrawList,
-    order: Vec<usize>,
-}
-
-impl LinearLists {
-    /// Fills, builds and uploads both lists, opaque first; returns the first instance of the translucent list.
-    fn prepare(&mut self, gpu: &SceneGpu, input: &FrameInput<'_>, buffer: &InstanceBuffer) -> u32 {
-        self.opaque.clear();
-        self.translucent.clear();
-        for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            if !s.in_transition() {
-                let raw = instance_raw(input, i, s.k, 1.0, s.lod_from);
-                self.opaque.push(0, inst.model, s.lod_from, raw);
-            }
-        }
-        back_to_front(input.distances, &mut self.order, |i| {
-            input.states[i].in_transition()
-        });
-        for &i in &self.order {
-            let s = &input.states[i];
-            let model = input.scene.instances[i].model;
-            for (lod, w) in translucent_draws(Weights::Linear, s) {
-                self.translucent
-                    .push(0, model, lod, instance_raw(input, i, s.k, w, lod));
-            }
-        }
-        self.opaque.build();
-        self.translucent.build_in_order();
-        let n_opaque = self.opaque.instances.len() as u32;
-        gpu.upload_at(buffer, 0, &self.opaque);
-        gpu.upload_at(buffer, n_opaque, &self.translucent);
-        n_opaque
+/// The opaque LOD of an instance under `weights`: Giegl's unpopping always has one, seed 003's blend only
+/// outside transitions.
+fn opaque_lod(weights: Weights, s: &InstanceState) -> Option<u32> {
+    match weights {
+        Weights::Unpop => Some(super::common::unpop(s).opaque),
+        Weights::Linear => (!s.in_transition()).then_some(s.lod_from),
     }
 }
 
 pub struct AlphaTwoPass {
     weights: Weights,
-    lists: UnpopLists,
-    linear: LinearLists,
+    lists: BlendLists,
     buffer: InstanceBuffer,
     depth_only: wgpu::RenderPipeline,
     colour: wgpu::RenderPipeline,
@@ -142,8 +109,7 @@ impl AlphaTwoPass {
         });
         AlphaTwoPass {
             weights,
-            lists: UnpopLists::default(),
-            linear: LinearLists::default(),
+            lists: BlendLists::default(),
             buffer: gpu
                 .create_instance_buffer("alpha-2pass instances", 2 * scene.instances.len() as u32),
             depth_only: gpu.mesh_pipeline(&MeshPipeline {
@@ -211,18 +177,15 @@ impl Method for AlphaTwoPass {
     ) -> DrawStats {
         let group = self.scene_depth_group(gpu, target);
         // Translucent neighbours of one bucket share a draw; each of its instances gets its own pair of passes.
-        let (n_opaque, opaque, translucent) = match self.weights {
-            Weights::Unpop => (
-                self.lists.prepare(gpu, input, &self.buffer, |_| 0),
-                &self.lists.opaque,
-                &self.lists.translucent,
-            ),
-            Weights::Linear => (
-                self.linear.prepare(gpu, input, &self.buffer),
-                &self.linear.opaque,
-                &self.linear.translucent,
-            ),
-        };
+        let weights = self.weights;
+        let n_opaque = self.lists.prepare_with(
+            gpu,
+            input,
+            &self.buffer,
+            |s| opaque_lod(weights, s),
+            |s| translucent_draws(weights, s).map(|d| d.map(|(lod, w)| (0, lod, w))),
+        );
+        let (opaque, translucent) = (&self.lists.opaque, &self.lists.translucent);
         let mut stats = {
             let mut pass = gpu.begin_clear_pass(encoder, target, "alpha-2pass opaque");
             gpu.draw(&mut pass, &self.buffer, 0, opaque, &[&gpu.opaque_pipeline])
@@ -289,6 +252,13 @@ mod tests {
             lod_to: to,
             k,
         }
+    }
+
+    fn translucent_draws(weights: Weights, s: &InstanceState) -> Vec<(u32, f32)> {
+        super::translucent_draws(weights, s)
+            .into_iter()
+            .flatten()
+            .collect()
     }
 
     #[test]

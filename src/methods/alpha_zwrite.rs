@@ -6,7 +6,7 @@
 //! draws first, translucent ones back to front.
 
 use super::alpha::OVER;
-use super::common::{FrameInput, Method, UnpopLists};
+use super::common::{BlendLists, FrameInput, Method};
 use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
@@ -15,7 +15,7 @@ const BEFORE_SWAP: u8 = 0;
 const AFTER_SWAP: u8 = 1;
 
 pub struct AlphaZWrite {
-    lists: UnpopLists,
+    lists: BlendLists,
     buffer: InstanceBuffer,
     less_equal: wgpu::RenderPipeline,
     less: wgpu::RenderPipeline,
@@ -37,7 +37,7 @@ impl AlphaZWrite {
             })
         };
         AlphaZWrite {
-            lists: UnpopLists::default(),
+            lists: BlendLists::default(),
             buffer: gpu
                 .create_instance_buffer("alpha-zwrite instances", 2 * scene.instances.len() as u32),
             less_equal: translucent(

@@ -139,18 +139,21 @@ pub(crate) fn back_to_front(
     out.sort_by(|&a, &b| distances[b].total_cmp(&distances[a]).then(a.cmp(&b)));
 }
 
-/// The draw lists of the unpopping methods: every instance's opaque LOD, then the translucent LODs of the
-/// t-instances back to front. Kept between frames.
+/// A t-instance's translucent draws, in drawing order: (pipeline index, LOD, alpha) each, at most two.
+pub(crate) type TranslucentDraws = [Option<(u8, u32, f32)>; 2];
+
+/// The draw lists of the blending methods: each instance's opaque LOD (if it has one), then the translucent
+/// LODs of the t-instances back to front. Kept between frames.
 #[derive(Default)]
-pub(crate) struct UnpopLists {
+pub(crate) struct BlendLists {
     pub opaque: DrawList,
     pub translucent: DrawList,
     order: Vec<usize>,
 }
 
-impl UnpopLists {
-    /// Fills and builds both lists and uploads them to `buffer`, opaque first; `pipeline_of` picks the
-    /// translucent draw's pipeline index. Returns the first instance of the translucent list in `buffer`.
+impl BlendLists {
+    /// The lists of Giegl's unpopping: every instance's opaque LOD, one translucent draw per t-instance, whose
+    /// pipeline index `pipeline_of` picks. See [`BlendLists::prepare_with`].
     pub fn prepare(
         &mut self,
         gpu: &SceneGpu,
@@ -158,27 +161,50 @@ impl UnpopLists {
         buffer: &InstanceBuffer,
         pipeline_of: impl Fn(&Unpop) -> u8,
     ) -> u32 {
+        self.prepare_with(
+            gpu,
+            input,
+            buffer,
+            |s| Some(unpop(s).opaque),
+            |s| {
+                let u = unpop(s);
+                [
+                    u.translucent
+                        .map(|(lod, alpha)| (pipeline_of(&u), lod, alpha)),
+                    None,
+                ]
+            },
+        )
+    }
+
+    /// Fills and builds both lists and uploads them to `buffer`, opaque first: `opaque_of` gives an instance's
+    /// opaque LOD (None: it has none), `translucent_of` a t-instance's translucent draws. Returns the first
+    /// instance of the translucent list in `buffer`.
+    pub fn prepare_with(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        buffer: &InstanceBuffer,
+        opaque_of: impl Fn(&InstanceState) -> Option<u32>,
+        translucent_of: impl Fn(&InstanceState) -> TranslucentDraws,
+    ) -> u32 {
         self.opaque.clear();
         self.translucent.clear();
         for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            let u = unpop(s);
-            self.opaque.push(
-                0,
-                inst.model,
-                u.opaque,
-                instance_raw(input, i, s.k, 1.0, u.opaque),
-            );
+            if let Some(lod) = opaque_of(s) {
+                self.opaque
+                    .push(0, inst.model, lod, instance_raw(input, i, s.k, 1.0, lod));
+            }
         }
         back_to_front(input.distances, &mut self.order, |i| {
             input.states[i].in_transition()
         });
         for &i in &self.order {
             let s = &input.states[i];
-            let u = unpop(s);
-            if let Some((lod, alpha)) = u.translucent {
-                let model = input.scene.instances[i].model;
+            let model = input.scene.instances[i].model;
+            for (pipeline, lod, alpha) in translucent_of(s).into_iter().flatten() {
                 self.translucent.push(
-                    pipeline_of(&u),
+                    pipeline,
                     model,
                     lod,
                     instance_raw(input, i, s.k, alpha, lod),
