@@ -471,12 +471,7 @@ impl Partition {
     /// stays degenerate and valid whatever LODs its two blocks show. (The borders then never reduce; seed 004's
     /// answer, combining blocks into coarser ones and reducing their inner borders, is not built yet.)
     pub fn lod_chains(&self, targets: &[f32]) -> Result<Vec<Vec<BlockLod>>> {
-        if targets.first() != Some(&1.0) || targets.windows(2).any(|w| w[1] >= w[0] || w[1] <= 0.0)
-        {
-            return Err(Error::Config(format!(
-                "block LOD targets must start at 1.0 and decrease strictly above 0: {targets:?}"
-            )));
-        }
+        crate::lod::check_targets("the blocks", targets)?;
         self.blocks
             .iter()
             .map(|b| {
@@ -501,10 +496,7 @@ impl Partition {
                                 error_abs: 0.0,
                             };
                         }
-                        let target = ((b.indices.len() as f64 * fraction as f64 / 3.0).round()
-                            as usize)
-                            .max(1)
-                            * 3;
+                        let target = crate::lod::target_index_count(b.indices.len(), fraction);
                         let mut error = 0.0f32;
                         let indices = meshopt::simplify_with_locks(
                             &b.indices,

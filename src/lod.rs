@@ -32,20 +32,32 @@ pub struct LodInfo {
     pub error_abs: f32,
 }
 
+/// Checks LOD target fractions: the first 1.0 (LOD0 is the input mesh), then strictly decreasing, above 0.
+pub fn check_targets(name: &str, targets: &[f32]) -> Result<()> {
+    if targets.first() != Some(&1.0) {
+        return Err(Error::Config(format!(
+            "LOD targets for {name} must start at 1.0 (LOD0 is the input mesh)"
+        )));
+    }
+    if targets.windows(2).any(|w| w[1] >= w[0] || w[1] <= 0.0) {
+        return Err(Error::Config(format!(
+            "LOD targets for {name} must decrease strictly and stay above 0: {targets:?}"
+        )));
+    }
+    Ok(())
+}
+
+/// The index count to ask the simplifier for: `fraction` of the triangles of an `index_count`-long list,
+/// rounded, at least one triangle.
+pub fn target_index_count(index_count: usize, fraction: f32) -> usize {
+    ((index_count as f64 * fraction as f64 / 3.0).round() as usize).max(1) * 3
+}
+
 impl LodChain {
     /// Simplifies `mesh` to each target fraction (the first must be 1.0: LOD0 is the input itself).
     /// Each LOD is simplified from LOD0, not from the previous LOD, so errors are measured against the original.
     pub fn build(name: &str, mesh: &Mesh, targets: &[f32]) -> Result<LodChain> {
-        if targets.first() != Some(&1.0) {
-            return Err(Error::Config(format!(
-                "LOD targets for {name} must start at 1.0 (LOD0 is the input mesh)"
-            )));
-        }
-        if targets.windows(2).any(|w| w[1] >= w[0] || w[1] <= 0.0) {
-            return Err(Error::Config(format!(
-                "LOD targets for {name} must decrease strictly and stay above 0: {targets:?}"
-            )));
-        }
+        check_targets(name, targets)?;
         let bytes: &[u8] = bytemuck::cast_slice(&mesh.positions);
         let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| Error::Mesh {
             path: name.to_string(),
@@ -57,8 +69,7 @@ impl LodChain {
             error_abs: 0.0,
         }];
         for &fraction in &targets[1..] {
-            let target_indices =
-                ((mesh.indices.len() as f64 * fraction as f64 / 3.0).round() as usize).max(1) * 3;
+            let target_indices = target_index_count(mesh.indices.len(), fraction);
             let mut error = 0.0f32;
             let indices = meshopt::simplify(
                 &mesh.indices,

@@ -280,7 +280,7 @@ impl SceneDef {
                 BUILT_IN.to_string(),
             ),
         };
-        let model = bunny_model(&file, &mesh, cfg, pv.height, fov_y)?;
+        let model = bunny_model(kind, &file, &mesh, cfg, pv.height, fov_y)?;
         let path = BunnyPath::new(
             &model,
             &cfg.schedule,
@@ -343,20 +343,11 @@ impl SceneDef {
     }
 
     pub fn instantiate(&self, count: u32) -> Scene {
-        if !self.kind.is_bunny() {
+        // The bunny scenes, and only they, have a path (SceneDef::new).
+        let Some(path) = self.path else {
             return self.instantiate_field(count);
-        }
+        };
         let m = &self.models[0];
-        let path = self.path.unwrap_or_else(|| {
-            BunnyPath::new(
-                m,
-                &self.schedule,
-                SweepStart::Fit,
-                self.width,
-                self.height,
-                self.fov_y,
-            )
-        });
         let (near_d, far_d) = (path.near, path.far);
         let yaw = BUNNY_YAW;
         let (instances, motion, far_plane) = match self.kind {
@@ -550,8 +541,9 @@ fn procedural_def(
 /// Yaw of the bunny instances: the classic three-quarter view, face to the right.
 pub const BUNNY_YAW: f32 = 1.0;
 
-/// The bunny scenes' model from `mesh`, read from `file` (named in error messages).
+/// The model of bunny scene `kind` from `mesh`, read from `file` (named in error messages).
 fn bunny_model(
+    kind: SceneKind,
     file: &str,
     mesh: &Mesh,
     cfg: &SceneConfig,
@@ -594,13 +586,7 @@ fn bunny_model(
             (s.clone(), "override")
         }
         None => (
-            lod::switch_distances(
-                &chain,
-                scale,
-                cfg.pixel_error(SceneKind::BunnySweep, height),
-                height,
-                fov_y,
-            ),
+            lod::switch_distances(&chain, scale, cfg.pixel_error(kind, height), height, fov_y),
             "pixel-error",
         ),
     };
