@@ -22,8 +22,11 @@ data allows):
                             in transition (ties: the largest rmse), cropped (an fsi method run with --dump-frames).
   - fig8_<scene>.png        seed 000 Fig. 8: median frame time against viewport size per method (experiment folders
                             sweeping `viewport`, e.g. `lodbench experiment` with [sweep] variable = "viewport").
-Experiment folders carry the swept variable as the first CSV column. A `viewport` sweep gets fig8 and its first value
-in the other figures; any other swept variable (`fsi-check`, `noise`, ...) makes each (method, value) pair its own
+  - unified_<scene>.png     unified LOD (experiment folders sweeping `pixel-error`, e.g.
+                            scenes/experiments/unified-lod.toml): mean triangles, largest lodpop and mean crack pixels
+                            against the pixel error, per method.
+Experiment folders carry the swept variable as the first CSV column. A `viewport` sweep gets fig8 and a `pixel-error`
+sweep the unified figure, and their first value in the other figures; any other swept variable (`fsi-check`, `noise`, ...) makes each (method, value) pair its own
 series, labelled `method (variable value)`.
 """
 import argparse
@@ -210,6 +213,27 @@ def fig8(scene, summary, path):
     ax.set_title(f"{scene}: frame time against viewport size (cf. seed 000 Fig. 8)")
     ax.legend()
     save(fig, path)
+
+
+def unified(scene, summary, path):
+    """Triangles, popping and cracks against the pixel error each method was run at (a `pixel-error` sweep)."""
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+    for (method,), rows in group(summary, "method").items():
+        rows = sorted(rows, key=lambda r: float(r["pixel-error"]))
+        px = [float(r["pixel-error"]) for r in rows]
+        for ax, col in zip(axes, ("triangles_mean", "lodpop_max", "crack_px_mean")):
+            ax.plot(px, [num(r.get(col)) for r in rows], marker="o", label=method)
+    for ax, what in zip(axes, ("mean triangles drawn", "largest lodpop (pose held)", "mean crack pixels")):
+        ax.set_xscale("log")
+        ax.set_xlabel("--pixel-error (pixels)")
+        ax.set_ylabel(what)
+        ax.grid(alpha=0.3)
+    axes[0].set_yscale("log")
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"{scene}: unified LOD against pixel error")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 def cost(scene, summary, path):
@@ -416,18 +440,21 @@ def report(folder: Path, transition: str = "worst") -> list:
     tables = []
     first_column = next(iter(summary[0]), None) if summary else None
     variable = first_column if first_column not in (None, "scene") else None
-    swept = variable == "viewport"
-    first_viewport = summary[0]["viewport"] if swept else None
+    swept = variable in ("viewport", "pixel-error")
+    first_viewport = summary[0][variable] if swept else None
     if variable and not swept:
         # Each value of the swept variable is its own series, in the figures and the tables.
         for r in summary + frames + (transitions_csv or []):
             r["method"] = f"{r['method']} ({variable} {r[variable]})"
     for (scene,), all_viewports in group(summary, "scene").items():
-        if swept:
+        if variable == "viewport":
             fig8(scene, all_viewports, figs / f"fig8_{scene}.png")
             made.append((f"fig8_{scene}.png", f"{scene}: median GPU frame time against viewport size"))
-        scene_summary = [r for r in all_viewports if not swept or r["viewport"] == first_viewport]
-        scene_frames = [r for r in frames if r["scene"] == scene and (not swept or r["viewport"] == first_viewport)]
+        if variable == "pixel-error":
+            unified(scene, all_viewports, figs / f"unified_{scene}.png")
+            made.append((f"unified_{scene}.png", f"{scene}: triangles, popping and cracks against pixel error"))
+        scene_summary = [r for r in all_viewports if not swept or r[variable] == first_viewport]
+        scene_frames = [r for r in frames if r["scene"] == scene and (not swept or r[variable] == first_viewport)]
         counts = sorted({r["count"] for r in scene_summary}, key=int)
         if len(counts) > 1:
             fig5(scene, scene_summary, figs / f"fig5_{scene}.png")
@@ -443,7 +470,7 @@ def report(folder: Path, transition: str = "worst") -> list:
             made.append((f"fig6_{scene}.png", f"{scene}: popping per method"))
             if transitions_csv is not None:
                 scene_transitions = [r for r in transitions_csv
-                                     if not swept or r["viewport"] == first_viewport]
+                                     if not swept or r[variable] == first_viewport]
                 per_transition = transition_table(scene_transitions, scene)
             else:
                 per_transition = transition_pops(by_method)
@@ -462,7 +489,8 @@ def report(folder: Path, transition: str = "worst") -> list:
     columns = ([variable] if variable else []) + ["scene", "method", "count", "frames", "gpu_ms_median",
                "gpu_ms_median_transition", "ratio_to_baseline", "ratio_to_baseline_ci95_lo", "ratio_to_baseline_ci95_hi",
                "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
-               "de2000_mean"] + (["lodpop_max", "lodpop_sum"] if summary and "lodpop_max" in summary[0] else [])
+               "de2000_mean"] + (["lodpop_max", "lodpop_sum"] if summary and "lodpop_max" in summary[0] else []) \
+        + (["crack_px_mean", "units_drawn_mean"] if summary and "crack_px_mean" in summary[0] else [])
     text = [f"# lodbench report: {folder.name}", "", "## Summary", "", markdown_table(summary, columns), ""]
     for scene, per_transition in tables:
         methods = list(per_transition[0][-1])

@@ -8,7 +8,14 @@
 //   pop term   |e_t - e_{t-1}|^2 summed over R, G, B      -> pop  = sqrt(sum / (3 * 255^2 * pixels))
 //   de2000     CIEDE2000 (sRGB D65 -> XYZ -> CIELAB, as colour-science), only for pixels that differ, in f32,
 //              rounded to 1/65536                         -> de2000_mean = sum / (65536 * pixels)
-// e_t is kept per pixel in `prev_error` for the next frame. Each frame slot holds three 64-bit sums (6 words).
+//   uncovered  the method shows the background (its bytes equal `params.background`, the bytes a clear to the
+//              background stores) where the reference does not               -> uncovered_px = count
+//   crack      an uncovered pixel with the method's own surface within CRACK_REACH pixels on both sides along
+//              its row or its column, and the reference's surface on every pixel within CRACK_MARGIN of it (a gap
+//              inside the surface, not a silhouette that a coarser LOD moved inwards)
+//                                                                                -> crack_px = count
+// e_t is kept per pixel in `prev_error` for the next frame. Each frame slot holds three 64-bit sums and the two
+// 32-bit counts (8 words; a count stays below 8192^2 = 2^26).
 // Two pipeline-overridable switches: DE2000 adds de2000 (`--metrics de2000`, which costs more than the rest);
 // WORKGROUP_REDUCE sums the row's 64 partial sums in workgroup memory behind a barrier and adds them with one
 // invocation (`--metric-reduction workgroup`) instead of each invocation adding its own (the default, `atomics`,
@@ -25,6 +32,11 @@ struct Params {
     height: u32,
     slot: u32,
     has_prev: u32,
+    // The background's bytes, r | g << 8 | b << 16.
+    background: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };
 
 @group(0) @binding(0) var method_img: texture_2d<f32>;
@@ -46,6 +58,50 @@ fn add_u64(lo: u32, value: u32) {
 }
 
 const LANES: u32 = 64u;
+const CRACK_REACH: i32 = 4;
+const CRACK_MARGIN: i32 = 2;
+const SLOT_WORDS: u32 = 8u;
+
+fn background_bytes() -> vec3<i32> {
+    let b = params.background;
+    return vec3<i32>(i32(b & 255u), i32((b >> 8u) & 255u), i32((b >> 16u) & 255u));
+}
+
+// The method's image shows surface at p (inside the image and not the background's bytes).
+fn method_surface(p: vec2<i32>) -> bool {
+    if (p.x < 0 || p.y < 0 || p.x >= i32(params.width) || p.y >= i32(params.height)) {
+        return false;
+    }
+    return any(to_bytes(textureLoad(method_img, p, 0)) != background_bytes());
+}
+
+// The reference shows surface on every pixel of the (2 CRACK_MARGIN + 1)^2 square around p (inside the image).
+fn inside_reference(p: vec2<i32>) -> bool {
+    let bg = background_bytes();
+    for (var dy = -CRACK_MARGIN; dy <= CRACK_MARGIN; dy = dy + 1) {
+        for (var dx = -CRACK_MARGIN; dx <= CRACK_MARGIN; dx = dx + 1) {
+            let q = p + vec2<i32>(dx, dy);
+            if (q.x < 0 || q.y < 0 || q.x >= i32(params.width) || q.y >= i32(params.height)) {
+                return false;
+            }
+            if (all(to_bytes(textureLoad(reference_img, q, 0)) == bg)) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+// Surface within CRACK_REACH pixels on both sides of p along `step`.
+fn enclosed_along(p: vec2<i32>, step: vec2<i32>) -> bool {
+    var before = false;
+    var after = false;
+    for (var d = 1; d <= CRACK_REACH; d = d + 1) {
+        before = before || method_surface(p - step * d);
+        after = after || method_surface(p + step * d);
+    }
+    return before && after;
+}
 const DE_SCALE: f32 = 65536.0;
 
 fn srgb_to_lab(c: vec3<i32>) -> vec3<f32> {
@@ -149,6 +205,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
     var rmse_sum = 0u;
     var pop_sum = 0u;
     var de_sum = 0u;
+    var uncovered = 0u;
+    var cracks = 0u;
     // Rows past the image still take part in the workgroup's barrier, with nothing to add.
     let width = select(0u, params.width, y < params.height);
     for (var x = gid.x; x < width; x = x + LANES) {
@@ -156,6 +214,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
         let a = to_bytes(textureLoad(method_img, p, 0));
         let b = to_bytes(textureLoad(reference_img, p, 0));
         let e = a - b;
+        let bg = background_bytes();
+        if (all(a == bg) && any(b != bg)) {
+            uncovered = uncovered + 1u;
+            if ((enclosed_along(p, vec2<i32>(1, 0)) || enclosed_along(p, vec2<i32>(0, 1)))
+                && inside_reference(p)) {
+                cracks = cracks + 1u;
+            }
+        }
         let s = u32(abs(e.x) + abs(e.y) + abs(e.z));
         rmse_sum = rmse_sum + s * s;
         if (DE2000 && s != 0u) {
@@ -175,7 +241,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
         let biased = vec3<u32>(e + vec3<i32>(255));
         prev_error[idx] = biased.x | (biased.y << 10u) | (biased.z << 20u);
     }
-    let slot = params.slot * 6u;
+    let slot = params.slot * SLOT_WORDS;
+    if (uncovered != 0u) {
+        atomicAdd(&sums[slot + 6u], uncovered);
+    }
+    if (cracks != 0u) {
+        atomicAdd(&sums[slot + 7u], cracks);
+    }
     if (!WORKGROUP_REDUCE) {
         add_u64_pair(slot, vec2<u32>(rmse_sum, 0u));
         add_u64_pair(slot + 2u, vec2<u32>(pop_sum, 0u));

@@ -4,6 +4,7 @@
 //! keys, the flags' names without dashes); a key it leaves out takes the flag's default
 //! (`crate::defaults::clap_defaults`), so a file and a command line with the same settings are the same run.
 
+use crate::blocks::PartitionMode;
 use crate::methods::MethodOptions;
 use crate::metrics::{Metric, MetricReduction};
 use crate::scene::{CameraMode, Profile, SweepStart};
@@ -97,6 +98,14 @@ pub struct SceneArgs {
     /// Explicit switch distances for LOD1, LOD2, ... (world units), overriding --pixel-error.
     #[arg(long, value_delimiter = ',')]
     pub switch_distances: Option<Vec<f32>>,
+    /// How bunny-halves and terrain divide their mesh into blocks: `clip` (triangles clipped at the block
+    /// faces) or `bin` (each triangle whole into the block of its barycentre).
+    #[arg(long, value_enum, default_value_t = PartitionMode::Clip)]
+    pub partition: PartitionMode,
+    /// terrain: blocks along the mesh's longest side (cubic blocks). Default: the profile's (4 at regress, 16 at
+    /// paper, 8 otherwise).
+    #[arg(long)]
+    pub blocks: Option<u32>,
     /// bunny-grid instance counts; each count is its own block of rows.
     #[arg(long, value_delimiter = ',')]
     #[serde(deserialize_with = "one_or_many")]

@@ -40,6 +40,13 @@ impl SceneConfig {
                 a.fov
             )));
         }
+        if let Some(b) = a.blocks {
+            if !(1..=256).contains(&b) {
+                return Err(Error::Config(format!(
+                    "--blocks {b} must be between 1 and 256"
+                )));
+            }
+        }
         if a.count.contains(&0) {
             return Err(Error::Config("--count values must be at least 1".into()));
         }
@@ -71,6 +78,8 @@ impl SceneConfig {
             pixel_error: a.pixel_error,
             sweep_start: a.sweep_start,
             switch_distances: a.switch_distances.clone(),
+            partition: a.partition,
+            blocks: a.blocks,
             counts: if a.count.is_empty() {
                 None
             } else {
@@ -87,14 +96,17 @@ impl SceneConfig {
 #[derive(Debug, Clone, Serialize)]
 pub struct RunConfig {
     pub scenes: Vec<SceneKind>,
+    /// Every label `--method` names (all methods when absent); each scene runs [`RunConfig::methods_for`].
     pub methods: Vec<String>,
+    /// `--method` was given: every scene runs exactly those (else each its defaults).
+    pub methods_given: bool,
     pub scene: SceneConfig,
     /// Explicit --warmup; None = the profile's.
     pub warmup: Option<u32>,
     pub seed: u64,
     /// `--rounds`: timing rounds per block (at most one per frame).
     pub rounds: u32,
-    /// `--baseline`, resolved: the label every method's time is divided by (None: no ratios).
+    /// `--baseline` as given (None: each scene's default, [`RunConfig::baseline_for`]).
     pub baseline: Option<String>,
     /// Every method's flags (recorded whether or not the method runs).
     #[serde(flatten)]
@@ -129,6 +141,18 @@ impl RunConfig {
         if a.rounds == 0 {
             return Err(Error::Config("--rounds must be at least 1".into()));
         }
+        let methods_given = !a.method.is_empty();
+        if methods_given {
+            if let Some(scene) = scenes.iter().find(|k| !k.is_unified()) {
+                if let Some(m) = methods.iter().find(|m| crate::methods::needs_unified(m)) {
+                    return Err(Error::Config(format!(
+                        "method {m} needs a scene of one large mesh in blocks (bunny-halves, terrain); scene \
+                         {} is not one: run it with --scene bunny-halves or --scene terrain",
+                        scene.name()
+                    )));
+                }
+            }
+        }
         let baseline = match &a.baseline {
             Some(b) if methods.iter().any(|m| m == b.trim()) => Some(b.trim().to_string()),
             Some(b) => {
@@ -137,7 +161,7 @@ impl RunConfig {
                     methods.join(", ")
                 )))
             }
-            None => methods.iter().find(|m| *m == "discrete").cloned(),
+            None => None,
         };
         if a.dump_every == 0 {
             return Err(Error::Config("--dump-every must be at least 1".into()));
@@ -151,6 +175,7 @@ impl RunConfig {
         Ok(RunConfig {
             scenes,
             methods,
+            methods_given,
             scene: SceneConfig::from_args(&a.scene_args)?,
             warmup: a.warmup,
             seed: a.seed,
@@ -168,6 +193,37 @@ impl RunConfig {
             color_format: format!("{COLOR_FORMAT:?}"),
             depth_format: format!("{DEPTH_FORMAT:?}"),
         })
+    }
+
+    /// The labels `scene` runs: `--method`'s, or by default every method that fits the scene (the unified
+    /// scenes: the reference and the four unified methods; the others: every method but those).
+    pub fn methods_for(&self, scene: SceneKind) -> Vec<String> {
+        if self.methods_given {
+            return self.methods.clone();
+        }
+        let builtin = crate::methods::names();
+        let defaults = crate::methods::defaults_for(scene.is_unified());
+        self.methods
+            .iter()
+            .filter(|m| {
+                defaults.contains(&m.as_str())
+                    || (!builtin.contains(&m.as_str()) && !scene.is_unified())
+            })
+            .cloned()
+            .collect()
+    }
+
+    /// The label the times of `methods` are divided by: `--baseline` when it is among them, else `discrete`,
+    /// else `blocks-discrete` (the unified scenes' hard switch), else none.
+    pub fn baseline_for(&self, methods: &[String]) -> Option<String> {
+        let has = |b: &str| methods.iter().any(|m| m == b);
+        match &self.baseline {
+            Some(b) => has(b).then(|| b.clone()),
+            None => ["discrete", "blocks-discrete"]
+                .into_iter()
+                .find(|b| has(b))
+                .map(String::from),
+        }
     }
 
     pub fn resolved(&self, scene: SceneKind) -> ProfileValues {

@@ -13,6 +13,7 @@
 
 pub mod blocks;
 pub mod cli;
+pub mod clusterlod;
 pub mod config;
 pub mod defaults;
 pub mod error;
@@ -35,5 +36,6 @@ pub mod runner;
 pub mod scene;
 pub mod schedule;
 pub mod stats;
+pub mod terrain;
 
 pub use error::{Error, Result};

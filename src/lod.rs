@@ -146,7 +146,7 @@ impl LodChain {
 }
 
 /// Keeps only the vertices `indices` reference (in first-use order), with LOD0's normals.
-fn compact(name: &str, src: &Mesh, indices: &[u32]) -> Result<Mesh> {
+pub(crate) fn compact(name: &str, src: &Mesh, indices: &[u32]) -> Result<Mesh> {
     let mut remap = vec![u32::MAX; src.positions.len()];
     let mut positions = Vec::new();
     let mut normals = Vec::new();

@@ -171,7 +171,53 @@ fn describe(args: &DescribeArgs) -> lodbench::Result<()> {
         d.instance_counts
     );
     outln!("mesh: {}", d.mesh);
-    for m in &d.models {
+    if let Some(u) = &d.unified {
+        let lods = d.models.iter().map(|m| m.lods.len()).max().unwrap_or(0);
+        let per_lod: Vec<String> = (0..lods)
+            .map(|l| {
+                let t: usize = d
+                    .models
+                    .iter()
+                    .filter_map(|m| m.lods.get(l))
+                    .map(|x| x.info.triangles)
+                    .sum();
+                format!("LOD{l} {t}")
+            })
+            .collect();
+        outln!(
+            "blocks: {} ({:?} grid of {:.3}-unit cubes, --partition {:?}), {} input triangles, {} in blocks; \
+             triangles of all blocks per LOD: {}",
+            u.blocks,
+            u.grid,
+            u.block_size,
+            u.partition,
+            u.input_triangles,
+            u.block_triangles,
+            per_lod.join(", ")
+        );
+        outln!(
+            "seams: {} block pairs, {} edges, {} triangles over all LOD pairs",
+            u.seam_pairs,
+            u.seam_edges,
+            u.seam_triangles_all_lod_pairs
+        );
+        outln!(
+            "preprocessing: blocks {:.0} ms (partition {:.0}, LOD chains {:.0}, seams {:.0}), {:.1} MiB; \
+             clusterlod {:.0} ms, {} clusters in {} groups, {} levels, {:.1} MiB",
+            u.blocks_ms,
+            u.partition_ms,
+            u.lod_chains_ms,
+            u.seams_ms,
+            (u.blocks_bytes + u.seams_bytes) as f64 / (1 << 20) as f64,
+            u.clusterlod_ms,
+            u.clusters,
+            u.cluster_groups,
+            u.cluster_levels,
+            u.clusterlod_bytes as f64 / (1 << 20) as f64
+        );
+        outln!("(every block's LODs and switch distances: --json)");
+    }
+    for m in d.models.iter().filter(|_| d.unified.is_none()) {
         outln!(
             "model {} (radius {:.3}, switch distances from {}):",
             m.name,

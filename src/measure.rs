@@ -344,8 +344,8 @@ impl<'a> BlockRunner<'a> {
             ctx,
             (&method_target, &reference_target),
             scene.frames,
-            quality.metrics.contains(&Metric::De2000),
-            quality.reduction,
+            (quality.metrics.contains(&Metric::De2000), quality.reduction),
+            gpu.background_bytes(ctx)?,
         )?;
         let metric_timer = GpuTimer::new(ctx, scene.frames);
         let readback = with_readback.then(|| {
@@ -516,12 +516,17 @@ impl<'a> BlockRunner<'a> {
                 cpu_ms: timed.cpu_ms[f],
                 triangles: timed.stats[f].triangles,
                 draw_calls: timed.stats[f].draw_calls,
+                units_drawn: timed.stats[f]
+                    .clusters
+                    .unwrap_or(scene.instances.len() as u64),
                 t_instances: timed.facts[f].t_instances,
                 lod_mean: timed.facts[f].lod_mean,
                 rmse: quality.metrics[f].rmse,
                 pop: quality.metrics[f].pop,
                 lodpop: quality.lodpop[f],
                 de2000_mean: de2000.then_some(quality.metrics[f].de2000),
+                uncovered_px: quality.metrics[f].uncovered_px,
+                crack_px: quality.metrics[f].crack_px,
                 flip_mean: quality.flip[f],
                 combine_gpu_ms: quality
                     .stage_ms
@@ -726,7 +731,8 @@ impl<'a> BlockRunner<'a> {
             history.truncate(depth + 1);
             let changed = history.len() > 1
                 && (history.iter().skip(1).any(|h| *h != history[0])
-                    || (depth > 1 && history.iter().flatten().any(|s| s.in_transition())));
+                    || (depth > 1 && history.iter().flatten().any(|s| s.in_transition()))
+                    || method.selection_changed());
             if changed {
                 let earlier: Vec<&[InstanceState]> =
                     history.iter().skip(1).map(Vec::as_slice).collect();

@@ -238,6 +238,8 @@ pub fn flip_mean(method: &[u8], reference: &[u8], width: u32, height: u32) -> f6
 #[derive(Debug, Default)]
 pub struct SequenceMetrics {
     previous: Option<Vec<f32>>,
+    /// Width, height and background bytes of the frames, for uncovered_px and crack_px (0 without).
+    image: Option<(u32, u32, [u8; 3])>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -246,6 +248,10 @@ pub struct FrameMetrics {
     pub pop: f64,
     /// Mean CIEDE2000 between method and reference frame.
     pub de2000: f64,
+    /// Pixels where the method shows the background and the reference does not ([`crack_pixels`]).
+    pub uncovered_px: u64,
+    /// The uncovered pixels enclosed by the method's own surface: cracks and holes ([`crack_pixels`]).
+    pub crack_px: u64,
 }
 
 impl SequenceMetrics {
@@ -253,17 +259,85 @@ impl SequenceMetrics {
         Self::default()
     }
 
+    /// Also counts uncovered and crack pixels of `width` x `height` frames whose background is `background`.
+    pub fn with_cracks(self, width: u32, height: u32, background: [u8; 3]) -> Self {
+        SequenceMetrics {
+            image: Some((width, height, background)),
+            ..self
+        }
+    }
+
     pub fn frame(&mut self, method: &[u8], reference: &[u8]) -> FrameMetrics {
         let e = error_image(method, reference);
         let pop = self.previous.as_deref().map_or(0.0, |p| pop(p, &e));
         let rmse = rmse_srgb(method, reference);
         self.previous = Some(e);
+        let (uncovered_px, crack_px) = self.image.map_or((0, 0), |(w, h, bg)| {
+            crack_pixels(method, reference, w, h, bg)
+        });
         FrameMetrics {
             rmse,
             pop,
             de2000: de2000_mean(method, reference),
+            uncovered_px,
+            crack_px,
         }
     }
+}
+
+/// How far (pixels) [`crack_pixels`] looks for the method's surface on each side of an uncovered pixel.
+pub const CRACK_REACH: i64 = 4;
+/// How far (pixels) from the reference's silhouette a crack must lie ([`crack_pixels`]).
+pub const CRACK_MARGIN: i64 = 2;
+
+/// (uncovered, crack) pixels of a method frame against the reference frame (RGBA8, `width` x `height`,
+/// `background` the bytes of a pixel nothing was drawn on):
+/// - uncovered: the method shows the background where the reference shows surface;
+/// - crack: an uncovered pixel with the method's own surface within [`CRACK_REACH`] pixels on both sides
+///   along its row or along its column, and the reference's surface on every pixel within [`CRACK_MARGIN`] of
+///   it (a square; outside the image counts as background). A crack or a hole through the method's surface (a
+///   missing seam, FSI's holes) counts, up to `2 CRACK_REACH - 1` pixels wide; a silhouette that a coarser LOD
+///   moved inwards does not: beyond it lies background on one side, and where it closes a concave corner (the
+///   bunny's neck seen from the side: 1-2 pixels per frame at 320x240) it lies within the margin of the
+///   reference's silhouette. A crack's pixels within the margin of the silhouette are not counted either.
+pub fn crack_pixels(
+    method: &[u8],
+    reference: &[u8],
+    width: u32,
+    height: u32,
+    background: [u8; 3],
+) -> (u64, u64) {
+    let (w, h) = (width as i64, height as i64);
+    let is_bg = |img: &[u8], x: i64, y: i64| {
+        let i = ((y * w + x) * 4) as usize;
+        img[i..i + 3] == background
+    };
+    let surface = |x: i64, y: i64| x >= 0 && y >= 0 && x < w && y < h && !is_bg(method, x, y);
+    let enclosed = |x: i64, y: i64, dx: i64, dy: i64| {
+        let before = (1..=CRACK_REACH).any(|d| surface(x - dx * d, y - dy * d));
+        let after = (1..=CRACK_REACH).any(|d| surface(x + dx * d, y + dy * d));
+        before && after
+    };
+    let inside_reference = |x: i64, y: i64| {
+        (-CRACK_MARGIN..=CRACK_MARGIN).all(|dy| {
+            (-CRACK_MARGIN..=CRACK_MARGIN).all(|dx| {
+                let (qx, qy) = (x + dx, y + dy);
+                qx >= 0 && qy >= 0 && qx < w && qy < h && !is_bg(reference, qx, qy)
+            })
+        })
+    };
+    let (mut uncovered, mut cracks) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            if is_bg(method, x, y) && !is_bg(reference, x, y) {
+                uncovered += 1;
+                if (enclosed(x, y, 1, 0) || enclosed(x, y, 0, 1)) && inside_reference(x, y) {
+                    cracks += 1;
+                }
+            }
+        }
+    }
+    (uncovered, cracks)
 }
 
 /// Per-pixel mean absolute difference over R, G, B in [0, 1]: the single-channel difference image of seed 003
@@ -289,6 +363,34 @@ mod tests {
         px.iter().flat_map(|p| [p[0], p[1], p[2], 255]).collect()
     }
 
+    /// A 12 x 9 frame of surface (S) on background (.): a one-pixel crack down the middle column counts as
+    /// uncovered and, where it lies at least 2 pixels inside the reference's surface (rows 2 to 5), as a crack;
+    /// background where the reference has surface outside the method's silhouette (the right edge) counts as
+    /// uncovered only.
+    #[test]
+    fn cracks_are_uncovered_pixels_enclosed_by_the_surface() {
+        let bg = [9, 9, 9];
+        let m = "SSSSS.SSSS..";
+        let rows_method = [m, m, m, m, m, m, m, "SSSSSSSSSS..", "............"];
+        let r = "SSSSSSSSSSSS";
+        let rows_reference = [r, r, r, r, r, r, r, r, "............"];
+        let image = |rows: &[&str]| -> Vec<u8> {
+            rows.iter()
+                .flat_map(|r| r.chars())
+                .flat_map(|c| match c {
+                    'S' => [200, 100, 50, 255],
+                    _ => [bg[0], bg[1], bg[2], 255],
+                })
+                .collect()
+        };
+        let (m, r) = (image(&rows_method), image(&rows_reference));
+        assert_eq!(crack_pixels(&m, &r, 12, 9, bg), (7 + 16, 4));
+        let mut s = SequenceMetrics::new().with_cracks(12, 9, bg);
+        let f = s.frame(&m, &r);
+        assert_eq!((f.uncovered_px, f.crack_px), (23, 4));
+        assert_eq!(crack_pixels(&r, &r, 12, 9, bg), (0, 0));
+    }
+
     #[test]
     fn identical_images_score_zero() {
         let a = img(&[[10, 20, 30], [200, 100, 0]]);
@@ -298,6 +400,8 @@ mod tests {
             rmse: 0.0,
             pop: 0.0,
             de2000: 0.0,
+            uncovered_px: 0,
+            crack_px: 0,
         };
         assert_eq!(s.frame(&a, &a), zero);
         assert_eq!(s.frame(&a, &a), zero);

@@ -19,6 +19,9 @@ pub struct FrameRecord {
     pub cpu_ms: f64,
     pub triangles: u64,
     pub draw_calls: u32,
+    /// What the method drew this frame in its own units: clusters for `clusterlod`, instances (blocks, in the
+    /// unified scenes) for every other method.
+    pub units_drawn: u64,
     /// Instances in transition (lod_from != lod_to) this frame.
     pub t_instances: u32,
     /// Mean over instances of lod_from + k (lod_to - lod_from), the same for every method.
@@ -32,6 +35,11 @@ pub struct FrameRecord {
     /// Mean CIEDE2000 over pixels between method and reference frame (sRGB D65 -> XYZ -> CIELAB), with
     /// `--metrics de2000` (empty otherwise).
     pub de2000_mean: Option<f64>,
+    /// Pixels where the method shows the background and the reference shows surface.
+    pub uncovered_px: u64,
+    /// The uncovered pixels with the method's own surface within 4 pixels on both sides along the row or the
+    /// column: cracks and holes (`metrics::crack_pixels`).
+    pub crack_px: u64,
     /// Mean FLIP error, with `--metrics ...,flip` (empty otherwise).
     pub flip_mean: Option<f64>,
     /// GPU time of FSI's combination pass and its copy into the frame's target, measured in the quality pass
@@ -76,6 +84,12 @@ pub struct SummaryRecord {
     pub de2000_max: Option<f64>,
     /// Mean over frames of flip_mean (empty without `--metrics flip`).
     pub flip_mean: Option<f64>,
+    /// Mean over frames of units_drawn (clusters for clusterlod, instances otherwise).
+    pub units_drawn_mean: f64,
+    /// Mean over frames of uncovered_px; mean and largest crack_px.
+    pub uncovered_px_mean: f64,
+    pub crack_px_mean: f64,
+    pub crack_px_max: u64,
     pub extra_target_bytes: u64,
     /// Largest relative change of the triangle count between consecutive frames,
     /// max |t_f - t_(f-1)| / t_(f-1) (seed 000 section 4 saw at most 2 % with FSI).
@@ -152,6 +166,10 @@ impl SummaryRecord {
                 .map(|r| r.flip_mean)
                 .collect::<Option<Vec<f64>>>()
                 .map(|v| mean(v.into_iter())),
+            units_drawn_mean: mean(rows.iter().map(|r| r.units_drawn as f64)),
+            uncovered_px_mean: mean(rows.iter().map(|r| r.uncovered_px as f64)),
+            crack_px_mean: mean(rows.iter().map(|r| r.crack_px as f64)),
+            crack_px_max: rows.iter().map(|r| r.crack_px).max().unwrap_or(0),
             extra_target_bytes,
             tri_alternation_max: tri_alternation_max(rows),
             combine_gpu_ms_median: percentile(
@@ -576,12 +594,15 @@ pub(crate) mod tests {
             cpu_ms: 2.0,
             triangles: 100 + frame as u64,
             draw_calls: 1,
+            units_drawn: 1,
             t_instances: 0,
             lod_mean: 0.0,
             rmse,
             pop,
             lodpop: 0.0,
             de2000_mean: Some(rmse / 2.0),
+            uncovered_px: 0,
+            crack_px: 0,
             flip_mean: None,
             combine_gpu_ms: None,
             lag_rmse: None,

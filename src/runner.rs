@@ -138,15 +138,15 @@ fn run_blocks(
 
     // Per block: every method's warm-up, timed and quality frames, and the reference's warm-up and timed frames
     // when it is timed without being reported.
-    let timed_only = !cfg.methods.iter().any(|m| is_reference(m)) as u64;
     let total: u64 = defs
         .iter()
         .map(|d| {
             let pv = cfg.resolved(d.kind);
+            let methods = cfg.methods_for(d.kind);
+            let timed_only = !methods.iter().any(|m| is_reference(m)) as u64;
             let (warmup, frames) = (pv.warmup as u64, pv.frames as u64);
             d.counts.len() as u64
-                * (cfg.methods.len() as u64 * (warmup + 2 * frames)
-                    + timed_only * (warmup + frames))
+                * (methods.len() as u64 * (warmup + 2 * frames) + timed_only * (warmup + frames))
         })
         .sum();
     let progress = ProgressBar::new(total);
@@ -161,6 +161,8 @@ fn run_blocks(
     let mut block_index = 0u64;
     for def in defs {
         let warmup = cfg.resolved(def.kind).warmup;
+        let methods = cfg.methods_for(def.kind);
+        let baseline = cfg.baseline_for(&methods);
         for &count in &def.counts {
             let scene = def.instantiate(count);
             let setup = MethodSetup {
@@ -181,7 +183,7 @@ fn run_blocks(
                 .next_u64()
                 .wrapping_add(block_index);
             let (timed, block_rounds) =
-                block.time_methods(&cfg.methods, warmup, cfg.rounds, rounds_seed, &progress)?;
+                block.time_methods(&methods, warmup, cfg.rounds, rounds_seed, &progress)?;
             let reference_ms = reference_ms_per_frame(&timed);
             let mut block_rows: Vec<Vec<FrameRecord>> = Vec::new();
             let mut extras = Vec::new();
@@ -218,7 +220,7 @@ fn run_blocks(
                 manifest.blocks.push(out.info);
                 manifest.write(out_dir)?;
             }
-            let baseline_rows = cfg.baseline.as_ref().and_then(|b| {
+            let baseline_rows = baseline.as_ref().and_then(|b| {
                 block_rows
                     .iter()
                     .find(|r| r.first().is_some_and(|r| &r.method == b))
@@ -227,7 +229,7 @@ fn run_blocks(
                 // Each block's bootstrap has its own seed, derived from --seed and the block's position.
                 let block_seed = cfg.seed.wrapping_add(summaries.len() as u64 + 1);
                 if let Some(mut s) = SummaryRecord::from_frames(rows, extra, block_seed) {
-                    if let (Some(b), Some(base)) = (&cfg.baseline, baseline_rows) {
+                    if let (Some(b), Some(base)) = (&baseline, baseline_rows) {
                         s.set_ratios(b, rows, base);
                     }
                     summaries.push(s);
@@ -236,7 +238,7 @@ fn run_blocks(
             rounds.extend(round_records(
                 &block_rows,
                 &block_rounds,
-                cfg.baseline.as_deref(),
+                baseline.as_deref(),
             ));
             manifest.timing_rounds.push(block_rounds);
             manifest.write(out_dir)?;

@@ -43,6 +43,8 @@ pub struct Draw {
 pub struct DrawStats {
     pub triangles: u64,
     pub draw_calls: u32,
+    /// Clusters drawn (`clusterlod`); None for methods that draw whole instances.
+    pub clusters: Option<u64>,
 }
 
 /// A frame's draws: items added in any order, then sorted into buckets by (pipeline, model, LOD) so that each
@@ -109,6 +111,10 @@ impl std::ops::Add for DrawStats {
         DrawStats {
             triangles: self.triangles + o.triangles,
             draw_calls: self.draw_calls + o.draw_calls,
+            clusters: match (self.clusters, o.clusters) {
+                (None, None) => None,
+                (a, b) => Some(a.unwrap_or(0) + b.unwrap_or(0)),
+            },
         }
     }
 }

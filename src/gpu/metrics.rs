@@ -17,17 +17,22 @@ pub struct MetricKernel {
     width: u32,
     height: u32,
     frames: u32,
+    background: u32,
 }
+
+/// 32-bit words of a frame's slot in the sums buffer: three 64-bit sums, then uncovered_px and crack_px.
+const SLOT_WORDS: u32 = 8;
 
 impl MetricKernel {
     /// Compares `method` against `reference` (both the same size) over up to `frames` frames; `de2000`: also
-    /// the mean CIEDE2000 (else it reads 0); `reduction`: how a row's partial sums are added.
+    /// the mean CIEDE2000 (else it reads 0); `reduction`: how a row's partial sums are added; `background`:
+    /// the bytes a target cleared to the background holds (for uncovered_px and crack_px).
     pub fn new(
         ctx: &GpuContext,
         (method, reference): (&RenderTarget, &RenderTarget),
         frames: u32,
-        de2000: bool,
-        reduction: MetricReduction,
+        (de2000, reduction): (bool, MetricReduction),
+        background: [u8; 3],
     ) -> Result<MetricKernel> {
         let device = &ctx.device;
         let (width, height) = (method.width, method.height);
@@ -59,7 +64,7 @@ impl MetricKernel {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let sums_size = frames as u64 * 24;
+        let sums_size = frames as u64 * 4 * SLOT_WORDS as u64;
         let sums = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("metric sums"),
             size: sums_size,
@@ -76,7 +81,7 @@ impl MetricKernel {
         });
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("metric params"),
-            size: 16,
+            size: 32,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -116,6 +121,9 @@ impl MetricKernel {
             width,
             height,
             frames,
+            background: background[0] as u32
+                | (background[1] as u32) << 8
+                | (background[2] as u32) << 16,
         })
     }
 
@@ -126,7 +134,16 @@ impl MetricKernel {
         if frame == 0 {
             encoder.clear_buffer(&self.sums, 0, None);
         }
-        let params = [self.width, self.height, slot, (frame > 0) as u32];
+        let params = [
+            self.width,
+            self.height,
+            slot,
+            (frame > 0) as u32,
+            self.background,
+            0,
+            0,
+            0,
+        ];
         queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("metric pass"),
@@ -137,17 +154,20 @@ impl MetricKernel {
         pass.dispatch_workgroups(1, self.height, 1);
     }
 
-    /// rmse, pop and de2000 of frames `0..frames`, after their submissions.
+    /// rmse, pop, de2000, uncovered_px and crack_px of frames `0..frames`, after their submissions.
     pub fn read(&self, ctx: &GpuContext, frames: u32) -> Result<Vec<FrameMetrics>> {
         let pixels = self.width as f64 * self.height as f64;
         let n = frames.min(self.frames) as usize;
-        let sums = ctx.read_u64_sums(&self.sums, &self.readback, 3 * n)?;
+        // Read as 64-bit words: the last one of a slot holds uncovered_px (low) and crack_px (high).
+        let sums = ctx.read_u64_sums(&self.sums, &self.readback, 4 * n)?;
         Ok(sums
-            .chunks_exact(3)
+            .chunks_exact(4)
             .map(|s| FrameMetrics {
                 rmse: (s[0] as f64 / (9.0 * 255.0 * 255.0 * pixels)).sqrt(),
                 pop: (s[1] as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt(),
                 de2000: s[2] as f64 / (65536.0 * pixels),
+                uncovered_px: s[3] & 0xffff_ffff,
+                crack_px: s[3] >> 32,
             })
             .collect())
     }

@@ -38,6 +38,7 @@ pub fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 2] {
 }
 
 /// How a mesh pipeline (shaders/mesh.wgsl) treats depth and colour.
+#[derive(Clone, Copy)]
 pub struct MeshPipeline<'a> {
     pub label: &'a str,
     /// Morphing vertex stage (`vs_morph`, with the morph-target buffer in slot 2) instead of `vs_main`.
@@ -48,7 +49,8 @@ pub struct MeshPipeline<'a> {
     /// A second colour target of this format (FSI's instance-id target).
     pub id_target: Option<wgpu::TextureFormat>,
     /// Faces culled (None for every shared pipeline: scanned meshes have holes through which their inside is
-    /// seen).
+    /// seen). `SceneGpu::mesh_pipeline` puts the scene's own culling in place of None (back faces in the
+    /// unified scenes).
     pub cull: Option<wgpu::Face>,
     pub depth_compare: wgpu::CompareFunction,
     pub depth_write: bool,

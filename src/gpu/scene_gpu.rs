@@ -44,8 +44,11 @@ pub struct SceneGpu {
     pub queue: wgpu::Queue,
     pub vertex_buffer: wgpu::Buffer,
     pub index_buffer: wgpu::Buffer,
-    /// `lods[model][lod]`.
+    /// `lods[model][lod]`; a unified scene's seams follow its models: `lods[seam_base + s][mesh]` is seam s's
+    /// mesh `mesh` ([`crate::scene::unified::Seam::mesh_index`]).
     pub lods: Vec<Vec<LodRange>>,
+    /// Index in `lods` of the first seam (the model count).
+    pub seam_base: u32,
     pub camera_buffer: wgpu::Buffer,
     pub camera_layout: wgpu::BindGroupLayout,
     pub camera_bind_group: wgpu::BindGroup,
@@ -53,6 +56,11 @@ pub struct SceneGpu {
     pub opaque_pipeline: wgpu::RenderPipeline,
     /// The scene has alpha-tested geometry: every mesh pipeline is built with `ALPHA_TEST` on.
     pub alpha_test: bool,
+    /// Faces every mesh pipeline culls where its own descriptor says None: back faces in the unified scenes
+    /// (closed meshes and heightfields wound outwards, their seams wound with them), so a crack between blocks
+    /// shows what lies behind the surface, as in an engine that culls a model's inside, and `crack_px` sees it;
+    /// none elsewhere.
+    pub cull: Option<wgpu::Face>,
     pub uploads: UploadCounters,
 }
 
@@ -64,7 +72,10 @@ impl SceneGpu {
             &self.shader,
             &self.camera_layout,
             self.alpha_test,
-            d,
+            &MeshPipeline {
+                cull: d.cull.or(self.cull),
+                ..*d
+            },
         )
     }
 
@@ -106,6 +117,25 @@ impl SceneGpu {
                         aux: *a,
                     },
                 ));
+                indices.extend_from_slice(&m.indices);
+            }
+            lods.push(ranges);
+        }
+        let seam_base = lods.len() as u32;
+        for seam in scene.unified.iter().flat_map(|u| &u.seams) {
+            let mut ranges = Vec::new();
+            for m in &seam.meshes {
+                ranges.push(LodRange {
+                    base_vertex: i32::try_from(vertices.len())
+                        .map_err(|_| Error::Gpu("scene has too many vertices".into()))?,
+                    first_index: indices.len() as u32,
+                    index_count: m.indices.len() as u32,
+                });
+                vertices.extend(m.positions.iter().zip(&m.normals).map(|(p, n)| Vertex {
+                    position: *p,
+                    normal: *n,
+                    aux: [0.0; 4],
+                }));
                 indices.extend_from_slice(&m.indices);
             }
             lods.push(ranges);
@@ -159,12 +189,16 @@ impl SceneGpu {
                     .any(|a| a[2] == crate::mesh::AUX_LEAF || a[2] == crate::mesh::AUX_LEAF_CLUSTER)
             })
         });
+        let cull = scene.unified.is_some().then_some(wgpu::Face::Back);
         let opaque_pipeline = mesh_pipeline(
             device,
             &shader,
             &camera_layout,
             alpha_test,
-            &MeshPipeline::opaque("opaque pipeline"),
+            &MeshPipeline {
+                cull,
+                ..MeshPipeline::opaque("opaque pipeline")
+            },
         );
         ctx.check_errors()?;
         Ok(SceneGpu {
@@ -173,14 +207,30 @@ impl SceneGpu {
             vertex_buffer,
             index_buffer,
             lods,
+            seam_base,
             camera_buffer,
             camera_layout,
             camera_bind_group,
             shader,
             opaque_pipeline,
             alpha_test,
+            cull,
             uploads: UploadCounters::default(),
         })
+    }
+
+    /// The bytes (R, G, B) a target cleared to the background holds on this device: the sRGB encoding the
+    /// device itself makes of [`BACKGROUND`], read back once, so uncovered_px and crack_px compare exactly.
+    pub fn background_bytes(&self, ctx: &GpuContext) -> Result<[u8; 3]> {
+        let target = RenderTarget::new(&self.device, "background probe", 1, 1);
+        let readback =
+            crate::gpu::readback::TextureReadback::color(&self.device, "background probe", 1, 1);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        drop(self.begin_clear_pass(&mut encoder, &target, "background probe"));
+        readback.encode_copy(&mut encoder, &target);
+        self.queue.submit([encoder.finish()]);
+        let px = readback.read(ctx)?;
+        Ok([px[0], px[1], px[2]])
     }
 
     pub fn write_camera(&self, camera: &Camera) {
@@ -314,6 +364,7 @@ impl SceneGpu {
         DrawStats {
             triangles: r.triangles() * count as u64,
             draw_calls: 1,
+            ..Default::default()
         }
     }
 

@@ -6,7 +6,7 @@
 //! draws first, translucent ones back to front.
 
 use super::alpha::OVER;
-use super::common::{BlendLists, FrameInput, Method};
+use super::common::{unpop, BlendLists, FrameInput, Method, SeamDraws};
 use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
@@ -19,6 +19,8 @@ pub struct AlphaZWrite {
     buffer: InstanceBuffer,
     less_equal: wgpu::RenderPipeline,
     less: wgpu::RenderPipeline,
+    /// `blocks`: a unified scene's seams, between the blocks' opaque LODs, drawn with the opaque blocks.
+    seams: Option<SeamDraws>,
 }
 
 impl AlphaZWrite {
@@ -45,6 +47,16 @@ impl AlphaZWrite {
                 wgpu::CompareFunction::LessEqual,
             ),
             less: translucent("alpha-zwrite translucent <", wgpu::CompareFunction::Less),
+            seams: None,
+        }
+    }
+
+    /// `blocks` (seeds 001 and 004): these rules per block of a unified scene, opaque blocks and the seams
+    /// between their opaque LODs first, then the translucent blocks back to front.
+    pub fn with_seams(gpu: &SceneGpu, scene: &Scene) -> Self {
+        AlphaZWrite {
+            seams: SeamDraws::new(gpu, scene),
+            ..Self::new(gpu, scene)
         }
     }
 }
@@ -64,14 +76,20 @@ impl Method for AlphaZWrite {
                 BEFORE_SWAP
             }
         });
+        if let Some(seams) = &mut self.seams {
+            seams.prepare(gpu, input, |s| unpop(s).opaque);
+        }
         let mut pass = gpu.begin_clear_pass(encoder, target, "alpha-zwrite pass");
-        let a = gpu.draw(
+        let mut a = gpu.draw(
             &mut pass,
             &self.buffer,
             0,
             &self.lists.opaque,
             &[&gpu.opaque_pipeline],
         );
+        if let Some(seams) = &self.seams {
+            a += seams.draw(gpu, &mut pass);
+        }
         let b = gpu.draw(
             &mut pass,
             &self.buffer,

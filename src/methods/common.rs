@@ -71,6 +71,14 @@ pub trait Method {
         self.encode(gpu, &previous, encoder, before);
     }
 
+    /// For a method that selects what it draws itself, beyond the shared schedule (`clusterlod`'s cut): whether
+    /// the frame just encoded selected differently from the frame before, so lodpop renders its
+    /// counterfactual (`encode_before` then draws the previous selection at this pose). Default: false, the
+    /// schedule's states decide alone.
+    fn selection_changed(&self) -> bool {
+        false
+    }
+
     /// How many earlier frames' states this method's frame depends on (1 for a frame that is a function of the
     /// current states; FSI's older LOD buffer makes it 2).
     fn lodpop_history(&self) -> usize {
@@ -242,10 +250,66 @@ pub fn instance_raw_with(
     )
 }
 
-/// Shared by methods that draw every instance once, opaque, at one LOD each.
+/// The seams of a unified scene (seed 004), drawn opaque between the blocks' opaque LODs: seam s between
+/// blocks a and b is drawn with its mesh for (LOD of a, LOD of b), at the blocks' shared identity transform.
+/// Empty seam meshes (every quad degenerate: both blocks at full resolution) are not drawn.
+pub struct SeamDraws {
+    list: DrawList,
+    buffer: InstanceBuffer,
+}
+
+impl SeamDraws {
+    /// None when the scene has no seams.
+    pub fn new(gpu: &SceneGpu, scene: &Scene) -> Option<SeamDraws> {
+        let n = scene.unified.as_ref().map_or(0, |u| u.seams.len());
+        (n > 0).then(|| SeamDraws {
+            list: DrawList::default(),
+            buffer: gpu.create_instance_buffer("seam instances", n as u32),
+        })
+    }
+
+    /// Builds and uploads the seams for the blocks' opaque LODs (`lod_of(state)` of each block instance).
+    pub fn prepare(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        lod_of: impl Fn(&InstanceState) -> u32,
+    ) {
+        self.list.clear();
+        let Some(u) = &input.scene.unified else {
+            return;
+        };
+        for (s, seam) in u.seams.iter().enumerate() {
+            let (a, b) = (seam.blocks.0 as usize, seam.blocks.1 as usize);
+            let mesh = seam.mesh_index(lod_of(&input.states[a]), lod_of(&input.states[b]));
+            if seam.meshes[mesh as usize].indices.is_empty() {
+                continue;
+            }
+            let model = &input.scene.models[input.scene.instances[a].model as usize];
+            let [r, g, bl] = model.color;
+            self.list.push(
+                0,
+                gpu.seam_base + s as u32,
+                mesh,
+                InstanceRaw::new(&Mat4::IDENTITY, [r, g, bl, 0.0], [0.0, 1.0, 0.0, a as f32]),
+            );
+        }
+        self.list.build();
+        gpu.upload(&self.buffer, &self.list);
+    }
+
+    /// Records the seams prepared last into `pass` with the opaque pipeline.
+    pub fn draw(&self, gpu: &SceneGpu, pass: &mut wgpu::RenderPass<'_>) -> DrawStats {
+        gpu.draw(pass, &self.buffer, 0, &self.list, &[&gpu.opaque_pipeline])
+    }
+}
+
+/// Shared by methods that draw every instance once, opaque, at one LOD each (and, for `blocks-discrete`, the
+/// seams between them).
 pub struct OpaqueInstances {
     list: DrawList,
     buffer: InstanceBuffer,
+    seams: Option<SeamDraws>,
 }
 
 impl OpaqueInstances {
@@ -253,6 +317,15 @@ impl OpaqueInstances {
         OpaqueInstances {
             list: DrawList::default(),
             buffer: gpu.create_instance_buffer(label, scene.instances.len() as u32),
+            seams: None,
+        }
+    }
+
+    /// The same, drawing a unified scene's seams too (none on other scenes).
+    pub fn with_seams(gpu: &SceneGpu, scene: &Scene, label: &str) -> Self {
+        OpaqueInstances {
+            seams: SeamDraws::new(gpu, scene),
+            ..Self::new(gpu, scene, label)
         }
     }
 
@@ -278,14 +351,21 @@ impl OpaqueInstances {
         }
         self.list.build();
         gpu.upload(&self.buffer, &self.list);
+        if let Some(seams) = &mut self.seams {
+            seams.prepare(gpu, input, &lod_of);
+        }
         let mut pass = gpu.begin_clear_pass(encoder, target, label);
-        gpu.draw(
+        let stats = gpu.draw(
             &mut pass,
             &self.buffer,
             0,
             &self.list,
             &[&gpu.opaque_pipeline],
-        )
+        );
+        match &self.seams {
+            Some(seams) => stats + seams.draw(gpu, &mut pass),
+            None => stats,
+        }
     }
 }
 

@@ -16,6 +16,14 @@ impl Discrete {
             draw: OpaqueInstances::new(gpu, scene, "discrete instances"),
         }
     }
+
+    /// `blocks-discrete` (seeds 001 and 004 without the blending): each block of a unified scene switches
+    /// hard, and the seams between the blocks' LODs close the cracks.
+    pub fn with_seams(gpu: &SceneGpu, scene: &Scene) -> Self {
+        Discrete {
+            draw: OpaqueInstances::with_seams(gpu, scene, "blocks-discrete instances"),
+        }
+    }
 }
 
 impl Method for Discrete {

@@ -9,6 +9,7 @@
 pub mod alpha;
 pub mod alpha_2pass;
 pub mod alpha_zwrite;
+pub mod clusterlod;
 pub mod common;
 pub mod discrete;
 pub mod dither;
@@ -85,6 +86,10 @@ pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "fsi", about: "Frame Sequential Interpolation (seed 000)", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::Sequential))), options: |o| json(o.fsi) },
     MethodEntry { name: "fsi-noreproject", about: "FSI ablation: the older buffer read at the same pixel", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::NoReproject))), options: |o| json(o.fsi.vis_texture) },
     MethodEntry { name: "fsi-sameframe", about: "FSI ablation: both LOD buffers rendered every frame", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::SameFrame))), options: |o| json(o.fsi.vis_texture) },
+    MethodEntry { name: "blocks", about: "unified LOD (seeds 001, 004): per-block alpha-zwrite blending, seams between the blocks", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::with_seams(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "blocks-noseams", about: "blocks without the seams (the ablation: cracks show where neighbours differ)", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "blocks-discrete", about: "blocks with seams, hard switches per block", create: |b| Ok(Box::new(discrete::Discrete::with_seams(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "clusterlod", about: "meshoptimizer's cluster DAG (Nanite-style), the per-frame cut at --pixel-error", create: |b| Ok(Box::new(clusterlod::ClusterLod::new(b.gpu, b.scene)?)), options: no_options },
 ];
 
 /// The methods a run can name: the built-in ones, plus any a caller (a test, a downstream crate) adds.
@@ -150,6 +155,35 @@ pub fn base_name(label: &str) -> &str {
         Some((base, k)) if !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()) => base,
         _ => label,
     }
+}
+
+/// The methods that need a scene of one large mesh in blocks (`SceneKind::is_unified`): they draw its seams or
+/// its cluster DAG.
+pub const UNIFIED_ONLY: [&str; 4] = ["blocks", "blocks-noseams", "blocks-discrete", "clusterlod"];
+
+/// What a unified scene runs when `--method` is absent: the reference and the four unified methods.
+pub const UNIFIED_DEFAULT: [&str; 5] = [
+    "reference",
+    "blocks",
+    "blocks-noseams",
+    "blocks-discrete",
+    "clusterlod",
+];
+
+/// Whether the method of `label` needs a unified scene.
+pub fn needs_unified(label: &str) -> bool {
+    UNIFIED_ONLY.contains(&base_name(label))
+}
+
+/// The built-in methods a scene runs when `--method` is absent, in [`BUILTIN`]'s order.
+pub fn defaults_for(unified: bool) -> Vec<&'static str> {
+    names()
+        .into_iter()
+        .filter(|n| match unified {
+            true => UNIFIED_DEFAULT.contains(n),
+            false => !needs_unified(n),
+        })
+        .collect()
 }
 
 /// Every built-in method name, in [`BUILTIN`]'s order.

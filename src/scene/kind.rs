@@ -80,16 +80,23 @@ pub enum SceneKind {
     Windmills,
     /// Seed 000's TREES: a field of alpha-tested trees.
     Trees,
+    /// Seed 004 Fig. 1: the bunny clipped in half, one half reduced to a quarter, the halves joined by the
+    /// seam; a turntable around it.
+    BunnyHalves,
+    /// One large procedural heightfield (`src/terrain.rs`) in blocks, flown over low.
+    Terrain,
 }
 
 impl SceneKind {
     /// Every scene, in the order runs use when `--scene` is absent.
-    pub const ALL: [SceneKind; 5] = [
+    pub const ALL: [SceneKind; 7] = [
         SceneKind::BunnySweep,
         SceneKind::BunnyGrid,
         SceneKind::Simple,
         SceneKind::Windmills,
         SceneKind::Trees,
+        SceneKind::BunnyHalves,
+        SceneKind::Terrain,
     ];
 
     /// The name `--scene` takes and the CSVs' `scene` column holds.
@@ -100,6 +107,8 @@ impl SceneKind {
             SceneKind::Simple => "simple",
             SceneKind::Windmills => "windmills",
             SceneKind::Trees => "trees",
+            SceneKind::BunnyHalves => "bunny-halves",
+            SceneKind::Terrain => "terrain",
         }
     }
 
@@ -119,6 +128,40 @@ impl SceneKind {
     /// The Stanford-bunny scenes of seed 003 (the others are seed 000's procedural camera flights).
     pub fn is_bunny(self) -> bool {
         matches!(self, SceneKind::BunnySweep | SceneKind::BunnyGrid)
+    }
+
+    /// The scenes of one large mesh divided into blocks (seed 004) and clusters: unified LOD, where each block
+    /// is a model of its own with one instance and the seams join them.
+    pub fn is_unified(self) -> bool {
+        matches!(self, SceneKind::BunnyHalves | SceneKind::Terrain)
+    }
+
+    /// Scenes that are one block of one instance count whatever `--count` says.
+    pub fn single_count(self) -> bool {
+        matches!(
+            self,
+            SceneKind::BunnySweep | SceneKind::BunnyHalves | SceneKind::Terrain
+        )
+    }
+
+    /// Cells along a side of the terrain's heightfield under `profile` (2 triangles each): about 2 million
+    /// triangles at the paper profile, 157 thousand at ci.
+    pub fn terrain_quads(profile: Profile) -> u32 {
+        match profile {
+            Profile::Quick => 160,
+            Profile::Ci => 280,
+            Profile::Regress => 48,
+            Profile::Paper => 1000,
+        }
+    }
+
+    /// Blocks along the longest side of the terrain under `profile`, unless `--blocks` says.
+    pub fn terrain_blocks(profile: Profile) -> u32 {
+        match profile {
+            Profile::Regress => 4,
+            Profile::Paper => 16,
+            _ => 8,
+        }
     }
 
     /// What `profile` sets for this scene.
@@ -176,7 +219,7 @@ impl SceneKind {
         use Profile::*;
         use SceneKind::*;
         match (self, profile) {
-            (BunnySweep, _) => vec![1],
+            (BunnySweep | BunnyHalves | Terrain, _) => vec![1],
             (BunnyGrid, Quick) => vec![50],
             (BunnyGrid, Ci) => vec![50, 250],
             (BunnyGrid, Regress) => vec![50],

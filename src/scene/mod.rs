@@ -16,6 +16,7 @@ use serde::Serialize;
 use std::sync::Arc;
 
 pub mod kind;
+pub mod unified;
 
 pub use kind::{CameraMode, Profile, ProfileValues, SceneKind, SweepStart, PAPER_COUNTS};
 
@@ -34,6 +35,10 @@ pub struct SceneConfig {
     /// `--sweep-start`; None = the profile's.
     pub sweep_start: Option<SweepStart>,
     pub switch_distances: Option<Vec<f32>>,
+    /// `--partition` (bunny-halves, terrain).
+    pub partition: crate::blocks::PartitionMode,
+    /// `--blocks`; None = the profile's.
+    pub blocks: Option<u32>,
     pub counts: Option<Vec<u32>>,
     pub fov_deg: f32,
     pub schedule: ScheduleParams,
@@ -69,9 +74,9 @@ impl SceneConfig {
 
     /// The instance counts of `kind`: `--count`, or the profile's (bunny-sweep is always one bunny).
     pub fn counts(&self, kind: SceneKind) -> Vec<u32> {
-        match (kind, &self.counts) {
-            (SceneKind::BunnySweep, _) | (_, None) => kind.profile_counts(self.profile),
-            (_, Some(c)) => c.clone(),
+        match &self.counts {
+            Some(c) if !kind.single_count() => c.clone(),
+            _ => kind.profile_counts(self.profile),
         }
     }
 }
@@ -173,7 +178,12 @@ pub struct Scene {
     /// Camera flight of the procedural scenes: the eye moves from `.0` to `.1` at constant speed over the
     /// frames, looking along `forward`; None = the eye stays at `eye`.
     pub flight: Option<(Vec3, Vec3)>,
+    /// bunny-halves' camera: once around `center` at `distance`, `elevation` radians above it (looking at it).
+    pub turntable: Option<(Vec3, f32, f32)>,
     pub schedule: ScheduleParams,
+    /// The unified-LOD scenes' blocks' mesh, seams and cluster DAG (every instance is a block at the identity
+    /// transform); None elsewhere.
+    pub unified: Option<Arc<unified::Unified>>,
 }
 
 /// Scene-level facts that do not depend on the instance count: built once per scene name.
@@ -194,6 +204,19 @@ pub struct SceneDef {
     pub lod_generation_ms: f64,
     /// The bunny scenes' path (sweep or grid); None for the procedural scenes.
     pub path: Option<BunnyPath>,
+    /// The unified scenes' blocks, camera and frustum.
+    pub unified: Option<Arc<UnifiedParts>>,
+}
+
+/// What a unified scene's blocks are built from, once per scene.
+#[derive(Debug)]
+pub struct UnifiedParts {
+    pub instances: Vec<Instance>,
+    pub data: Arc<unified::Unified>,
+    pub camera: unified::UnifiedCamera,
+    pub forward: Vec3,
+    pub near: f32,
+    pub far: f32,
 }
 
 /// Where the bunny scenes' bunnies are: bunny-sweep's bunny moves from `near` to `far` and back, bunny-grid's
@@ -263,6 +286,32 @@ impl SceneDef {
     pub fn new(kind: SceneKind, cfg: &SceneConfig) -> Result<SceneDef> {
         let pv = cfg.resolved(kind);
         let fov_y = cfg.fov_deg.to_radians();
+        if kind.is_unified() {
+            let started = std::time::Instant::now();
+            let u = unified::build(kind, cfg, pv.width, pv.height, fov_y)?;
+            return Ok(SceneDef {
+                kind,
+                models: Arc::from(u.models),
+                frames: pv.frames,
+                width: pv.width,
+                height: pv.height,
+                fov_y,
+                schedule: cfg.schedule,
+                counts: cfg.counts(kind),
+                camera_mode: cfg.camera,
+                mesh_source: u.mesh_source,
+                lod_generation_ms: started.elapsed().as_secs_f64() * 1e3,
+                path: None,
+                unified: Some(Arc::new(UnifiedParts {
+                    instances: u.instances,
+                    data: u.unified,
+                    camera: u.camera,
+                    forward: u.forward,
+                    near: u.near,
+                    far: u.far,
+                })),
+            });
+        }
         if !kind.is_bunny() {
             return procedural_def(kind, cfg, pv.frames, pv.width, pv.height, fov_y);
         }
@@ -303,6 +352,7 @@ impl SceneDef {
             mesh_source,
             lod_generation_ms,
             path: Some(path),
+            unified: None,
         })
     }
 
@@ -343,6 +393,9 @@ impl SceneDef {
     }
 
     pub fn instantiate(&self, count: u32) -> Scene {
+        if let Some(u) = &self.unified {
+            return self.instantiate_unified(count, u);
+        }
         // The bunny scenes, and only they, have a path (SceneDef::new).
         let Some(path) = self.path else {
             return self.instantiate_field(count);
@@ -394,7 +447,45 @@ impl SceneDef {
             forward: Vec3::X,
             camera_mode: self.camera_mode,
             flight: None,
+            turntable: None,
             schedule: self.schedule,
+            unified: None,
+        }
+    }
+
+    /// A unified scene: one instance per block, at the identity transform.
+    fn instantiate_unified(&self, count: u32, u: &UnifiedParts) -> Scene {
+        let (eye, flight, turntable) = match u.camera {
+            unified::UnifiedCamera::Flight(from, to) => (from, Some((from, to)), None),
+            unified::UnifiedCamera::Turntable {
+                center,
+                distance,
+                elevation,
+            } => (
+                center + Vec3::new(0.0, elevation.sin(), elevation.cos()) * distance,
+                None,
+                Some((center, distance, elevation)),
+            ),
+        };
+        Scene {
+            kind: self.kind,
+            count,
+            models: self.models.clone(),
+            instances: u.instances.clone(),
+            motion: Motion::Static,
+            frames: self.frames,
+            width: self.width,
+            height: self.height,
+            fov_y: self.fov_y,
+            near: u.near,
+            far: u.far,
+            eye,
+            forward: u.forward,
+            camera_mode: self.camera_mode,
+            flight,
+            turntable,
+            schedule: self.schedule,
+            unified: Some(u.data.clone()),
         }
     }
 
@@ -451,7 +542,9 @@ impl SceneDef {
             forward,
             camera_mode: self.camera_mode,
             flight: Some((from, to)),
+            turntable: None,
             schedule: self.schedule,
+            unified: None,
         }
     }
 }
@@ -535,6 +628,7 @@ fn procedural_def(
         mesh_source: source.to_string(),
         lod_generation_ms,
         path: None,
+        unified: None,
     })
 }
 
@@ -657,6 +751,10 @@ impl Scene {
     /// Object-to-world matrix of instance `i` on `frame`: the model's bounding-sphere centre goes to the
     /// instance position.
     pub fn instance_matrix(&self, i: usize, frame: u32) -> Mat4 {
+        if self.unified.is_some() {
+            // Blocks and seams are in world space: every block shares one exact transform with its seams.
+            return Mat4::IDENTITY;
+        }
         let inst = &self.instances[i];
         let m = &self.models[inst.model as usize];
         Mat4::from_translation(self.instance_position(i, frame))
@@ -673,6 +771,17 @@ impl Scene {
 
     pub fn camera(&self, frame: u32) -> Camera {
         let (eye, view) = match (self.camera_mode, self.flight) {
+            _ if self.turntable.is_some() => {
+                let (center, distance, elevation) = self.turntable.unwrap_or_default();
+                let theta = std::f32::consts::TAU * frame as f32 / self.frames.max(1) as f32;
+                let dir = Vec3::new(
+                    elevation.cos() * theta.sin(),
+                    elevation.sin(),
+                    elevation.cos() * theta.cos(),
+                );
+                let eye = center + dir * distance;
+                (eye, Mat4::look_at_rh(eye, center, Vec3::Y))
+            }
             (_, Some((from, to))) => {
                 let t = if self.frames > 1 {
                     frame as f32 / (self.frames - 1) as f32
@@ -768,6 +877,9 @@ pub struct SceneDescription {
     /// [`SceneDef::notes`]: what the run warns about this scene.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// The unified scenes' preprocessing: blocks, seams, cluster DAG, with times and sizes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unified: Option<unified::Preprocessing>,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -836,6 +948,7 @@ impl SceneDef {
             instance_build_ms,
             path: self.path,
             notes: self.notes(),
+            unified: self.unified.as_ref().map(|u| u.data.preprocessing.clone()),
         }
     }
 }

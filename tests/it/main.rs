@@ -18,4 +18,5 @@ mod registry;
 mod regress;
 mod render;
 mod shaders;
+mod unified;
 mod variants;

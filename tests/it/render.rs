@@ -128,7 +128,7 @@ fn same_flags_same_metrics() {
     };
     let a = run_once("a");
     let b = run_once("b");
-    for method in lodbench::methods::names() {
+    for method in lodbench::methods::defaults_for(false) {
         for name in [
             "rmse",
             "pop",
@@ -426,9 +426,13 @@ fn snapshot_scenes_every_method() {
     let bless = std::env::var_os("LODBENCH_BLESS").is_some();
     let mut problems = Vec::new();
     let mut checked = 0;
-    for scene in SceneKind::names() {
-        let count = if scene == "bunny-sweep" { 1 } else { 4 };
-        for method in lodbench::methods::names() {
+    let mut expected = 0;
+    for kind in SceneKind::ALL {
+        let scene = kind.name();
+        let count = if kind.single_count() { 1 } else { 4 };
+        let methods = lodbench::methods::defaults_for(kind.is_unified());
+        expected += methods.len();
+        for method in methods {
             let stem = format!("{scene}_{method}_c{count}_f00002_method.png");
             let frame = out.join("frames").join(&stem);
             let actual = image::open(&frame)
@@ -446,7 +450,7 @@ fn snapshot_scenes_every_method() {
         "scene snapshots differ:\n{}",
         problems.join("\n")
     );
-    assert!(bless || checked == SceneKind::ALL.len() * lodbench::methods::BUILTIN.len());
+    assert!(bless || checked == expected);
 }
 
 /// A run of `methods` on a short bunny-sweep with `rounds` timing rounds and `seed`: its folder.

@@ -1,0 +1,236 @@
+//! Cluster LOD, the cluster DAG of Nanite as meshoptimizer 1.x builds it (`meshopt::clod_build`): the mesh is
+//! split into clusters of at most [`MAX_TRIANGLES`] triangles; groups of neighbouring clusters are merged,
+//! simplified with their outer border locked and split again, level after level, so every group carries the
+//! error of its simplified version and every cluster names the more refined group it was made from. Pure CPU.
+//!
+//! The per-frame cut ([`ClusterDag::cut`]) follows meshoptimizer's rule (`clodGroup`'s documentation): a
+//! cluster is drawn when the projected error of the group it is in is over the threshold and the cluster is
+//! original geometry or the projected error of the group it was refined from is at or under it. Projected
+//! error in pixels: `error / max(distance(centre, eye) - radius, znear) * height / (2 tan(fov_y / 2))`, the same
+//! conservative distance the block scenes' switch distances use (docs/methods.md, "Unified LOD"). A cluster
+//! either is drawn or not: cut changes are hard switches, there is no transition between them.
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use glam::Vec3;
+
+/// Triangles per cluster at most (meshoptimizer's default configuration for rasterisation at this size).
+pub const MAX_TRIANGLES: usize = 128;
+
+/// Sphere bounds and error of a group's simplified geometry, in mesh units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GroupBounds {
+    pub center: Vec3,
+    pub radius: f32,
+    /// `f32::MAX` for a terminal group (nothing coarser was made from it).
+    pub error: f32,
+    pub depth: u32,
+}
+
+/// One cluster: a range of [`ClusterDag::indices`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cluster {
+    pub first_index: u32,
+    pub index_count: u32,
+    /// The group the cluster is in.
+    pub group: u32,
+    /// The group it was simplified from, or None for original geometry.
+    pub refined: Option<u32>,
+}
+
+/// The DAG of one mesh.
+#[derive(Debug, Clone)]
+pub struct ClusterDag {
+    /// Every cluster's triangles, into the mesh's own vertices, cluster after cluster.
+    pub indices: Vec<u32>,
+    pub clusters: Vec<Cluster>,
+    pub groups: Vec<GroupBounds>,
+    /// Milliseconds `clod_build` took.
+    pub build_ms: f64,
+}
+
+/// How the cut projects errors: the camera's position, pixels per unit of error at distance 1
+/// (`height / (2 tan(fov_y / 2))`), the near plane and the threshold in pixels.
+#[derive(Debug, Clone, Copy)]
+pub struct CutCamera {
+    pub eye: Vec3,
+    pub pixels_per_unit: f32,
+    pub znear: f32,
+    pub pixel_error: f32,
+}
+
+impl CutCamera {
+    fn over(&self, g: &GroupBounds) -> bool {
+        if g.error == f32::MAX {
+            return true;
+        }
+        let d = (g.center.distance(self.eye) - g.radius).max(self.znear);
+        g.error / d * self.pixels_per_unit > self.pixel_error
+    }
+}
+
+impl ClusterDag {
+    /// Builds the DAG of `mesh` (positions only; meshoptimizer's default configuration for rasterisation
+    /// with [`MAX_TRIANGLES`]).
+    pub fn build(name: &str, mesh: &Mesh) -> Result<ClusterDag> {
+        let started = std::time::Instant::now();
+        let bytes: &[u8] = bytemuck::cast_slice(&mesh.positions);
+        let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| Error::Mesh {
+            path: name.to_string(),
+            problem: format!("meshopt rejected the vertices: {e}"),
+        })?;
+        let mut dag = ClusterDag {
+            indices: Vec::new(),
+            clusters: Vec::new(),
+            groups: Vec::new(),
+            build_ms: 0.0,
+        };
+        let config = meshopt::clod_default_config(MAX_TRIANGLES);
+        meshopt::clod_build(
+            config,
+            &meshopt::ClodMesh::new(&mesh.indices, &adapter),
+            |group, clusters| {
+                let id = dag.groups.len() as u32;
+                let s = group.simplified;
+                dag.groups.push(GroupBounds {
+                    center: Vec3::from(s.center),
+                    radius: s.radius,
+                    error: s.error,
+                    depth: group.depth.max(0) as u32,
+                });
+                for c in clusters {
+                    dag.clusters.push(Cluster {
+                        first_index: dag.indices.len() as u32,
+                        index_count: c.indices.len() as u32,
+                        group: id,
+                        refined: u32::try_from(c.refined).ok(),
+                    });
+                    dag.indices.extend_from_slice(c.indices);
+                }
+                id as i32
+            },
+        );
+        if dag.clusters.is_empty() {
+            return Err(Error::Mesh {
+                path: name.to_string(),
+                problem: "cluster LOD built no clusters".into(),
+            });
+        }
+        dag.build_ms = started.elapsed().as_secs_f64() * 1e3;
+        Ok(dag)
+    }
+
+    /// Levels of the DAG (the deepest group's depth + 1).
+    pub fn levels(&self) -> u32 {
+        self.groups
+            .iter()
+            .map(|g| g.depth)
+            .max()
+            .map_or(0, |d| d + 1)
+    }
+
+    /// Bytes of the clusters' indices and their records.
+    pub fn bytes(&self) -> u64 {
+        (self.indices.len() * 4
+            + self.clusters.len() * std::mem::size_of::<Cluster>()
+            + self.groups.len() * std::mem::size_of::<GroupBounds>()) as u64
+    }
+
+    /// The clusters to draw for `camera`, in cluster order, into `out` (cleared first).
+    pub fn cut(&self, camera: &CutCamera, out: &mut Vec<u32>) {
+        self.cut_into(camera, &mut Vec::new(), out);
+    }
+
+    /// [`ClusterDag::cut`] with the per-group scratch `over` kept by the caller (nothing allocated once it
+    /// has grown).
+    pub fn cut_into(&self, camera: &CutCamera, over: &mut Vec<bool>, out: &mut Vec<u32>) {
+        out.clear();
+        over.clear();
+        over.extend(self.groups.iter().map(|g| camera.over(g)));
+        out.extend(
+            self.clusters
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| {
+                    over[c.group as usize] && c.refined.is_none_or(|r| !over[r as usize])
+                })
+                .map(|(i, _)| i as u32),
+        );
+    }
+
+    /// Triangles of the clusters `selected`.
+    pub fn triangles(&self, selected: &[u32]) -> u64 {
+        selected
+            .iter()
+            .map(|&c| self.clusters[c as usize].index_count as u64 / 3)
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera(eye: Vec3, pixel_error: f32) -> CutCamera {
+        CutCamera {
+            eye,
+            pixels_per_unit: 600.0 / (2.0 * 30f32.to_radians().tan()),
+            znear: 0.01,
+            pixel_error,
+        }
+    }
+
+    /// At a vanishing pixel error the cut is the original mesh, triangle for triangle; at a huge one it is the
+    /// terminal groups' clusters; farther or more tolerant never draws more.
+    #[test]
+    fn the_cut_runs_from_the_mesh_to_the_coarsest_clusters() {
+        let mesh = crate::terrain::terrain_mesh(3, 64).unwrap();
+        let dag = ClusterDag::build("terrain", &mesh).unwrap();
+        assert!(dag.levels() > 2, "{} levels", dag.levels());
+        let mut cut = Vec::new();
+        dag.cut(&camera(Vec3::new(50.0, 20.0, 50.0), 1e-9), &mut cut);
+        assert!(cut
+            .iter()
+            .all(|&c| dag.clusters[c as usize].refined.is_none()));
+        assert_eq!(dag.triangles(&cut), mesh.triangle_count() as u64);
+        let mut tris: Vec<[u32; 3]> = cut
+            .iter()
+            .flat_map(|&c| {
+                let c = dag.clusters[c as usize];
+                dag.indices[c.first_index as usize..(c.first_index + c.index_count) as usize]
+                    .chunks_exact(3)
+                    .map(|t| {
+                        let mut t = [t[0], t[1], t[2]];
+                        t.sort_unstable();
+                        t
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let mut original: Vec<[u32; 3]> = mesh
+            .indices
+            .chunks_exact(3)
+            .map(|t| {
+                let mut t = [t[0], t[1], t[2]];
+                t.sort_unstable();
+                t
+            })
+            .collect();
+        tris.sort_unstable();
+        original.sort_unstable();
+        assert_eq!(tris, original);
+        dag.cut(&camera(Vec3::new(50.0, 20.0, 50.0), 1e9), &mut cut);
+        assert!(cut
+            .iter()
+            .all(|&c| dag.groups[dag.clusters[c as usize].group as usize].error == f32::MAX));
+        let coarsest = dag.triangles(&cut);
+        assert!(coarsest * 10 < mesh.triangle_count() as u64, "{coarsest}");
+        let mut last = u64::MAX;
+        for d in [5.0, 20.0, 80.0, 320.0] {
+            dag.cut(&camera(Vec3::new(50.0, d, 50.0), 1.0), &mut cut);
+            let t = dag.triangles(&cut);
+            assert!(t <= last && t >= coarsest, "{t} at height {d}");
+            last = t;
+        }
+    }
+}

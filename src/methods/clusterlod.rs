@@ -1,0 +1,168 @@
+//! `clusterlod`: the Nanite-style cluster DAG of meshoptimizer 1.x (`meshopt::clod_build`) on a unified
+//! scene's whole mesh, with the per-frame cut at `--pixel-error` ([`crate::clusterlod`]). Clusters are drawn
+//! where the cut selects them, opaque; a cut change is a hard switch. The shared schedule's block states are
+//! not used: the cut is this method's own selection, and lodpop's counterfactual is the previous frame's cut
+//! drawn at this frame's pose ([`Method::selection_changed`]).
+
+use super::common::{FrameInput, Method};
+use crate::clusterlod::CutCamera;
+use crate::error::{Error, Result};
+use crate::gpu::{DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu, Vertex};
+use crate::scene::unified::Unified;
+use crate::scene::Scene;
+use crate::schedule::InstanceState;
+use glam::Mat4;
+use std::sync::Arc;
+use wgpu::util::DeviceExt;
+
+pub struct ClusterLod {
+    unified: Arc<Unified>,
+    vertex_buffer: wgpu::Buffer,
+    index_buffer: wgpu::Buffer,
+    instance: InstanceBuffer,
+    /// This frame's cut and the previous frame's, in cluster order.
+    cut: Vec<u32>,
+    previous: Vec<u32>,
+    over: Vec<bool>,
+}
+
+impl ClusterLod {
+    pub fn new(gpu: &SceneGpu, scene: &Scene) -> Result<Self> {
+        let unified = scene.unified.clone().ok_or_else(|| {
+            Error::Config(format!(
+                "clusterlod needs a scene of one large mesh (bunny-halves, terrain), not {}",
+                scene.name()
+            ))
+        })?;
+        let m = &unified.mesh;
+        let vertices: Vec<Vertex> = m
+            .positions
+            .iter()
+            .zip(&m.normals)
+            .map(|(p, n)| Vertex {
+                position: *p,
+                normal: *n,
+                aux: [0.0; 4],
+            })
+            .collect();
+        let vertex_buffer = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("clusterlod vertices"),
+                contents: bytemuck::cast_slice(&vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+        let index_buffer = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("clusterlod indices"),
+                contents: bytemuck::cast_slice(&unified.dag.indices),
+                usage: wgpu::BufferUsages::INDEX,
+            });
+        let instance = gpu.create_instance_buffer("clusterlod instance", 1);
+        let mut instance_list = crate::gpu::DrawList::default();
+        let [r, g, b] = scene.models.first().map_or([0.7; 3], |m| m.color);
+        instance_list.push(
+            0,
+            0,
+            0,
+            InstanceRaw::new(&Mat4::IDENTITY, [r, g, b, 0.0], [0.0, 1.0, 0.0, 0.0]),
+        );
+        instance_list.build();
+        gpu.upload(&instance, &instance_list);
+        Ok(ClusterLod {
+            unified,
+            vertex_buffer,
+            index_buffer,
+            instance,
+            cut: Vec::new(),
+            previous: Vec::new(),
+            over: Vec::new(),
+        })
+    }
+
+    /// Draws the clusters of `cut` (cluster order) into a cleared `target`, one draw per run of consecutive
+    /// clusters (their indices are contiguous).
+    fn draw(
+        &self,
+        gpu: &SceneGpu,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+        cut: &[u32],
+    ) -> DrawStats {
+        let dag = &self.unified.dag;
+        let mut pass = gpu.begin_clear_pass(encoder, target, "clusterlod pass");
+        pass.set_bind_group(0, &gpu.camera_bind_group, &[]);
+        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+        pass.set_vertex_buffer(1, self.instance.buffer.slice(..));
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+        pass.set_pipeline(&gpu.opaque_pipeline);
+        let mut stats = DrawStats {
+            clusters: Some(cut.len() as u64),
+            ..Default::default()
+        };
+        let mut i = 0;
+        while i < cut.len() {
+            let first = dag.clusters[cut[i] as usize];
+            let (start, mut end) = (first.first_index, first.first_index + first.index_count);
+            let mut j = i + 1;
+            while j < cut.len() && cut[j] == cut[j - 1] + 1 {
+                let c = dag.clusters[cut[j] as usize];
+                end = c.first_index + c.index_count;
+                j += 1;
+            }
+            pass.draw_indexed(start..end, 0, 0..1);
+            stats.triangles += (end - start) as u64 / 3;
+            stats.draw_calls += 1;
+            i = j;
+        }
+        stats
+    }
+
+    fn camera(&self, input: &FrameInput<'_>) -> CutCamera {
+        let s = input.scene;
+        CutCamera {
+            eye: s.camera(input.frame).eye,
+            pixels_per_unit: s.height as f32 / (2.0 * (s.fov_y * 0.5).tan()),
+            znear: s.near,
+            pixel_error: self.unified.pixel_error,
+        }
+    }
+}
+
+impl Method for ClusterLod {
+    fn encode(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) -> DrawStats {
+        std::mem::swap(&mut self.cut, &mut self.previous);
+        let camera = self.camera(input);
+        self.unified
+            .dag
+            .cut_into(&camera, &mut self.over, &mut self.cut);
+        let cut = std::mem::take(&mut self.cut);
+        let stats = self.draw(gpu, encoder, target, &cut);
+        self.cut = cut;
+        stats
+    }
+
+    fn selection_changed(&self) -> bool {
+        self.cut != self.previous
+    }
+
+    fn encode_before(
+        &mut self,
+        gpu: &SceneGpu,
+        _input: &FrameInput<'_>,
+        _history: &[&[InstanceState]],
+        encoder: &mut wgpu::CommandEncoder,
+        before: &RenderTarget,
+    ) {
+        let previous = std::mem::take(&mut self.previous);
+        self.draw(gpu, encoder, before, &previous);
+        self.previous = previous;
+    }
+}
