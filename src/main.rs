@@ -185,12 +185,12 @@ fn describe(args: &DescribeArgs) -> lodbench::Result<()> {
             })
             .collect();
         outln!(
-            "blocks: {} ({:?} grid of {:.3}-unit cubes, --partition {:?}), {} input triangles, {} in blocks; \
+            "blocks: {} ({:?} grid of {:.3}-unit cubes, --partition {}), {} input triangles, {} in blocks; \
              triangles of all blocks per LOD: {}",
             u.blocks,
             u.grid,
             u.block_size,
-            u.partition,
+            format!("{:?}", u.partition).to_lowercase(),
             u.input_triangles,
             u.block_triangles,
             per_lod.join(", ")

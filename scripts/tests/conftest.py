@@ -70,3 +70,15 @@ def check_experiment(tmp_path_factory) -> Path:
     out = base / "run"
     lodbench("experiment", str(spec), "--out", str(out))
     return out
+
+
+@pytest.fixture(scope="session")
+def pixel_error_experiment(tmp_path_factory) -> Path:
+    """A two-value pixel-error sweep of the terrain at the regress profile (small), every unified method."""
+    base = tmp_path_factory.mktemp("experiment")
+    spec = base / "unified.toml"
+    spec.write_text('name = "unified"\n[run]\nscene = ["terrain"]\nprofile = "regress"\nframes = 8\nwarmup = 0\n'
+                    '[sweep]\nvariable = "pixel-error"\nvalues = [1.0, 4.0]\n')
+    out = base / "run"
+    lodbench("experiment", str(spec), "--out", str(out))
+    return out

@@ -84,3 +84,16 @@ def test_other_sweep_variable_splits_the_series(check_experiment, tmp_path):
     assert "| none | windmills | fsi (fsi-check none) |" in report
     assert "| forward | windmills | fsi (fsi-check forward) |" in report
     assert "fig8_windmills.png" not in figures(folder)
+
+
+def test_pixel_error_experiment_gets_the_unified_figure(pixel_error_experiment, tmp_path):
+    folder = tmp_path / "exp"
+    shutil.copytree(pixel_error_experiment, folder)
+    r = plot(folder)
+    assert r.returncode == 0, r.stderr
+    assert "unified_terrain.png" in figures(folder)
+    report = (folder / "report.md").read_text()
+    assert "| 1.0 | terrain | clusterlod |" in report and "| 4.0 | terrain | blocks |" in report
+    assert "crack_px_mean" in report
+    with Image.open(folder / "figures" / "unified_terrain.png") as im:
+        assert im.width > 600

@@ -635,6 +635,28 @@ fn procedural_def(
 /// Yaw of the bunny instances: the classic three-quarter view, face to the right.
 pub const BUNNY_YAW: f32 = 1.0;
 
+/// An error naming `file` when every triangle of `mesh` has zero area.
+pub(crate) fn check_area(file: &str, mesh: &Mesh) -> Result<()> {
+    let area: f64 = mesh
+        .indices
+        .chunks_exact(3)
+        .map(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3::from(mesh.positions[i as usize]));
+            f64::from((b - a).cross(c - a).length())
+        })
+        .sum();
+    if area.is_nan() || area <= 0.0 {
+        return Err(Error::Mesh {
+            path: file.to_string(),
+            problem: format!(
+                "all {} triangles are degenerate (zero area)",
+                mesh.triangle_count()
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// The model of bunny scene `kind` from `mesh`, read from `file` (named in error messages).
 fn bunny_model(
     kind: SceneKind,
@@ -648,20 +670,7 @@ fn bunny_model(
         path: file.to_string(),
         problem,
     };
-    let area: f64 = mesh
-        .indices
-        .chunks_exact(3)
-        .map(|t| {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3::from(mesh.positions[i as usize]));
-            f64::from((b - a).cross(c - a).length())
-        })
-        .sum();
-    if area.is_nan() || area <= 0.0 {
-        return Err(bad(format!(
-            "all {} triangles are degenerate (zero area)",
-            mesh.triangle_count()
-        )));
-    }
+    check_area(file, mesh)?;
     let chain = LodChain::build(file, mesh, &DEFAULT_TARGETS)?;
     let (center, radius) = chain.lods[0].mesh.bounding_sphere();
     if !(radius.is_finite() && radius > 0.0) {

@@ -157,6 +157,7 @@ pub fn build(
         ),
     };
     let name = kind.name();
+    super::check_area(&mesh_source, &mesh)?;
     let (lo, hi) = mesh.bounds();
     let extent = (hi - lo).max_element();
     if !(extent.is_finite() && extent > 0.0) {

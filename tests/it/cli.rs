@@ -413,3 +413,42 @@ fn bad_timing_flags_are_rejected() {
     let out = lodbench(&["run", "--rounds", "0"], &[]);
     fails_with(&out, &["--rounds"]);
 }
+
+/// The unified methods need a unified scene, the unified scenes take no --switch-distances (each block has its
+/// own), and --blocks stays in range: each a one-line error before any GPU work.
+#[test]
+fn unified_scenes_and_methods_reject_what_does_not_fit() {
+    let out = lodbench(
+        &["run", "--scene", "simple,terrain", "--method", "blocks"],
+        &[],
+    );
+    fails_with(
+        &out,
+        &["method blocks", "scene simple", "bunny-halves", "terrain"],
+    );
+    let out = lodbench(&["run", "--method", "clusterlod"], &[]);
+    fails_with(&out, &["method clusterlod", "scene bunny-sweep"]);
+    let out = lodbench(
+        &[
+            "describe",
+            "--scene",
+            "terrain",
+            "--profile",
+            "regress",
+            "--switch-distances",
+            "1,2,3",
+        ],
+        &[],
+    );
+    fails_with(&out, &["--switch-distances", "terrain", "--pixel-error"]);
+    let out = lodbench(&["describe", "--scene", "terrain", "--blocks", "0"], &[]);
+    fails_with(&out, &["--blocks 0"]);
+    let dir = tempfile::tempdir().unwrap();
+    let flat = write(
+        dir.path(),
+        "flat.obj",
+        "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
+    );
+    let out = lodbench(&["describe", "--scene", "terrain", "--mesh", &flat], &[]);
+    fails_with(&out, &["flat.obj"]);
+}
