@@ -297,9 +297,13 @@ mod tests {
         let c = RunConfig::from_args(&run_args(&["--method", "discrete,alpha,discrete,discrete"]))
             .unwrap();
         assert_eq!(c.methods, ["discrete", "alpha", "discrete#2", "discrete#3"]);
-        assert_eq!(c.baseline.as_deref(), Some("discrete"));
+        assert_eq!(c.baseline_for(&c.methods).as_deref(), Some("discrete"));
         let c = RunConfig::from_args(&run_args(&["--method", "alpha,fsi"])).unwrap();
-        assert_eq!(c.baseline, None, "no discrete, no default baseline");
+        assert_eq!(
+            c.baseline_for(&c.methods),
+            None,
+            "no discrete, no default baseline"
+        );
         let c = RunConfig::from_args(&run_args(&[
             "--method",
             "alpha,alpha",
@@ -307,7 +311,7 @@ mod tests {
             "alpha#2",
         ]))
         .unwrap();
-        assert_eq!(c.baseline.as_deref(), Some("alpha#2"));
+        assert_eq!(c.baseline_for(&c.methods).as_deref(), Some("alpha#2"));
         let e = RunConfig::from_args(&run_args(&["--method", "alpha", "--baseline", "discrete"]))
             .unwrap_err()
             .to_string();
@@ -339,6 +343,17 @@ mod tests {
         let c = RunConfig::from_args(&run_args(&[])).unwrap();
         assert_eq!(c.scenes, SceneKind::ALL);
         assert_eq!(c.methods, crate::methods::names());
+        // Each scene runs the methods that fit it, with its own default baseline.
+        let terrain = c.methods_for(SceneKind::Terrain);
+        assert_eq!(terrain, crate::methods::UNIFIED_DEFAULT);
+        assert_eq!(c.baseline_for(&terrain).as_deref(), Some("blocks-discrete"));
+        let sweep = c.methods_for(SceneKind::BunnySweep);
+        assert!(sweep.contains(&"fsi".to_string()) && !sweep.iter().any(|m| m == "blocks"));
+        assert_eq!(c.baseline_for(&sweep).as_deref(), Some("discrete"));
+        // Named methods run as named on every scene they fit.
+        let c = RunConfig::from_args(&run_args(&["--scene", "terrain", "--method", "fsi,blocks"]))
+            .unwrap();
+        assert_eq!(c.methods_for(SceneKind::Terrain), ["fsi", "blocks"]);
     }
 
     #[test]

@@ -149,6 +149,28 @@ impl Mesh {
         self.indices.len() / 3
     }
 
+    /// An error naming `name` (the file) when every triangle has zero area.
+    pub fn check_area(&self, name: &str) -> Result<()> {
+        let area: f64 = self
+            .indices
+            .chunks_exact(3)
+            .map(|t| {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3::from(self.positions[i as usize]));
+                f64::from((b - a).cross(c - a).length())
+            })
+            .sum();
+        if area.is_nan() || area <= 0.0 {
+            return Err(Error::Mesh {
+                path: name.to_string(),
+                problem: format!(
+                    "all {} triangles are degenerate (zero area)",
+                    self.triangle_count()
+                ),
+            });
+        }
+        Ok(())
+    }
+
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
     }

@@ -287,30 +287,7 @@ impl SceneDef {
         let pv = cfg.resolved(kind);
         let fov_y = cfg.fov_deg.to_radians();
         if kind.is_unified() {
-            let started = std::time::Instant::now();
-            let u = unified::build(kind, cfg, pv.width, pv.height, fov_y)?;
-            return Ok(SceneDef {
-                kind,
-                models: Arc::from(u.models),
-                frames: pv.frames,
-                width: pv.width,
-                height: pv.height,
-                fov_y,
-                schedule: cfg.schedule,
-                counts: cfg.counts(kind),
-                camera_mode: cfg.camera,
-                mesh_source: u.mesh_source,
-                lod_generation_ms: started.elapsed().as_secs_f64() * 1e3,
-                path: None,
-                unified: Some(Arc::new(UnifiedParts {
-                    instances: u.instances,
-                    data: u.unified,
-                    camera: u.camera,
-                    forward: u.forward,
-                    near: u.near,
-                    far: u.far,
-                })),
-            });
+            return unified_def(kind, cfg, &pv, fov_y);
         }
         if !kind.is_bunny() {
             return procedural_def(kind, cfg, pv.frames, pv.width, pv.height, fov_y);
@@ -549,6 +526,95 @@ impl SceneDef {
     }
 }
 
+/// A unified scene (`scene/unified.rs`): its mesh (`--mesh`, the built-in bunny, or the terrain), its blocks as
+/// models with one instance each, and its seams and cluster DAG.
+fn unified_def(
+    kind: SceneKind,
+    cfg: &SceneConfig,
+    pv: &ProfileValues,
+    fov_y: f32,
+) -> Result<SceneDef> {
+    if cfg.switch_distances.is_some() {
+        return Err(Error::Config(format!(
+            "--switch-distances does not apply to {}: each of its blocks has switch distances of its own (set \
+             --pixel-error)",
+            kind.name()
+        )));
+    }
+    let started = std::time::Instant::now();
+    let quads = SceneKind::terrain_quads(cfg.profile);
+    let (mesh, mesh_source) = match (&cfg.mesh, kind) {
+        (Some(p), _) => (Mesh::load(p)?, p.display().to_string()),
+        (None, SceneKind::BunnyHalves) => (
+            Mesh::parse_obj("scenes/bunny.obj (built in)", BUNNY_OBJ)?,
+            "scenes/bunny.obj (npm bunny@1.0.1, built in)".to_string(),
+        ),
+        (None, _) => (
+            crate::terrain::terrain_mesh(SCENE_SEED, quads)?,
+            format!("procedural (src/terrain.rs, seed SCENE_SEED = 2008, {quads} x {quads} cells)"),
+        ),
+    };
+    let u = unified::build(unified::UnifiedInput {
+        kind,
+        mesh,
+        mesh_source: &mesh_source,
+        partition: cfg.partition,
+        blocks: cfg
+            .blocks
+            .unwrap_or_else(|| SceneKind::terrain_blocks(cfg.profile)),
+        pixel_error: cfg.pixel_error(kind, pv.height),
+        schedule: &cfg.schedule,
+        width: pv.width,
+        height: pv.height,
+        fov_y,
+    })?;
+    let instances = (0..u.blocks.len())
+        .map(|i| Instance {
+            model: i as u32,
+            position: u.blocks[i].center,
+            yaw: 0.0,
+        })
+        .collect();
+    let models: Vec<Model> = u
+        .blocks
+        .into_iter()
+        .map(|b| Model {
+            name: b.name,
+            color: b.color,
+            lod_colors: Vec::new(),
+            spin_per_frame: 0.0,
+            chain: b.chain,
+            switches: b.switches,
+            switch_source: b.switch_source,
+            center: b.center,
+            radius: b.radius,
+            scale: 1.0,
+        })
+        .collect();
+    Ok(SceneDef {
+        kind,
+        models: Arc::from(models),
+        frames: pv.frames,
+        width: pv.width,
+        height: pv.height,
+        fov_y,
+        schedule: cfg.schedule,
+        counts: cfg.counts(kind),
+        camera_mode: cfg.camera,
+        mesh_source,
+        lod_generation_ms: started.elapsed().as_secs_f64() * 1e3,
+        path: None,
+        unified: Some(Arc::new(UnifiedParts {
+            instances,
+            data: u.unified,
+            camera: u.camera,
+            forward: u.forward,
+            near: u.near,
+            far: u.far,
+        })),
+    })
+}
+
 /// The models of a procedural scene, built once: SIMPLE's sphere and box, the windmill, the tree
 /// (`crate::procgen`). Switch distances: from the measured LOD errors and `--pixel-error` like the bunny's,
 /// except SIMPLE, whose box is no approximation of the sphere at any distance: it switches at 12 sphere
@@ -635,28 +701,6 @@ fn procedural_def(
 /// Yaw of the bunny instances: the classic three-quarter view, face to the right.
 pub const BUNNY_YAW: f32 = 1.0;
 
-/// An error naming `file` when every triangle of `mesh` has zero area.
-pub(crate) fn check_area(file: &str, mesh: &Mesh) -> Result<()> {
-    let area: f64 = mesh
-        .indices
-        .chunks_exact(3)
-        .map(|t| {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3::from(mesh.positions[i as usize]));
-            f64::from((b - a).cross(c - a).length())
-        })
-        .sum();
-    if area.is_nan() || area <= 0.0 {
-        return Err(Error::Mesh {
-            path: file.to_string(),
-            problem: format!(
-                "all {} triangles are degenerate (zero area)",
-                mesh.triangle_count()
-            ),
-        });
-    }
-    Ok(())
-}
-
 /// The model of bunny scene `kind` from `mesh`, read from `file` (named in error messages).
 fn bunny_model(
     kind: SceneKind,
@@ -670,7 +714,7 @@ fn bunny_model(
         path: file.to_string(),
         problem,
     };
-    check_area(file, mesh)?;
+    mesh.check_area(file)?;
     let chain = LodChain::build(file, mesh, &DEFAULT_TARGETS)?;
     let (center, radius) = chain.lods[0].mesh.bounding_sphere();
     if !(radius.is_finite() && radius > 0.0) {

@@ -19,12 +19,13 @@
 //! `clusterlod`'s cut uses too), i.e. [`crate::lod::switch_distance`] plus the radius, spread so that
 //! consecutive transition bands never overlap.
 
-use super::{Instance, Model, SceneConfig, SceneKind, BUNNY_OBJ};
+use super::kind::SceneKind;
 use crate::blocks::{BlockLod, Grid, Partition, PartitionMode};
 use crate::clusterlod::ClusterDag;
 use crate::error::{Error, Result};
 use crate::lod::{Lod, LodChain};
 use crate::mesh::Mesh;
+use crate::schedule::ScheduleParams;
 use glam::{DVec3, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
@@ -122,47 +123,66 @@ pub enum UnifiedCamera {
     },
 }
 
+/// One block as the scene's model of it (`SceneDef` makes a `Model` and one instance of each).
+#[derive(Debug, Clone)]
+pub struct BlockModel {
+    pub name: String,
+    pub color: [f32; 3],
+    pub chain: LodChain,
+    pub switches: Vec<f32>,
+    pub switch_source: &'static str,
+    /// Bounding-sphere centre and radius of LOD0 (world units: blocks are at the identity transform).
+    pub center: Vec3,
+    pub radius: f32,
+}
+
 /// Everything `SceneDef` needs of a unified scene.
 pub struct UnifiedDef {
-    pub models: Vec<Model>,
-    pub instances: Vec<Instance>,
+    pub blocks: Vec<BlockModel>,
     pub unified: Arc<Unified>,
     pub camera: UnifiedCamera,
     pub forward: Vec3,
     pub near: f32,
     pub far: f32,
-    pub mesh_source: String,
 }
 
-/// Builds `kind`'s mesh, blocks, seams and DAG.
-pub fn build(
-    kind: SceneKind,
-    cfg: &SceneConfig,
-    width: u32,
-    height: u32,
-    fov_y: f32,
-) -> Result<UnifiedDef> {
-    let (mesh, mesh_source) = match (&cfg.mesh, kind) {
-        (Some(p), _) => (Mesh::load(p)?, p.display().to_string()),
-        (None, SceneKind::BunnyHalves) => (
-            Mesh::parse_obj("scenes/bunny.obj (built in)", BUNNY_OBJ)?,
-            "scenes/bunny.obj (npm bunny@1.0.1, built in)".to_string(),
-        ),
-        (None, _) => (
-            crate::terrain::terrain_mesh(super::SCENE_SEED, SceneKind::terrain_quads(cfg.profile))?,
-            format!(
-                "procedural (src/terrain.rs, seed SCENE_SEED = 2008, {0} x {0} cells)",
-                SceneKind::terrain_quads(cfg.profile)
-            ),
-        ),
-    };
+/// What a unified scene is built from: its mesh (named `mesh_source` in errors), the flags that shape it, and
+/// the viewport.
+pub struct UnifiedInput<'a> {
+    pub kind: SceneKind,
+    pub mesh: Mesh,
+    pub mesh_source: &'a str,
+    pub partition: PartitionMode,
+    /// terrain: blocks along the longest side.
+    pub blocks: u32,
+    pub pixel_error: f32,
+    pub schedule: &'a ScheduleParams,
+    pub width: u32,
+    pub height: u32,
+    pub fov_y: f32,
+}
+
+/// Builds `input.kind`'s blocks, seams and DAG.
+pub fn build(input: UnifiedInput<'_>) -> Result<UnifiedDef> {
+    let UnifiedInput {
+        kind,
+        mesh,
+        mesh_source,
+        partition: partition_mode,
+        blocks,
+        pixel_error,
+        schedule,
+        width,
+        height,
+        fov_y,
+    } = input;
     let name = kind.name();
-    super::check_area(&mesh_source, &mesh)?;
+    mesh.check_area(mesh_source)?;
     let (lo, hi) = mesh.bounds();
     let extent = (hi - lo).max_element();
     if !(extent.is_finite() && extent > 0.0) {
         return Err(Error::Mesh {
-            path: mesh_source,
+            path: mesh_source.to_string(),
             problem: "has zero extent".into(),
         });
     }
@@ -181,16 +201,13 @@ pub fn build(
             dims: [2, 1, 1],
         }
     } else {
-        let blocks = cfg
-            .blocks
-            .unwrap_or_else(|| SceneKind::terrain_blocks(cfg.profile));
         Grid::covering(
             &mesh.positions,
             extent as f64 / blocks as f64 * (1.0 + 1e-6),
         )?
     };
     let started = std::time::Instant::now();
-    let partition = match cfg.partition {
+    let partition = match partition_mode {
         PartitionMode::Clip => Partition::clip(&mesh.positions, &mesh.indices, grid),
         PartitionMode::Bin => Partition::bin(&mesh.positions, &mesh.indices, grid),
     };
@@ -212,8 +229,6 @@ pub fn build(
     }
     let normals = partition.vertex_normals(&mesh.positions, &mesh.normals, &mesh.indices);
     let color = if halves { BUNNY_COLOR } else { TERRAIN_COLOR };
-    let schedule = &cfg.schedule;
-    let pixel_error = cfg.pixel_error(kind, height);
     let mut models = Vec::with_capacity(partition.blocks.len());
     let mut blocks_bytes = 0u64;
     for (bi, (b, chain)) in partition.blocks.iter().zip(&chains).enumerate() {
@@ -240,17 +255,14 @@ pub fn build(
             .map(|l| l.mesh.vertex_count() as u64 * VERTEX_BYTES + l.mesh.indices.len() as u64 * 4)
             .sum::<u64>();
         let (center, radius) = lods[0].mesh.bounding_sphere();
-        models.push(Model {
+        models.push(BlockModel {
             name: block_name,
             color,
-            lod_colors: Vec::new(),
-            spin_per_frame: 0.0,
             chain: LodChain { lods },
             switches: Vec::new(),
             switch_source: if halves { "scene" } else { "pixel-error" },
             center,
             radius,
-            scale: 1.0,
         });
     }
     let lod_chains_ms = started.elapsed().as_secs_f64() * 1e3;
@@ -280,7 +292,7 @@ pub fn build(
     }
     let seams_ms = started.elapsed().as_secs_f64() * 1e3;
 
-    let dag = ClusterDag::build(&mesh_source, &mesh)?;
+    let dag = ClusterDag::build(mesh_source, &mesh)?;
 
     // The camera, then the switch distances (bunny-halves' depend on the turntable's distance).
     let aspect = width as f32 / height as f32;
@@ -314,22 +326,21 @@ pub fn build(
         / ((1.0 - schedule.band) * (1.0 - schedule.hysteresis))
         * 1.01;
     for (bi, m) in models.iter_mut().enumerate() {
-        m.switches = match (camera, &cfg.switch_distances) {
-            (_, Some(_)) => {
-                return Err(Error::Config(format!(
-                    "--switch-distances does not apply to {name}: each of its blocks has switch distances \
-                     of its own (set --pixel-error)"
-                )))
-            }
-            (UnifiedCamera::Turntable { distance, .. }, None) => {
+        m.switches = match camera {
+            UnifiedCamera::Turntable { distance, .. } => {
                 // The first half never leaves LOD0, the second never shows it.
-                vec![if bi == 0 { distance * 1e3 } else { distance * 0.05 }]
+                vec![if bi == 0 {
+                    distance * 1e3
+                } else {
+                    distance * 0.05
+                }]
             }
-            (UnifiedCamera::Flight(..), None) => {
+            UnifiedCamera::Flight(..) => {
                 let mut out: Vec<f32> = Vec::new();
                 for lod in &m.chain.lods[1..] {
-                    let d = crate::lod::switch_distance(lod.error_abs, 1.0, pixel_error, height, fov_y)
-                        + m.radius;
+                    let d =
+                        crate::lod::switch_distance(lod.error_abs, 1.0, pixel_error, height, fov_y)
+                            + m.radius;
                     let d = match out.last() {
                         Some(&prev) if d < prev * band_ratio => prev * band_ratio,
                         _ => d,
@@ -341,15 +352,6 @@ pub fn build(
         };
         schedule.check_switches(&m.name, &m.switches)?;
     }
-    let instances = models
-        .iter()
-        .enumerate()
-        .map(|(i, m)| Instance {
-            model: i as u32,
-            position: m.center,
-            yaw: 0.0,
-        })
-        .collect();
     let preprocessing = Preprocessing {
         partition: partition.mode,
         grid: partition.grid.dims,
@@ -374,8 +376,7 @@ pub fn build(
         cluster_levels: dag.levels(),
     };
     Ok(UnifiedDef {
-        models,
-        instances,
+        blocks: models,
         unified: Arc::new(Unified {
             mesh,
             dag,
@@ -387,7 +388,6 @@ pub fn build(
         forward,
         near,
         far,
-        mesh_source,
     })
 }
 
