@@ -35,6 +35,8 @@ pub enum Command {
     Describe(DescribeArgs),
     /// Run a sweep described in a TOML file (scenes/experiments/) into one results folder.
     Experiment(ExperimentArgs),
+    /// Merge the folders of an experiment's shards (`experiment --shard`) into one results folder.
+    Merge(MergeArgs),
     /// Score each method's clip of each transition of a run (made with --dump-frames --dump-transitions)
     /// against the reference's with ColorVideoVDP; writes perceptual.csv and compares with lodpop.
     Perceptual(PerceptualArgs),
@@ -62,6 +64,36 @@ pub struct ExperimentArgs {
     /// Validate the file and print the planned runs without rendering.
     #[arg(long)]
     pub check: bool,
+    /// Print the planned runs with the shard each belongs to under `--shard i/N` (N from --shard, else 1),
+    /// without rendering.
+    #[arg(long)]
+    pub list: bool,
+    /// Run only part i of n of the planned runs (run k goes to shard k mod n + 1), e.g. a Slurm array task's
+    /// `--shard $((SLURM_ARRAY_TASK_ID + 1))/$SLURM_ARRAY_TASK_COUNT`; merge the shards' folders with
+    /// `lodbench merge`.
+    #[arg(long)]
+    pub shard: Option<String>,
+    /// Skip the runs whose run.json in the output folder says complete with the same flags, and run the rest
+    /// (an interrupted or failed experiment, rerun).
+    #[arg(long)]
+    pub resume: bool,
+    /// Run every run on the adapter whose name contains this (overrides the file's `adapter`): one GPU per
+    /// shard on a machine with several.
+    #[arg(long)]
+    pub adapter: Option<String>,
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct MergeArgs {
+    /// Experiment folders to merge (shards, or runs made on different machines).
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// The merged folder.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Merge the complete runs when some are missing, failed or were interrupted (listed either way).
+    #[arg(long)]
+    pub allow_partial: bool,
 }
 
 /// Flags that change what a scene is (shared by `run` and `describe`).

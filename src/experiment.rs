@@ -82,6 +82,60 @@ fn run_args(table: &toml::Table) -> std::result::Result<RunArgs, (String, String
     })
 }
 
+/// `--shard i/n`: the i-th (1-based) of n parts of an experiment's planned runs, by index: run k belongs to
+/// shard `k % n + 1` (the way `cargo nextest --partition slice:i/n` deals tests out), so the n shards partition
+/// the runs whatever their count.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct Shard {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl Shard {
+    /// Parses `i/n` with 1 <= i <= n.
+    pub fn parse(text: &str) -> Result<Shard> {
+        let bad = || {
+            Error::Config(format!(
+                "--shard {text}: expected i/n with 1 <= i <= n (for example 2/4)"
+            ))
+        };
+        let (i, n) = text.split_once('/').ok_or_else(bad)?;
+        let (index, count) = (
+            i.trim().parse::<u32>().map_err(|_| bad())?,
+            n.trim().parse::<u32>().map_err(|_| bad())?,
+        );
+        if index == 0 || index > count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// Whether planned run `k` (0-based) belongs to this shard.
+    pub fn owns(&self, k: usize) -> bool {
+        k % self.count as usize + 1 == self.index as usize
+    }
+}
+
+/// How `Experiment::run_with` runs the plan.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunOptions {
+    /// Only this shard's runs.
+    pub shard: Option<Shard>,
+    /// Skip the runs whose run.json says complete with the planned configuration.
+    pub resume: bool,
+}
+
+/// What `experiment.json` records: the experiment (every planned run), the shard this folder holds, and the
+/// version that made it (`lodbench merge` checks all three).
+#[derive(Debug, Serialize)]
+struct ExperimentRecord<'a> {
+    #[serde(flatten)]
+    experiment: &'a Experiment,
+    shard: Option<Shard>,
+    lodbench_version: &'static str,
+    git_commit: Option<&'static str>,
+}
+
 /// One run of the experiment: the swept value (as written in the column) and its validated configuration.
 #[derive(Debug, Clone, Serialize)]
 pub struct PlannedRun {
@@ -198,35 +252,87 @@ impl Experiment {
     /// `out/frames.csv` and `out/summary.csv` with the swept variable as the first column, and
     /// `out/experiment.json`.
     pub fn run(&self, out: &Path) -> Result<Vec<PathBuf>> {
+        self.run_with(out, &RunOptions::default())
+    }
+
+    /// The folder planned run `k` writes to under `out`.
+    pub fn run_folder(&self, out: &Path, k: usize) -> PathBuf {
+        match (&self.variable, &self.runs[k].value) {
+            (Some(var), Some(v)) => out
+                .join("runs")
+                .join(format!("{var}={}", v.replace(',', "x"))),
+            _ => out.to_path_buf(),
+        }
+    }
+
+    /// The planned runs' indices `shard` holds (all without one).
+    pub fn indices(&self, shard: Option<Shard>) -> Vec<usize> {
+        (0..self.runs.len())
+            .filter(|&k| shard.is_none_or(|s| s.owns(k)))
+            .collect()
+    }
+
+    /// [`Experiment::run`] with `options`: only the shard's runs, and with `resume` none whose run.json says
+    /// complete with the same configuration. The merged CSVs cover the runs this folder holds. Returns the run
+    /// folders of this shard (the skipped ones too).
+    pub fn run_with(&self, out: &Path, options: &RunOptions) -> Result<Vec<PathBuf>> {
         crate::runner::prepare_output(out)?;
+        let record = ExperimentRecord {
+            experiment: self,
+            shard: options.shard,
+            lodbench_version: env!("CARGO_PKG_VERSION"),
+            git_commit: option_env!("LODBENCH_GIT_COMMIT").filter(|s| !s.is_empty()),
+        };
         std::fs::write(
             out.join("experiment.json"),
-            serde_json::to_string_pretty(self)? + "\n",
+            serde_json::to_string_pretty(&record)? + "\n",
         )
         .map_err(|e| Error::io(out.join("experiment.json"), e))?;
+        let mine = self.indices(options.shard);
         let mut folders = Vec::new();
-        for r in &self.runs {
-            let folder = match (&self.variable, &r.value) {
-                (Some(var), Some(v)) => out
-                    .join("runs")
-                    .join(format!("{var}={}", v.replace(',', "x"))),
-                _ => out.to_path_buf(),
-            };
-            let mut cfg = r.config.clone();
+        for &k in &mine {
+            let folder = self.run_folder(out, k);
+            let mut cfg = self.runs[k].config.clone();
             cfg.out = Some(folder.clone());
-            crate::runner::run(&cfg)?;
+            if options.resume && completed(&folder, &cfg) {
+                eprintln!("{}: complete, skipped (--resume)", folder.display());
+            } else {
+                crate::runner::run(&cfg)?;
+            }
             folders.push(folder);
         }
         if let Some(var) = &self.variable {
+            let runs: Vec<PlannedRun> = mine.iter().map(|&k| self.runs[k].clone()).collect();
             for file in ["frames.csv", "summary.csv", "transitions.csv", "rounds.csv"] {
-                merge(out, file, var, &self.runs, &folders)?;
+                merge(out, file, var, &runs, &folders)?;
             }
         }
         Ok(folders)
     }
 }
 
-/// Concatenates `file` of each run folder with the swept value as a first column.
+/// Whether `folder` holds a complete run of `cfg`: its run.json says `complete` and records the same
+/// configuration.
+fn completed(folder: &Path, cfg: &RunConfig) -> bool {
+    let Ok(text) = std::fs::read_to_string(folder.join("run.json")) else {
+        return false;
+    };
+    let Ok(run) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return false;
+    };
+    // Compared as written: an f32 flag reads back from its text as another f64 than it converts to.
+    let planned = serde_json::to_string(cfg)
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok());
+    run["status"] == "complete"
+        && planned.is_some_and(|c| c == run["config"])
+        && ["frames.csv", "summary.csv"]
+            .iter()
+            .all(|f| folder.join(f).is_file())
+}
+
+/// Concatenates `file` of each run folder with the swept value as a first column (runs whose file is empty add
+/// nothing).
 fn merge(
     out: &Path,
     file: &str,
@@ -236,12 +342,18 @@ fn merge(
 ) -> Result<()> {
     let path = out.join(file);
     let mut w = csv::Writer::from_path(&path)?;
-    for (i, (run, folder)) in runs.iter().zip(folders).enumerate() {
+    let mut header_written = false;
+    for (run, folder) in runs.iter().zip(folders) {
         let mut r = csv::Reader::from_path(folder.join(file))?;
-        if i == 0 {
+        // A run without rows of this file (no transition on its path) wrote it empty, without a header.
+        if r.headers()?.is_empty() {
+            continue;
+        }
+        if !header_written {
             let mut header = csv::StringRecord::from(vec![var]);
             header.extend(r.headers()?.iter());
             w.write_record(&header)?;
+            header_written = true;
         }
         for rec in r.records() {
             let mut row = csv::StringRecord::from(vec![run.value.clone().unwrap_or_default()]);
@@ -261,6 +373,35 @@ mod tests {
         let p = dir.join("e.toml");
         std::fs::write(&p, text).unwrap();
         p
+    }
+
+    /// Every run is in exactly one shard, for 1 to 7 shards and 0 to 20 runs, and the shards are as even as
+    /// dealing makes them.
+    #[test]
+    fn shards_partition_the_runs() {
+        for runs in 0..=20usize {
+            for n in 1..=7u32 {
+                let shards: Vec<Shard> = (1..=n).map(|index| Shard { index, count: n }).collect();
+                for k in 0..runs {
+                    assert_eq!(
+                        shards.iter().filter(|s| s.owns(k)).count(),
+                        1,
+                        "{k} of {runs}, n {n}"
+                    );
+                }
+                let sizes: Vec<usize> = shards
+                    .iter()
+                    .map(|s| (0..runs).filter(|&k| s.owns(k)).count())
+                    .collect();
+                let (lo, hi) = (sizes.iter().min().unwrap(), sizes.iter().max().unwrap());
+                assert!(hi - lo <= 1, "{sizes:?}");
+            }
+        }
+        assert_eq!(Shard::parse("2/4").unwrap(), Shard { index: 2, count: 4 });
+        for bad in ["0/3", "4/3", "3", "a/b", "1/0", "-1/2"] {
+            let e = Shard::parse(bad).unwrap_err().to_string();
+            assert!(e.contains("--shard") && e.contains(bad), "{e}");
+        }
     }
 
     #[test]

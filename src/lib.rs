@@ -23,6 +23,7 @@ pub mod formats;
 pub mod gpu;
 pub mod lod;
 pub mod measure;
+pub mod merge;
 pub mod mesh;
 pub mod methods;
 pub mod metrics;

@@ -31,6 +31,7 @@ fn main() -> ExitCode {
         Command::List => list(),
         Command::Describe(args) => describe(&args),
         Command::Experiment(args) => experiment(&args),
+        Command::Merge(args) => merge(&args),
         Command::Perceptual(args) => perceptual(&args),
     };
     match result {
@@ -70,7 +71,12 @@ fn run(args: &lodbench::cli::RunArgs) -> lodbench::Result<()> {
 }
 
 fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
-    let e = lodbench::experiment::Experiment::load(&args.file)?;
+    let mut e = lodbench::experiment::Experiment::load(&args.file)?;
+    if let Some(a) = &args.adapter {
+        for r in &mut e.runs {
+            r.config.adapter = Some(a.clone());
+        }
+    }
     outln!(
         "experiment {} ({} run{}{}): {}",
         e.name,
@@ -81,10 +87,21 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
             .map_or(String::new(), |v| format!(", sweeping {v}")),
         e.description
     );
-    if args.check {
-        for r in &e.runs {
+    let shard = args
+        .shard
+        .as_deref()
+        .map(lodbench::experiment::Shard::parse)
+        .transpose()?;
+    if args.check || args.list {
+        let n = shard.map_or(1, |s| s.count);
+        for (k, r) in e.runs.iter().enumerate() {
+            let part = if args.list {
+                format!(" shard {}/{n}", k % n as usize + 1)
+            } else {
+                String::new()
+            };
             outln!(
-                "  {} scenes {:?} methods {:?}",
+                "  {}{part} scenes {:?} methods {:?}",
                 r.value.as_deref().unwrap_or("-"),
                 r.config.scenes.iter().map(|s| s.name()).collect::<Vec<_>>(),
                 r.config.methods
@@ -101,8 +118,21 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| runner::default_out_dir(&[e.name.as_str()]));
-    let folders = e.run(&out)?;
+    let options = lodbench::experiment::RunOptions {
+        shard,
+        resume: args.resume,
+    };
+    let folders = e.run_with(&out, &options)?;
     outln!("{} run(s) in {}", folders.len(), out.display());
+    Ok(())
+}
+
+fn merge(args: &lodbench::cli::MergeArgs) -> lodbench::Result<()> {
+    let m = lodbench::merge::merge(&args.dirs, &args.out, args.allow_partial)?;
+    for l in &m.left_out {
+        eprintln!("note: left out {l}");
+    }
+    outln!("{} run(s) merged into {}", m.runs, args.out.display());
     Ok(())
 }
 

@@ -93,7 +93,7 @@ def test_pixel_error_experiment_gets_the_unified_figure(pixel_error_experiment, 
     assert r.returncode == 0, r.stderr
     assert "unified_terrain.png" in figures(folder)
     report = (folder / "report.md").read_text()
-    assert "| 1.0 | terrain | clusterlod |" in report and "| 4.0 | terrain | blocks |" in report
+    assert "| 1 | terrain | clusterlod |" in report and "| 4 | terrain | blocks |" in report
     assert "crack_px_mean" in report
     with Image.open(folder / "figures" / "unified_terrain.png") as im:
         assert im.width > 600

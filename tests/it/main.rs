@@ -18,5 +18,6 @@ mod registry;
 mod regress;
 mod render;
 mod shaders;
+mod sharding;
 mod unified;
 mod variants;

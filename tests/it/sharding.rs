@@ -1,0 +1,311 @@
+//! `lodbench experiment --shard i/n`, `lodbench merge` and `lodbench experiment --resume`, through the binary
+//! on the software adapter: a small bunny-sweep experiment of four runs (a `band` sweep).
+
+use crate::common::{read_csv, Rows};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn lodbench(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lodbench"))
+        .args(args)
+        .output()
+        .expect("lodbench runs")
+}
+
+fn ok(out: Output) -> Output {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+fn failure(out: Output) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!out.status.success(), "expected failure: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr
+}
+
+fn experiment_file(dir: &Path, frames: u32) -> PathBuf {
+    let p = dir.join("shards.toml");
+    std::fs::write(
+        &p,
+        format!(
+            "name = \"shards\"\n[run]\nscene = [\"bunny-sweep\"]\nmethod = [\"discrete\", \"dither\"]\n\
+             width = 64\nheight = 48\nframes = {frames}\nwarmup = 0\nrounds = 2\n\
+             [sweep]\nvariable = \"band\"\nvalues = [0.02, 0.05, 0.1, 0.15]\n"
+        ),
+    )
+    .unwrap();
+    p
+}
+
+/// The columns that are the same on every run of the same flags on the same adapter (not the timings).
+const SAME: [&str; 10] = [
+    "band",
+    "scene",
+    "method",
+    "frame",
+    "triangles",
+    "t_instances",
+    "lod_mean",
+    "rmse",
+    "pop",
+    "lodpop",
+];
+
+fn deterministic(rows: &Rows) -> Vec<Vec<String>> {
+    rows.iter()
+        .map(|r| SAME.iter().map(|c| r[*c].clone()).collect())
+        .collect()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Three shards of four runs (2, 1 and 1 of them), merged, give the unsharded experiment's frames: the same
+/// rows in the same order, the deterministic columns identical, plus an `adapter` column; `--list` shows the
+/// split.
+#[test]
+fn three_shards_merged_equal_one_unsharded_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = experiment_file(dir.path(), 24);
+    let list = ok(lodbench(&[
+        "experiment",
+        s(&file),
+        "--list",
+        "--shard",
+        "1/3",
+    ]));
+    let text = String::from_utf8_lossy(&list.stdout);
+    for (value, shard) in [("0.02", 1), ("0.05", 2), ("0.1", 3), ("0.15", 1)] {
+        assert!(
+            text.contains(&format!("  {value} shard {shard}/3 ")),
+            "{text}"
+        );
+    }
+    let whole = dir.path().join("whole");
+    ok(lodbench(&["experiment", s(&file), "--out", s(&whole)]));
+    let mut shards = Vec::new();
+    for i in 1..=3 {
+        let out = dir.path().join(format!("shard-{i}"));
+        ok(lodbench(&[
+            "experiment",
+            s(&file),
+            "--shard",
+            &format!("{i}/3"),
+            "--out",
+            s(&out),
+        ]));
+        shards.push(out);
+    }
+    assert!(shards[0].join("runs/band=0.15/run.json").is_file());
+    assert!(!shards[1].join("runs/band=0.15").exists());
+    let merged = dir.path().join("merged");
+    let mut args = vec!["merge"];
+    args.extend(shards.iter().map(|p| s(p)));
+    args.extend(["--out", s(&merged)]);
+    ok(lodbench(&args));
+    for file in ["frames.csv", "summary.csv"] {
+        let (a, b) = (read_csv(&whole.join(file)), read_csv(&merged.join(file)));
+        assert_eq!(a.len(), b.len(), "{file}");
+        if file == "frames.csv" {
+            assert_eq!(deterministic(&a), deterministic(&b));
+        }
+        assert!(
+            b.iter().all(|r| !r["adapter"].is_empty()),
+            "{file}: adapter column"
+        );
+    }
+    let e: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(merged.join("experiment.json")).unwrap())
+            .unwrap();
+    assert_eq!(e["merged_from"].as_array().unwrap().len(), 3);
+    assert!(merged.join("runs/band=0.05/run.json").is_file());
+}
+
+/// Merge refuses duplicates, missing runs, runs of another lodbench version, failed runs and another
+/// experiment, each with a message naming the runs or folders; `--allow-partial` merges the complete runs and
+/// lists the rest.
+#[test]
+fn merge_refuses_what_does_not_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = experiment_file(dir.path(), 12);
+    let shard = |i: u32| {
+        let out = dir.path().join(format!("shard-{i}"));
+        ok(lodbench(&[
+            "experiment",
+            s(&file),
+            "--shard",
+            &format!("{i}/2"),
+            "--out",
+            s(&out),
+        ]));
+        out
+    };
+    let (a, b) = (shard(1), shard(2));
+    let out = dir.path().join("merged");
+    let e = failure(lodbench(&["merge", s(&a), s(&a), s(&b), "--out", s(&out)]));
+    assert!(e.contains("band=0.02") && e.contains("duplicate"), "{e}");
+    let e = failure(lodbench(&["merge", s(&a), "--out", s(&out)]));
+    assert!(e.contains("missing: band=0.05, band=0.15"), "{e}");
+    let partial = ok(lodbench(&[
+        "merge",
+        s(&a),
+        "--out",
+        s(&out),
+        "--allow-partial",
+    ]));
+    let note = String::from_utf8_lossy(&partial.stderr);
+    assert!(note.contains("left out band=0.05: missing"), "{note}");
+    assert_eq!(
+        read_csv(&out.join("summary.csv"))
+            .iter()
+            .filter(|r| r["method"] == "discrete")
+            .count(),
+        2
+    );
+
+    // Another version: a copy of shard 2 whose run of band=0.05 claims another lodbench.
+    let edit = |from: &Path, name: &str, run: &str, key: &str, value: &str| {
+        let to = dir.path().join(name);
+        copy_dir(from, &to);
+        let p = to.join("runs").join(run).join("run.json");
+        let mut j: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+        j[key] = serde_json::Value::from(value);
+        std::fs::write(&p, serde_json::to_string(&j).unwrap()).unwrap();
+        to
+    };
+    let other = edit(
+        &b,
+        "other-version",
+        "band=0.05",
+        "lodbench_version",
+        "9.9.9",
+    );
+    let e = failure(lodbench(&["merge", s(&a), s(&other), "--out", s(&out)]));
+    assert!(e.contains("9.9.9") && e.contains("one version"), "{e}");
+    let failed = edit(&b, "failed", "band=0.15", "status", "failed");
+    let e = failure(lodbench(&["merge", s(&a), s(&failed), "--out", s(&out)]));
+    assert!(
+        e.contains("not complete: band=0.15") && e.contains("failed"),
+        "{e}"
+    );
+    let renamed = dir.path().join("renamed");
+    copy_dir(&b, &renamed);
+    let p = renamed.join("experiment.json");
+    let text = std::fs::read_to_string(&p)
+        .unwrap()
+        .replace("\"shards\"", "\"other\"");
+    std::fs::write(&p, text).unwrap();
+    let e = failure(lodbench(&["merge", s(&a), s(&renamed), "--out", s(&out)]));
+    assert!(
+        e.contains("another experiment") && e.contains("name"),
+        "{e}"
+    );
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let path = entry.path();
+        if path.is_dir() {
+            copy_dir(&path, &to.join(entry.file_name()));
+        } else {
+            std::fs::copy(&path, to.join(entry.file_name())).unwrap();
+        }
+    }
+}
+
+/// An experiment killed by SIGTERM after its first run, then rerun with `--resume`, skips the complete run and
+/// ends with the frames of an uninterrupted experiment (deterministic columns identical).
+#[test]
+fn resume_after_sigterm_ends_like_an_uninterrupted_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = experiment_file(dir.path(), 240);
+    let out = dir.path().join("resumed");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lodbench"))
+        .args(["experiment", s(&file), "--out", s(&out)])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let first = out.join("runs/band=0.02/run.json");
+    let started = std::time::Instant::now();
+    loop {
+        let done =
+            std::fs::read_to_string(&first).is_ok_and(|t| t.contains("\"status\": \"complete\""));
+        if done {
+            break;
+        }
+        assert!(
+            started.elapsed().as_secs() < 120,
+            "the first run did not complete"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let pid = child.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-TERM", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let status = child.wait().unwrap();
+    assert!(!status.success(), "the experiment ended before the signal");
+    let second = std::fs::read_to_string(out.join("runs/band=0.05/run.json")).unwrap_or_default();
+    assert!(!second.contains("\"status\": \"complete\""), "{second}");
+    assert!(!out.join("frames.csv").exists());
+
+    let resumed = ok(lodbench(&[
+        "experiment",
+        s(&file),
+        "--out",
+        s(&out),
+        "--resume",
+    ]));
+    let note = String::from_utf8_lossy(&resumed.stderr);
+    assert!(
+        note.contains("band=0.02: complete, skipped (--resume)"),
+        "{note}"
+    );
+    assert!(!note.contains("band=0.05: complete"), "{note}");
+    let whole = dir.path().join("whole");
+    ok(lodbench(&["experiment", s(&file), "--out", s(&whole)]));
+    assert_eq!(
+        deterministic(&read_csv(&out.join("frames.csv"))),
+        deterministic(&read_csv(&whole.join("frames.csv")))
+    );
+}
+
+/// The GNU parallel recipe of docs/cluster.md (`scripts/cluster/parallel-shards.sh`) with 3 shards on the
+/// software adapter: its merged folder has the unsharded experiment's frames (deterministic columns identical).
+#[test]
+fn the_parallel_recipe_merges_to_the_unsharded_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = experiment_file(dir.path(), 12);
+    let out = dir.path().join("parallel");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/cluster/parallel-shards.sh");
+    let run = Command::new("bash")
+        .arg(&script)
+        .args([s(&file), s(&out), "llvmpipe", "llvmpipe", "llvmpipe"])
+        .env("LODBENCH", env!("CARGO_BIN_EXE_lodbench"))
+        .output()
+        .expect("bash runs");
+    assert!(
+        run.status.success(),
+        "the recipe failed (GNU parallel comes with bash .ci/setup): {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let whole = dir.path().join("whole");
+    ok(lodbench(&["experiment", s(&file), "--out", s(&whole)]));
+    assert_eq!(
+        deterministic(&read_csv(&out.join("merged/frames.csv"))),
+        deterministic(&read_csv(&whole.join("frames.csv")))
+    );
+    assert!(out.join("shard-3/runs/band=0.1/run.json").is_file());
+}
