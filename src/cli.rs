@@ -81,6 +81,9 @@ pub struct ExperimentArgs {
     /// shard on a machine with several.
     #[arg(long)]
     pub adapter: Option<String>,
+    /// Override a `[run]` key of the file in every run: `--set frames=300` (VALUE in TOML syntax; repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
 }
 
 #[derive(Debug, Clone, Args)]

@@ -164,6 +164,13 @@ fn value_text(v: &toml::Value) -> String {
 impl Experiment {
     /// Reads and validates an experiment file: its shape, then every run's flags as `lodbench run` would.
     pub fn load(path: &Path) -> Result<Experiment> {
+        Self::load_with(path, &[])
+    }
+
+    /// [`Experiment::load`] with `--set KEY=VALUE` overrides of `[run]` keys (VALUE in TOML syntax, or a bare
+    /// word taken as a string), applied before the sweep, so they hold in every run; a key the sweep varies
+    /// cannot be set.
+    pub fn load_with(path: &Path, overrides: &[String]) -> Result<Experiment> {
         let name = path.display().to_string();
         let bad = |problem: String| Error::Config(format!("experiment {name}: {problem}"));
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
@@ -176,8 +183,32 @@ impl Experiment {
             }
             None => e.message().to_string(),
         };
-        let file: ExperimentFile = toml::from_str(&text).map_err(|e| bad(at(&e)))?;
+        let mut file: ExperimentFile = toml::from_str(&text).map_err(|e| bad(at(&e)))?;
         let keys = run_keys();
+        for o in overrides {
+            let Some((key, value)) = o.split_once('=') else {
+                return Err(bad(format!("--set {o}: expected KEY=VALUE")));
+            };
+            let key = key.trim();
+            if !keys.iter().any(|k| k == key) {
+                return Err(bad(format!(
+                    "--set {o}: '{key}' is not a [run] key (the keys: {})",
+                    keys.join(", ")
+                )));
+            }
+            if file.sweep.as_ref().is_some_and(|sw| {
+                sw.variable == key
+                    || (sw.variable == "viewport" && (key == "width" || key == "height"))
+            }) {
+                return Err(bad(format!("--set {o}: '{key}' is the swept variable")));
+            }
+            let value = value.trim();
+            let parsed = toml::from_str::<toml::Table>(&format!("v = {value}"))
+                .ok()
+                .and_then(|mut t| t.remove("v"))
+                .unwrap_or_else(|| toml::Value::String(value.to_string()));
+            file.run.insert(key.to_string(), parsed);
+        }
         let where_is = |key: &str| match key_line(&text, key) {
             Some((line, source)) => format!("line {line} (`{source}`): "),
             None => String::new(),
@@ -401,6 +432,33 @@ mod tests {
         for bad in ["0/3", "4/3", "3", "a/b", "1/0", "-1/2"] {
             let e = Shard::parse(bad).unwrap_err().to_string();
             assert!(e.contains("--shard") && e.contains(bad), "{e}");
+        }
+    }
+
+    /// `--set` overrides a [run] key in every run, takes TOML values or bare words, and refuses unknown keys and
+    /// the swept variable.
+    #[test]
+    fn set_overrides_run_keys() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "name = \"x\"\n[run]\nscene = [\"bunny-sweep\"]\nframes = 50\n[sweep]\nvariable = \"band\"\nvalues = [0.02, 0.05]\n",
+        );
+        let e = Experiment::load_with(&p, &["frames=7".into(), "fade=time".into()]).unwrap();
+        assert!(e.runs.iter().all(|r| r.config.scene.frames == Some(7)));
+        assert!(e
+            .runs
+            .iter()
+            .all(|r| r.config.scene.schedule.fade == crate::schedule::FadeMode::Time));
+        for (bad, needle) in [
+            ("framez=7", "framez"),
+            ("band=0.1", "swept"),
+            ("frames", "KEY=VALUE"),
+        ] {
+            let msg = Experiment::load_with(&p, &[bad.into()])
+                .unwrap_err()
+                .to_string();
+            assert!(msg.contains(needle), "{bad}: {msg}");
         }
     }
 

@@ -71,7 +71,7 @@ fn run(args: &lodbench::cli::RunArgs) -> lodbench::Result<()> {
 }
 
 fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
-    let mut e = lodbench::experiment::Experiment::load(&args.file)?;
+    let mut e = lodbench::experiment::Experiment::load_with(&args.file, &args.set)?;
     if let Some(a) = &args.adapter {
         for r in &mut e.runs {
             r.config.adapter = Some(a.clone());
@@ -100,11 +100,16 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
             } else {
                 String::new()
             };
+            let per_scene: Vec<String> = r
+                .config
+                .scenes
+                .iter()
+                .map(|&k| format!("{}: {}", k.name(), r.config.methods_for(k).join(", ")))
+                .collect();
             outln!(
-                "  {}{part} scenes {:?} methods {:?}",
+                "  {}{part} {}",
                 r.value.as_deref().unwrap_or("-"),
-                r.config.scenes.iter().map(|s| s.name()).collect::<Vec<_>>(),
-                r.config.methods
+                per_scene.join("; ")
             );
         }
         return Ok(());

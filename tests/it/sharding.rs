@@ -309,3 +309,28 @@ fn the_parallel_recipe_merges_to_the_unsharded_run() {
     );
     assert!(out.join("shard-3/runs/band=0.1/run.json").is_file());
 }
+
+/// The GPU suite stops at once, before any experiment, when the best adapter is a software one (as here).
+#[test]
+fn the_gpu_suite_refuses_a_software_adapter() {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/gpu-suite.sh");
+    let run = Command::new("bash")
+        .arg(&script)
+        .arg("5")
+        .env("LODBENCH", env!("CARGO_BIN_EXE_lodbench"))
+        .output()
+        .expect("bash runs");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("software") && stderr.contains("llvmpipe"),
+        "{stderr}"
+    );
+    let e = Command::new("bash")
+        .arg(&script)
+        .arg("many")
+        .env("LODBENCH", env!("CARGO_BIN_EXE_lodbench"))
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&e.stderr).contains("whole number"));
+}

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# The papers' experiments on this machine's GPU, in one command (docs/cluster.md, "The GPU suite"):
+#   scripts/gpu-suite.sh [FRAMES]
+# runs scenes/experiments/{fsi-fig8,sheliemietiev-fig5,sheliemietiev-fig6,trees-sorting,unified-lod}.toml at
+# the papers' scenes, instance counts and viewports, with FRAMES timed frames (default 150; the papers' 3,600
+# would take hours) and 10 warm-up frames per block, into results/gpu/<adapter>/<experiment>/, draws the
+# figures (scripts/plot.py), writes each experiment's wall time to results/gpu/<adapter>/times.txt and prints
+# the claims that need a GPU (docs/claims.md) to read the figures against. It stops at once when the best
+# adapter is a software one. LODBENCH names a lodbench binary to use instead of building one.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+frames=${1:-${FRAMES:-150}}
+case $frames in
+    '' | *[!0-9]*) echo "error: FRAMES must be a whole number, not '$frames'" >&2; exit 2 ;;
+esac
+lodbench=${LODBENCH:-}
+if [[ -z $lodbench ]]; then
+    cargo build --release --quiet
+    lodbench=target/release/lodbench
+fi
+# The first adapter `lodbench list` prints is the one the runs use.
+best=$("$lodbench" list | sed -n '/^adapters/{n;p;q;}')
+case $best in
+    '' | *", Cpu,"*)
+        echo "error: the best adapter is a software one (${best:-none found}): the GPU suite needs a GPU" >&2
+        exit 2
+        ;;
+esac
+name=$(printf '%s' "${best%%[*}" | sed 's/^ *//; s/ *$//' | tr -c 'A-Za-z0-9._-' '_')
+out=results/gpu/$name
+mkdir -p "$out"
+echo "adapter: $best" | tee "$out/times.txt"
+for exp in fsi-fig8 sheliemietiev-fig5 sheliemietiev-fig6 trees-sorting unified-lod; do
+    extra=()
+    if [[ $exp == trees-sorting ]]; then
+        extra=(--set dump-every=50)
+    fi
+    start=$(date +%s)
+    "$lodbench" experiment "scenes/experiments/$exp.toml" --set "frames=$frames" --set warmup=10 \
+        "${extra[@]}" --out "$out/$exp"
+    python3 scripts/plot.py "$out/$exp"
+    echo "$exp: $(($(date +%s) - start)) s ($frames frames)" | tee -a "$out/times.txt"
+done
+echo
+echo "The claims that need a GPU (docs/claims.md); read them against the figures in $out:"
+grep -F '**needs a GPU**' docs/claims.md | cut -d '|' -f 2,3
