@@ -14,6 +14,8 @@
 //              its row or its column, and the reference's surface on every pixel within CRACK_MARGIN of it (a gap
 //              inside the surface, not a silhouette that a coarser LOD moved inwards)
 //                                                                                -> crack_px = count
+// Uncovered pixels are counted in the loop; those of a row are listed (`uncovered_list`) and the crack test runs
+// on the list in a second dispatch, `crack_main`.
 // e_t is kept per pixel in `prev_error` for the next frame. Each frame slot holds three 64-bit sums and the two
 // 32-bit counts (8 words; a count stays below 8192^2 = 2^26).
 // Two pipeline-overridable switches: DE2000 adds de2000 (`--metrics de2000`, which costs more than the rest);
@@ -44,6 +46,9 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> prev_error: array<u32>;
 @group(0) @binding(3) var<storage, read_write> sums: array<atomic<u32>>;
 @group(0) @binding(4) var<uniform> params: Params;
+// The frame's uncovered pixels (indices y * width + x), appended by `main`, checked for cracks by `crack_main`.
+@group(0) @binding(5) var<storage, read_write> uncovered_list: array<u32>;
+@group(0) @binding(6) var<storage, read_write> uncovered_count: atomic<u32>;
 
 fn to_bytes(v: vec4<f32>) -> vec3<i32> {
     return vec3<i32>(round(clamp(v.rgb, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0));
@@ -181,6 +186,25 @@ fn ciede2000(lab1: vec3<f32>, lab2: vec3<f32>) -> f32 {
 
 var<workgroup> partial: array<vec3<u32>, 64>;
 
+/// Workgroups of `crack_main` (each of 64 invocations).
+const CRACK_GROUPS: u32 = 4u;
+
+// The crack test of every uncovered pixel `main` listed (dispatched after it, CRACK_GROUPS workgroups).
+@compute @workgroup_size(64, 1, 1)
+fn crack_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let n = atomicLoad(&uncovered_count);
+    var cracks = 0u;
+    for (var i = gid.x; i < n; i = i + 64u * CRACK_GROUPS) {
+        let idx = uncovered_list[i];
+        let p = vec2<i32>(i32(idx % params.width), i32(idx / params.width));
+        let enclosed = enclosed_along(p, vec2<i32>(1, 0)) || enclosed_along(p, vec2<i32>(0, 1));
+        cracks = cracks + select(0u, 1u, enclosed && inside_reference(p));
+    }
+    if (cracks != 0u) {
+        atomicAdd(&sums[params.slot * SLOT_WORDS + 7u], cracks);
+    }
+}
+
 // Adds `v` to the 64-bit (lo, hi) pair.
 fn add_pair(acc: vec2<u32>, v: u32) -> vec2<u32> {
     let lo = acc.x + v;
@@ -206,7 +230,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
     var pop_sum = 0u;
     var de_sum = 0u;
     var uncovered = 0u;
-    var cracks = 0u;
     // Rows past the image still take part in the workgroup's barrier, with nothing to add.
     let width = select(0u, params.width, y < params.height);
     for (var x = gid.x; x < width; x = x + LANES) {
@@ -215,13 +238,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
         let b = to_bytes(textureLoad(reference_img, p, 0));
         let e = a - b;
         let bg = background_bytes();
-        if (all(a == bg) && any(b != bg)) {
-            uncovered = uncovered + 1u;
-            if ((enclosed_along(p, vec2<i32>(1, 0)) || enclosed_along(p, vec2<i32>(0, 1)))
-                && inside_reference(p)) {
-                cracks = cracks + 1u;
-            }
-        }
+        uncovered = uncovered + select(0u, 1u, all(a == bg) && any(b != bg));
         let s = u32(abs(e.x) + abs(e.y) + abs(e.z));
         rmse_sum = rmse_sum + s * s;
         if (DE2000 && s != 0u) {
@@ -242,11 +259,21 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
         prev_error[idx] = biased.x | (biased.y << 10u) | (biased.z << 20u);
     }
     let slot = params.slot * SLOT_WORDS;
+    // Only an invocation that met an uncovered pixel walks its pixels again to list them: the crack test's
+    // neighbourhood reads run in `crack_main`, on the list, not in this loop (lavapipe runs a branch's body for
+    // every pixel of a vector whatever the condition, so the test inside the loop slowed every frame several
+    // times over).
     if (uncovered != 0u) {
         atomicAdd(&sums[slot + 6u], uncovered);
-    }
-    if (cracks != 0u) {
-        atomicAdd(&sums[slot + 7u], cracks);
+        let bg = background_bytes();
+        for (var x = gid.x; x < width; x = x + LANES) {
+            let p = vec2<i32>(i32(x), i32(y));
+            let a = to_bytes(textureLoad(method_img, p, 0));
+            let b = to_bytes(textureLoad(reference_img, p, 0));
+            if (all(a == bg) && any(b != bg)) {
+                uncovered_list[atomicAdd(&uncovered_count, 1u)] = y * params.width + x;
+            }
+        }
     }
     if (!WORKGROUP_REDUCE) {
         add_u64_pair(slot, vec2<u32>(rmse_sum, 0u));

@@ -10,6 +10,10 @@ pub const METRICS_WGSL: &str = include_str!("../../shaders/metrics.wgsl");
 
 pub struct MetricKernel {
     pipeline: wgpu::ComputePipeline,
+    /// `crack_main`: the crack test of the uncovered pixels `main` listed.
+    crack_pipeline: wgpu::ComputePipeline,
+    uncovered_count: wgpu::Buffer,
+    _uncovered_list: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     params: wgpu::Buffer,
     sums: wgpu::Buffer,
@@ -19,6 +23,9 @@ pub struct MetricKernel {
     frames: u32,
     background: u32,
 }
+
+/// Workgroups of `crack_main` (CRACK_GROUPS in the shader).
+const CRACK_GROUPS: u32 = 4;
 
 /// 32-bit words of a frame's slot in the sums buffer: three 64-bit sums, then uncovered_px and crack_px.
 const SLOT_WORDS: u32 = 8;
@@ -41,22 +48,86 @@ impl MetricKernel {
             label: Some("metrics.wgsl"),
             source: wgpu::ShaderSource::Wgsl(METRICS_WGSL.into()),
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("metric kernel"),
-            layout: None,
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &[
-                    ("DE2000", de2000 as u32 as f64),
-                    (
-                        "WORKGROUP_REDUCE",
-                        (reduction == MetricReduction::Workgroup) as u32 as f64,
-                    ),
-                ],
-                ..Default::default()
+        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
             },
-            cache: None,
+            count: None,
+        };
+        let texture = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        // One layout for both entry points, so one bind group serves the two dispatches of a frame.
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("metric layout"),
+            entries: &[
+                texture(0),
+                texture(1),
+                storage(2, false),
+                storage(3, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                storage(5, false),
+                storage(6, false),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("metric pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let constants = [
+            ("DE2000", de2000 as u32 as f64),
+            (
+                "WORKGROUP_REDUCE",
+                (reduction == MetricReduction::Workgroup) as u32 as f64,
+            ),
+        ];
+        let compute = |label, entry_point| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry_point),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                cache: None,
+            })
+        };
+        let pipeline = compute("metric kernel", "main");
+        let crack_pipeline = compute("crack kernel", "crack_main");
+        let uncovered_list = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("uncovered pixels"),
+            size: (width as u64 * height as u64).max(1) * 4,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let uncovered_count = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("uncovered pixel count"),
+            size: 4,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
         });
         let prev_error = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("previous error image"),
@@ -87,7 +158,7 @@ impl MetricKernel {
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("metric bind group"),
-            layout: &pipeline.get_bind_group_layout(0),
+            layout: &layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -109,11 +180,22 @@ impl MetricKernel {
                     binding: 4,
                     resource: params.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: uncovered_list.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: uncovered_count.as_entire_binding(),
+                },
             ],
         });
         ctx.check_errors()?;
         Ok(MetricKernel {
             pipeline,
+            crack_pipeline,
+            uncovered_count,
+            _uncovered_list: uncovered_list,
             bind_group,
             params,
             sums,
@@ -134,6 +216,7 @@ impl MetricKernel {
         if frame == 0 {
             encoder.clear_buffer(&self.sums, 0, None);
         }
+        encoder.clear_buffer(&self.uncovered_count, 0, None);
         let params = [
             self.width,
             self.height,
@@ -152,6 +235,8 @@ impl MetricKernel {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.dispatch_workgroups(1, self.height, 1);
+        pass.set_pipeline(&self.crack_pipeline);
+        pass.dispatch_workgroups(CRACK_GROUPS, 1, 1);
     }
 
     /// rmse, pop, de2000, uncovered_px and crack_px of frames `0..frames`, after their submissions.
