@@ -823,9 +823,8 @@ impl Scene {
     }
 
     pub fn camera(&self, frame: u32) -> Camera {
-        let (eye, view) = match (self.camera_mode, self.flight) {
-            _ if self.turntable.is_some() => {
-                let (center, distance, elevation) = self.turntable.unwrap_or_default();
+        let (eye, view) = match (self.camera_mode, self.flight, self.turntable) {
+            (_, _, Some((center, distance, elevation))) => {
                 let theta = std::f32::consts::TAU * frame as f32 / self.frames.max(1) as f32;
                 let dir = Vec3::new(
                     elevation.cos() * theta.sin(),
@@ -835,7 +834,7 @@ impl Scene {
                 let eye = center + dir * distance;
                 (eye, Mat4::look_at_rh(eye, center, Vec3::Y))
             }
-            (_, Some((from, to))) => {
+            (_, Some((from, to)), None) => {
                 let t = if self.frames > 1 {
                     frame as f32 / (self.frames - 1) as f32
                 } else {
@@ -844,11 +843,11 @@ impl Scene {
                 let eye = from.lerp(to, t);
                 (eye, Mat4::look_at_rh(eye, eye + self.forward, Vec3::Y))
             }
-            (CameraMode::Fixed, None) => (
+            (CameraMode::Fixed, None, None) => (
                 self.eye,
                 Mat4::look_at_rh(self.eye, self.eye + self.forward, Vec3::Y),
             ),
-            (CameraMode::Dolly, None) => {
+            (CameraMode::Dolly, None, None) => {
                 let eye = match self.motion {
                     // Back from the bunny by as much as the fixed camera's bunny has moved away from it.
                     Motion::SweepX { near, far } => {
@@ -858,7 +857,7 @@ impl Scene {
                 };
                 (eye, Mat4::look_at_rh(eye, eye + self.forward, Vec3::Y))
             }
-            (CameraMode::Orbit, None) => {
+            (CameraMode::Orbit, None, None) => {
                 let target = match self.instances.first() {
                     Some(_) => self.instance_position(0, frame),
                     None => self.eye + self.forward,
