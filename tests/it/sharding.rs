@@ -227,7 +227,7 @@ fn copy_dir(from: &Path, to: &Path) {
 #[test]
 fn resume_after_sigterm_ends_like_an_uninterrupted_run() {
     let dir = tempfile::tempdir().unwrap();
-    let file = experiment_file(dir.path(), 240);
+    let file = experiment_file(dir.path(), 120);
     let out = dir.path().join("resumed");
     let mut child = Command::new(env!("CARGO_BIN_EXE_lodbench"))
         .args(["experiment", s(&file), "--out", s(&out)])
