@@ -288,12 +288,7 @@ impl Experiment {
 
     /// The folder planned run `k` writes to under `out`.
     pub fn run_folder(&self, out: &Path, k: usize) -> PathBuf {
-        match (&self.variable, &self.runs[k].value) {
-            (Some(var), Some(v)) => out
-                .join("runs")
-                .join(format!("{var}={}", v.replace(',', "x"))),
-            _ => out.to_path_buf(),
-        }
+        run_folder_of(out, self.variable.as_deref(), self.runs[k].value.as_deref())
     }
 
     /// The planned runs' indices `shard` holds (all without one).
@@ -333,9 +328,18 @@ impl Experiment {
             folders.push(folder);
         }
         if let Some(var) = &self.variable {
-            let runs: Vec<PlannedRun> = mine.iter().map(|&k| self.runs[k].clone()).collect();
-            for file in ["frames.csv", "summary.csv", "transitions.csv", "rounds.csv"] {
-                merge(out, file, var, &runs, &folders)?;
+            for file in RUN_CSVS {
+                let parts: Vec<(Vec<String>, PathBuf)> = mine
+                    .iter()
+                    .zip(&folders)
+                    .map(|(&k, f)| {
+                        (
+                            vec![self.runs[k].value.clone().unwrap_or_default()],
+                            f.join(file),
+                        )
+                    })
+                    .collect();
+                concat_csv(&out.join(file), &[var.as_str()], &parts)?;
             }
         }
         Ok(folders)
@@ -362,37 +366,48 @@ fn completed(folder: &Path, cfg: &RunConfig) -> bool {
             .all(|f| folder.join(f).is_file())
 }
 
-/// Concatenates `file` of each run folder with the swept value as a first column (runs whose file is empty add
-/// nothing).
-fn merge(
-    out: &Path,
-    file: &str,
-    var: &str,
-    runs: &[PlannedRun],
-    folders: &[PathBuf],
+/// The CSV files of a run folder that an experiment, and `lodbench merge`, join across runs.
+pub const RUN_CSVS: [&str; 4] = ["frames.csv", "summary.csv", "transitions.csv", "rounds.csv"];
+
+/// The folder of the run with swept `value` of `variable` under `out`: `runs/<variable>=<value>/` (a comma of a
+/// value as `x`), or `out` itself without a sweep.
+pub fn run_folder_of(out: &Path, variable: Option<&str>, value: Option<&str>) -> PathBuf {
+    match (variable, value) {
+        (Some(var), Some(v)) => out
+            .join("runs")
+            .join(format!("{var}={}", v.replace(',', "x"))),
+        _ => out.to_path_buf(),
+    }
+}
+
+/// Writes `path`: under `lead_header` and the parts' own header, each part's CSV rows after its lead values. A
+/// part whose file is empty (a run without rows of it, e.g. no transition on its path, writes no header) adds
+/// nothing.
+pub(crate) fn concat_csv(
+    path: &Path,
+    lead_header: &[&str],
+    parts: &[(Vec<String>, PathBuf)],
 ) -> Result<()> {
-    let path = out.join(file);
-    let mut w = csv::Writer::from_path(&path)?;
+    let mut w = csv::Writer::from_path(path)?;
     let mut header_written = false;
-    for (run, folder) in runs.iter().zip(folders) {
-        let mut r = csv::Reader::from_path(folder.join(file))?;
-        // A run without rows of this file (no transition on its path) wrote it empty, without a header.
+    for (lead, source) in parts {
+        let mut r = csv::Reader::from_path(source)?;
         if r.headers()?.is_empty() {
             continue;
         }
         if !header_written {
-            let mut header = csv::StringRecord::from(vec![var]);
+            let mut header = csv::StringRecord::from(lead_header.to_vec());
             header.extend(r.headers()?.iter());
             w.write_record(&header)?;
             header_written = true;
         }
         for rec in r.records() {
-            let mut row = csv::StringRecord::from(vec![run.value.clone().unwrap_or_default()]);
+            let mut row = csv::StringRecord::from(lead.clone());
             row.extend(rec?.iter());
             w.write_record(&row)?;
         }
     }
-    w.flush().map_err(|e| Error::io(&path, e))
+    w.flush().map_err(|e| Error::io(path, e))
 }
 
 #[cfg(test)]

@@ -20,9 +20,6 @@ use crate::error::{Error, Result};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
-/// The CSV files merged.
-const FILES: [&str; 4] = ["frames.csv", "summary.csv", "transitions.csv", "rounds.csv"];
-
 /// What a merge did.
 #[derive(Debug, Clone)]
 pub struct MergeSummary {
@@ -50,12 +47,7 @@ struct Found {
 
 /// The folder planned run `value` of `variable` has under `dir` (as `Experiment::run_folder` names it).
 fn run_folder(dir: &Path, variable: &Value, value: &Value) -> PathBuf {
-    match (variable.as_str(), value.as_str()) {
-        (Some(var), Some(v)) => dir
-            .join("runs")
-            .join(format!("{var}={}", v.replace(',', "x"))),
-        _ => dir.to_path_buf(),
-    }
+    crate::experiment::run_folder_of(dir, variable.as_str(), value.as_str())
 }
 
 /// Merges the experiment folders `inputs` into `out`; see the module docs.
@@ -200,45 +192,24 @@ pub fn merge(inputs: &[PathBuf], out: &Path, allow_partial: bool) -> Result<Merg
     for (_, f) in &runs {
         copy_run(&f.folder, &destination(out, f))?;
     }
-    for file in FILES {
-        let path = out.join(file);
-        let mut w = csv::Writer::from_path(&path)?;
-        let mut header_written = false;
-        for (k, f) in &runs {
-            let source = f.folder.join(file);
-            if !source.is_file() {
-                continue;
-            }
-            let mut r = csv::Reader::from_path(&source)?;
-            if r.headers()?.is_empty() {
-                continue;
-            }
-            let lead: Vec<String> = variable
-                .as_str()
-                .map(|_| value_of(&planned[*k]))
-                .into_iter()
-                .chain([f.run["adapter"]["name"]
+    let mut lead_header: Vec<&str> = variable.as_str().into_iter().collect();
+    lead_header.push("adapter");
+    for file in crate::experiment::RUN_CSVS {
+        let parts: Vec<(Vec<String>, PathBuf)> = runs
+            .iter()
+            .filter(|(_, f)| f.folder.join(file).is_file())
+            .map(|(k, f)| {
+                let adapter = f.run["adapter"]["name"].as_str().unwrap_or("unknown");
+                let lead = variable
                     .as_str()
-                    .unwrap_or("unknown")
-                    .to_string()])
-                .collect();
-            if !header_written {
-                let mut header = csv::StringRecord::new();
-                if let Some(var) = variable.as_str() {
-                    header.push_field(var);
-                }
-                header.push_field("adapter");
-                header.extend(r.headers()?.iter());
-                w.write_record(&header)?;
-                header_written = true;
-            }
-            for rec in r.records() {
-                let mut row = csv::StringRecord::from(lead.clone());
-                row.extend(rec?.iter());
-                w.write_record(&row)?;
-            }
-        }
-        w.flush().map_err(|e| Error::io(&path, e))?;
+                    .map(|_| value_of(&planned[*k]))
+                    .into_iter()
+                    .chain([adapter.to_string()])
+                    .collect();
+                (lead, f.folder.join(file))
+            })
+            .collect();
+        crate::experiment::concat_csv(&out.join(file), &lead_header, &parts)?;
     }
     let mut record = first.clone();
     record["shard"] = Value::Null;
