@@ -93,6 +93,7 @@ fn csv_export(c: &mut Criterion) {
             units_drawn: 1,
             t_instances: 0,
             lod_mean: f as f64 / 1200.0,
+            k_mean: None,
             rmse: 0.01,
             pop: 0.001,
             lodpop: 0.0,

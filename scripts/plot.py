@@ -3,8 +3,10 @@
 
     python3 scripts/plot.py RESULTS_DIR [RESULTS_DIR ...]
 
-Writes into each folder a `figures/` subfolder and `report.md` (the summary table and every figure that folder's
-data allows):
+Writes into each folder a `figures/` subfolder, `report.md` (the summary table and every figure that folder's
+data allows) and `report.html` (the same tables and figures, the run's manifest and, where `lodbench clips FOLDER`
+wrote `clips/`, a player per transition stepping through the methods' frames side by side; self-contained: it loads
+nothing but the folder's own files, see scripts/report_html.py):
   - sweep_<scene>.png       rmse, pop and lodpop along the path per method, and FSI's lag_rmse, discrete LOD switch
                             frames marked;
   - fig6_<scene>.png        seed 003 Fig. 6: popping per method (mean rmse, max pop, max lodpop; bunny-sweep or any
@@ -42,6 +44,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 import numpy as np  # noqa: E402
 from PIL import Image  # noqa: E402
+
+import report_html  # noqa: E402  (scripts/report_html.py, beside this file)
 
 # Eleven methods and more: matplotlib's ten default colours would give two methods one colour.
 plt.rcParams["axes.prop_cycle"] = matplotlib.cycler(
@@ -415,8 +419,10 @@ def fsi_buffers(scene, frames_dir, by_method, path):
     return None
 
 
-def markdown_table(rows, columns):
-    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+def table_cells(rows, columns):
+    """The text of each cell of a table of `rows` (dicts) under `columns`: numbers to 4 significant digits, other
+    values as they are, a missing one empty. report.md and report.html show the same cells."""
+    out = []
     for r in rows:
         cells = []
         for c in columns:
@@ -426,11 +432,23 @@ def markdown_table(rows, columns):
                 cells.append(f"{x:.4g}")
             except ValueError:
                 cells.append(v)
+        out.append(cells)
+    return out
+
+
+def markdown_table(rows, columns):
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    for cells in table_cells(rows, columns):
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
 def report(folder: Path, transition: str = "worst") -> list:
+    """Writes folder's figures, report.md and report.html; returns the figures as [(file name, caption)]. Raises
+    ValueError on what the folder's data does not allow (a malformed clips/index.json, a missing clip image, ...)
+    before anything is written."""
+    clips = report_html.load_clips(folder)
+    runs = report_html.manifest(folder)
     frames = read_csv(folder / "frames.csv")
     summary = read_csv(folder / "summary.csv")
     transitions_csv = read_csv(folder / "transitions.csv") if (folder / "transitions.csv").is_file() else None
@@ -491,23 +509,30 @@ def report(folder: Path, transition: str = "worst") -> list:
                "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
                "de2000_mean"] + (["lodpop_max", "lodpop_sum"] if summary and "lodpop_max" in summary[0] else []) \
         + (["crack_px_mean", "units_drawn_mean"] if summary and "crack_px_mean" in summary[0] else [])
-    text = [f"# lodbench report: {folder.name}", "", "## Summary", "", markdown_table(summary, columns), ""]
+    # The tables once, as (heading, rows, columns): report.md and report.html render the same ones.
+    sections = [("Summary", summary, columns)]
     for scene, per_transition in tables:
         methods = list(per_transition[0][-1])
         if len(per_transition[0]) == 4:
             for k, what in ((0, "max lodpop (pose held)"), (1, "max pop (motion included)")):
                 rows = [{"transition": f"frames {a}-{b} ({lods})", **{m: f"{p[m][k]:.4f}" for m in methods}}
                         for a, b, lods, p in per_transition]
-                text += [f"## {scene}: {what} of each transition (its frames and the 2 after)", "",
-                         markdown_table(rows, ["transition"] + methods), ""]
+                sections.append((f"{scene}: {what} of each transition (its frames and the 2 after)", rows,
+                                 ["transition"] + methods))
         else:
             rows = [{"transition": f"frames {a}-{b}", **{m: f"{p[m]:.4f}" for m in methods}}
                     for a, b, p in per_transition]
-            text += [f"## {scene}: max pop within {TRANSITION_WINDOW} frames of each transition", "",
-                     markdown_table(rows, ["transition"] + methods), ""]
+            sections.append((f"{scene}: max pop within {TRANSITION_WINDOW} frames of each transition", rows,
+                             ["transition"] + methods))
+    title = f"lodbench report: {folder.name}"
+    text = [f"# {title}", ""]
+    for heading, rows, cols in sections:
+        text += [f"## {heading}", "", markdown_table(rows, cols), ""]
     for name, caption in made:
         text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
     (folder / "report.md").write_text("\n".join(text))
+    tables_html = [(heading, cols, table_cells(rows, cols)) for heading, rows, cols in sections]
+    (folder / "report.html").write_text(report_html.page(title, tables_html, made, clips, runs))
     return made
 
 
@@ -530,7 +555,7 @@ def main() -> int:
         except ValueError as e:
             print(f"error: {folder}: {e}", file=sys.stderr)
             return 2
-        print(f"{folder}: report.md and {len(made)} figures in {folder / 'figures'}")
+        print(f"{folder}: report.md, report.html and {len(made)} figures in {folder / 'figures'}")
     return 0
 
 

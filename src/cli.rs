@@ -40,6 +40,42 @@ pub enum Command {
     /// Score each method's clip of each transition of a run (made with --dump-frames --dump-transitions)
     /// against the reference's with ColorVideoVDP; writes perceptual.csv and compares with lodpop.
     Perceptual(PerceptualArgs),
+    /// Animated side-by-side clips of every transition of a run (made with --dump-frames
+    /// --dump-transitions): the reference, each method and its error heat-map; animated PNG, GIF, and MP4
+    /// with ffmpeg.
+    Clips(ClipsArgs),
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct ClipsArgs {
+    /// A results folder of `lodbench run ... --dump-frames --dump-transitions`.
+    pub dir: PathBuf,
+    /// Methods to show, in this order (default: every method of the run).
+    #[arg(long, value_delimiter = ',')]
+    pub methods: Option<Vec<String>>,
+    /// Tiles per row.
+    #[arg(long, default_value_t = 4)]
+    pub columns: u32,
+    /// Nearest-neighbour upscaling factor (default: the smallest that makes the shown part at least 200
+    /// pixels high, and no wider than 480 or the run's width).
+    #[arg(long)]
+    pub scale: Option<u32>,
+    /// Show the whole frame (default: the box around everything the clip's pictures draw, with 8 pixels
+    /// around it, or the whole frame when that box covers more than half of it).
+    #[arg(long)]
+    pub full_frame: bool,
+    /// Frames per second of the GIF and MP4.
+    #[arg(long, default_value_t = 10)]
+    pub fps: u32,
+    /// At most this many frames per clip, spread evenly over the transition's dumped frames (0: all).
+    #[arg(long, default_value_t = 0)]
+    pub max_frames: u32,
+    /// Also a GIF of each clip (beside its animated PNG).
+    #[arg(long)]
+    pub gif: bool,
+    /// MP4s with ffmpeg: auto (when ffmpeg is on the PATH), on (an error without it), off.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub mp4: crate::clips::Mp4,
 }
 
 #[derive(Debug, Clone, Args)]

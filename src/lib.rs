@@ -13,6 +13,7 @@
 
 pub mod blocks;
 pub mod cli;
+pub mod clips;
 pub mod clusterlod;
 pub mod config;
 pub mod defaults;

@@ -33,6 +33,7 @@ fn main() -> ExitCode {
         Command::Experiment(args) => experiment(&args),
         Command::Merge(args) => merge(&args),
         Command::Perceptual(args) => perceptual(&args),
+        Command::Clips(args) => clips(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -138,6 +139,40 @@ fn merge(args: &lodbench::cli::MergeArgs) -> lodbench::Result<()> {
         eprintln!("note: left out {l}");
     }
     outln!("{} run(s) merged into {}", m.runs, args.out.display());
+    Ok(())
+}
+
+fn clips(args: &lodbench::cli::ClipsArgs) -> lodbench::Result<()> {
+    let settings = lodbench::clips::ClipSettings {
+        methods: args.methods.clone(),
+        columns: args.columns,
+        scale: args.scale,
+        fps: args.fps,
+        max_frames: args.max_frames,
+        full_frame: args.full_frame,
+        gif: args.gif,
+        mp4: args.mp4,
+    };
+    let index = lodbench::clips::make(&args.dir, &settings)?;
+    for c in &index.clips {
+        outln!(
+            "{}: {} frames ({}-{}), {}{}",
+            c.name,
+            c.frames.len(),
+            c.frames.first().copied().unwrap_or_default(),
+            c.frames.last().copied().unwrap_or_default(),
+            c.apng,
+            [&c.gif, &c.mp4]
+                .iter()
+                .filter_map(|f| f.as_ref().map(|f| format!(", {f}")))
+                .collect::<String>()
+        );
+    }
+    outln!(
+        "{} clips in {}",
+        index.clips.len(),
+        args.dir.join(lodbench::clips::CLIPS_DIR).display()
+    );
     Ok(())
 }
 

@@ -55,6 +55,8 @@ pub struct FrameDriver<'s> {
 pub struct FrameFacts {
     pub lod_mean: f64,
     pub t_instances: u32,
+    /// Mean k over the instances in transition (None when none is).
+    pub k_mean: Option<f64>,
     /// The LODs the t-instances go between.
     pub pair: TransitionPair,
 }
@@ -82,6 +84,7 @@ impl<'s> FrameDriver<'s> {
         self.distances.clear();
         let mut lod_sum = 0.0f64;
         let mut t = 0u32;
+        let mut k_sum = 0.0f64;
         let mut pair = TransitionPair::None;
         let eye = self.scene.camera(frame).eye;
         for (i, inst) in self.scene.instances.iter().enumerate() {
@@ -91,6 +94,7 @@ impl<'s> FrameDriver<'s> {
             lod_sum += s.lod_value() as f64;
             if s.in_transition() {
                 t += 1;
+                k_sum += s.k as f64;
                 pair = pair.with(s.lod_from, s.lod_to);
             }
             self.states.push(s);
@@ -100,6 +104,7 @@ impl<'s> FrameDriver<'s> {
         FrameFacts {
             lod_mean: lod_sum / self.scene.instances.len().max(1) as f64,
             t_instances: t,
+            k_mean: (t > 0).then(|| k_sum / t as f64),
             pair,
         }
     }
@@ -521,6 +526,7 @@ impl<'a> BlockRunner<'a> {
                     .unwrap_or(scene.instances.len() as u64),
                 t_instances: timed.facts[f].t_instances,
                 lod_mean: timed.facts[f].lod_mean,
+                k_mean: timed.facts[f].k_mean,
                 rmse: quality.metrics[f].rmse,
                 pop: quality.metrics[f].pop,
                 lodpop: quality.lodpop[f],

@@ -26,6 +26,8 @@ pub struct FrameRecord {
     pub t_instances: u32,
     /// Mean over instances of lod_from + k (lod_to - lod_from), the same for every method.
     pub lod_mean: f64,
+    /// Mean over the instances in transition of their blend factor k in [0, 1] (empty when none is).
+    pub k_mean: Option<f64>,
     pub rmse: f64,
     pub pop: f64,
     /// RMS over pixels and channels of the method's frame minus the same frame rendered with the previous
@@ -597,6 +599,7 @@ pub(crate) mod tests {
             units_drawn: 1,
             t_instances: 0,
             lod_mean: 0.0,
+            k_mean: None,
             rmse,
             pop,
             lodpop: 0.0,

@@ -82,3 +82,68 @@ def pixel_error_experiment(tmp_path_factory) -> Path:
     out = base / "run"
     lodbench("experiment", str(spec), "--out", str(out))
     return out
+
+
+def write_clips(folder: Path, clips=2, frames=8, tile=(160, 120), methods=("reference", "discrete", "alpha")) -> dict:
+    """A synthetic `clips/` in `folder`, laid out as `lodbench clips` writes it (index.json, per clip a frame and an
+    error image per frame, an animated PNG and a GIF, no MP4): each tile a method's colour with a white bar that
+    moves with the frame, so every frame differs from every other. Returns the index."""
+    from PIL import Image, ImageDraw
+    import json
+
+    colours = [(70, 110, 200), (200, 90, 60), (60, 160, 90), (170, 150, 40)]
+    width, height = tile[0] * len(methods), tile[1]
+    out = folder / "clips"
+    index = {"run": folder.name, "fps": 10, "scale": 1, "heatmap_full_scale": 0.25, "clips": []}
+    for c in range(clips):
+        name = f"bunny-sweep_c1_t{c:02d}"
+        (out / name).mkdir(parents=True, exist_ok=True)
+        first = 10 + 20 * c
+        numbers = list(range(first - 2, first - 2 + frames))
+        gif = []
+        for j, f in enumerate(numbers):
+            for kind in ("frame", "error"):
+                im = Image.new("RGB", (width, height), (0, 0, 0))
+                d = ImageDraw.Draw(im)
+                for t, method in enumerate(methods):
+                    x0 = t * tile[0]
+                    if kind == "frame":
+                        d.rectangle([x0, 0, x0 + tile[0] - 1, height - 1], fill=colours[t % len(colours)])
+                    bar = x0 + 4 + (tile[0] - 16) * j // max(1, frames - 1)
+                    d.rectangle([bar, 20, bar + 8, height - 4], fill=(255, 255, 255) if kind == "frame" else
+                                (255, 60 * t, 0))
+                    d.text((x0 + 4, 4), f"{method} {kind} {f}", fill=(255, 255, 255))
+                im.save(out / name / f"{kind}_{f:05d}.png")
+                if kind == "frame":
+                    gif.append(im)
+        gif[0].save(out / f"{name}.gif", save_all=True, append_images=gif[1:], duration=100, loop=0)
+        gif[0].save(out / f"{name}.png", save_all=True, append_images=gif[1:], duration=100, loop=0)
+        t_instances = [0 if j in (0, frames - 1) else 1 for j in range(frames)]
+        index["clips"].append({
+            "name": name, "scene": "bunny-sweep", "count": 1, "transition": c, "lods": f"{c}->{c + 1}",
+            "first_frame": first, "last_frame": numbers[-2], "methods": list(methods), "frames": numbers,
+            "k": [None if t == 0 else round(j / frames, 3) for j, t in enumerate(t_instances)],
+            "t_instances": t_instances,
+            "frame_images": [f"{name}/frame_{f:05d}.png" for f in numbers],
+            "error_images": [f"{name}/error_{f:05d}.png" for f in numbers],
+            "apng": f"{name}.png", "gif": f"{name}.gif", "mp4": None, "width": width, "height": height,
+        })
+    (out / "index.json").write_text(json.dumps(index, indent=2))
+    return index
+
+
+@pytest.fixture(scope="session")
+def make_clips():
+    """write_clips (a synthetic clips/ folder, as `lodbench clips` writes it) for tests of report.html."""
+    return write_clips
+
+
+@pytest.fixture(scope="session")
+def software_run(tmp_path_factory) -> Path:
+    """bunny-sweep, reference, discrete and alpha at the quick profile (320x240), 120 frames every one dumped with
+    the transitions' clips (--dump-transitions): what `lodbench clips` needs. About 5 s on a 2-core software
+    adapter."""
+    out = tmp_path_factory.mktemp("software") / "run"
+    lodbench("run", "--scene", "bunny-sweep", "--method", "reference,discrete,alpha", "--profile", "quick",
+             "--frames", "120", "--dump-frames", "--dump-transitions", "--out", str(out))
+    return out

@@ -93,10 +93,10 @@ mod tests {
         assert!(!dir.path().join(FRAMES_CSV).exists());
         let partial = std::fs::read_to_string(dir.path().join("frames.csv.partial")).unwrap();
         assert!(partial.starts_with(
-            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,units_drawn,t_instances,lod_mean,rmse,pop,lodpop,de2000_mean,uncovered_px,crack_px,flip_mean,combine_gpu_ms,lag_rmse,round\n"
+            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,units_drawn,t_instances,lod_mean,k_mean,rmse,pop,lodpop,de2000_mean,uncovered_px,crack_px,flip_mean,combine_gpu_ms,lag_rmse,round\n"
         ));
         assert!(
-            partial.contains("s,m,1,0,,2.0,100,1,1,0,0.0,0.5,0.0"),
+            partial.contains("s,m,1,0,,2.0,100,1,1,0,0.0,,0.5,0.0"),
             "{partial}"
         );
         w.finish().unwrap();
@@ -114,7 +114,7 @@ mod tests {
         let mut rd = ::csv::Reader::from_path(path).unwrap();
         let rec = rd.records().next().unwrap().unwrap();
         assert_eq!(rec[4].parse::<f64>().unwrap(), 0.1 + 0.2);
-        assert_eq!(rec[11].parse::<f64>().unwrap(), 1.0 / 3.0);
-        assert_eq!(rec[12].parse::<f64>().unwrap(), 2f64.sqrt());
+        assert_eq!(rec[12].parse::<f64>().unwrap(), 1.0 / 3.0);
+        assert_eq!(rec[13].parse::<f64>().unwrap(), 2f64.sqrt());
     }
 }

@@ -3,7 +3,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn lodbench(args: &[&str], env: &[(&str, &str)]) -> Output {
+pub(crate) fn lodbench(args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_lodbench"));
     c.args(args);
     for (k, v) in env {
@@ -13,7 +13,7 @@ fn lodbench(args: &[&str], env: &[(&str, &str)]) -> Output {
 }
 
 /// Asserts failure with exactly one `error:` line mentioning every needle.
-fn fails_with(out: &Output, needles: &[&str]) {
+pub(crate) fn fails_with(out: &Output, needles: &[&str]) {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "expected failure, stderr: {stderr}");
     assert!(!stderr.contains("panicked"), "panic: {stderr}");

@@ -10,6 +10,7 @@
 mod architecture;
 mod ci_profile;
 mod cli;
+mod clips;
 mod common;
 mod fidelity;
 mod fsi;

@@ -67,7 +67,7 @@ const BLOCK_EXACT: [&str; 6] = [
 ];
 const BLOCK_CLOSE: [&str; 3] = ["rmse_mean", "de2000_mean", "crack_px_mean"];
 
-fn regress_run() -> &'static PathBuf {
+pub(crate) fn regress_run() -> &'static PathBuf {
     static OUT: OnceLock<PathBuf> = OnceLock::new();
     OUT.get_or_init(|| {
         let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("regress");

@@ -1,0 +1,921 @@
+//! `lodbench clips RUN_DIR`: animated side-by-side clips of every transition of a run, from its frame dumps
+//! (`--dump-frames --dump-transitions`).
+//!
+//! For each transition of transitions.csv, the dumped frames from [`TRANSITION_LEAD`] before its first frame
+//! to [`TRANSITION_TAIL`] after its last form one clip. Each frame of the clip is two grids of the same
+//! layout, one tile per picture, labelled, upscaled by an integer factor (nearest neighbour):
+//! - the frame grid: the reference's frame, then each method's;
+//! - the error grid: a legend of the heat-map's scale in the reference's tile, then each method's error
+//!   heat-map against the reference (`export::png::heatmap`, full scale [`HEATMAP_FULL_SCALE`]).
+//!
+//! A header above each grid names the scene, the transition, the frame and k (the mean blend factor of the
+//! instances in transition, from frames.csv). Written into `RUN_DIR/clips/`:
+//! - `<clip>.png`: an animated PNG of the frame grid over the error grid, looping (lossless, and about half
+//!   the size of a GIF of the same frames; the `png` crate, no system dependency); with `--gif` also
+//!   `<clip>.gif` (the `image` crate);
+//! - `<clip>.mp4`: the same, H.264, when `ffmpeg` is on the PATH (`--mp4 auto`, the default);
+//! - `<clip>/frame_FFFFF.png` and `<clip>/error_FFFFF.png`: each frame's two grids, for report.html's player;
+//! - `index.json`: the clips, their frames, k per frame and the files ([`ClipIndex`]).
+//!
+//! The folder is built as `clips.partial/` and renamed to `clips/` only when every clip is written, so a
+//! folder named `clips/` is always complete.
+
+use crate::error::{Error, Result};
+use crate::export::png::{heatmap, FrameDumper, HEATMAP_FULL_SCALE};
+use crate::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use image::codecs::gif::{GifEncoder, Repeat};
+use image::{Delay, Frame, Rgba, RgbaImage};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+pub const CLIPS_DIR: &str = "clips";
+pub const INDEX_JSON: &str = "index.json";
+
+/// Whether to write MP4s with ffmpeg.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
+pub enum Mp4 {
+    /// When `ffmpeg` is on the PATH.
+    Auto,
+    /// Always; an error when `ffmpeg` is missing.
+    On,
+    Off,
+}
+
+/// The settings of `lodbench clips`.
+#[derive(Debug, Clone)]
+pub struct ClipSettings {
+    /// The methods to show, in this order (None: every method of transitions.csv but the reference).
+    pub methods: Option<Vec<String>>,
+    /// Tiles per row of a grid.
+    pub columns: u32,
+    /// Upscaling factor; None: the smallest that makes the shown part at least [`MIN_TILE_HEIGHT`] pixels
+    /// high (at most [`MAX_TILE_WIDTH`] wide).
+    pub scale: Option<u32>,
+    /// Show the whole frame, not the box around what the clip's pictures draw.
+    pub full_frame: bool,
+    pub fps: u32,
+    /// At most this many frames per clip, spread evenly over its dumped frames (0: all of them).
+    pub max_frames: u32,
+    /// Also a GIF of each clip.
+    pub gif: bool,
+    pub mp4: Mp4,
+}
+
+impl Default for ClipSettings {
+    fn default() -> Self {
+        ClipSettings {
+            methods: None,
+            columns: 4,
+            scale: None,
+            fps: 10,
+            max_frames: 0,
+            full_frame: false,
+            gif: false,
+            mp4: Mp4::Auto,
+        }
+    }
+}
+
+/// Pictures lower than this are upscaled (by default) until they are at least this high.
+pub const MIN_TILE_HEIGHT: u32 = 200;
+/// ... unless that makes them wider than this or the run's width, whichever is larger.
+pub const MAX_TILE_WIDTH: u32 = 480;
+/// Pixels around the drawn box kept in the crop.
+pub const CROP_MARGIN: u32 = 8;
+/// A box covering more than this share of the frame shows the whole frame.
+pub const CROP_MAX_SHARE: f64 = 0.5;
+
+/// A rectangle of the run's pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Crop {
+    pub x: u32,
+    pub y: u32,
+    pub w: u32,
+    pub h: u32,
+}
+
+/// The box around every pixel of `pictures` (all `w` x `h`) that differs from the background (the first
+/// picture's top-left pixel, the clear colour), widened by [`CROP_MARGIN`]; the whole frame when nothing is
+/// drawn or the box covers more than [`CROP_MAX_SHARE`] of it.
+pub fn crop_box<'a>(pictures: impl Iterator<Item = &'a RgbaImage>, w: u32, h: u32) -> Crop {
+    let full = Crop { x: 0, y: 0, w, h };
+    let mut background = None;
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0u32, 0u32);
+    for p in pictures {
+        let bg = *background.get_or_insert(*p.get_pixel(0, 0));
+        for (x, y, px) in p.enumerate_pixels() {
+            if *px != bg {
+                x0 = x0.min(x);
+                y0 = y0.min(y);
+                x1 = x1.max(x);
+                y1 = y1.max(y);
+            }
+        }
+    }
+    if x0 > x1 || y0 > y1 {
+        return full;
+    }
+    let x = x0.saturating_sub(CROP_MARGIN);
+    let y = y0.saturating_sub(CROP_MARGIN);
+    let c = Crop {
+        x,
+        y,
+        w: (x1 + CROP_MARGIN + 1).min(w) - x,
+        h: (y1 + CROP_MARGIN + 1).min(h) - y,
+    };
+    if (c.w as f64 * c.h as f64) > CROP_MAX_SHARE * w as f64 * h as f64 {
+        full
+    } else {
+        c
+    }
+}
+
+/// The smallest factor that makes `crop` at least [`MIN_TILE_HEIGHT`] high, capped so it is no wider than
+/// [`MAX_TILE_WIDTH`] or the run's width `w`; at least 1.
+pub fn auto_scale(crop: &Crop, w: u32) -> u32 {
+    let tall = MIN_TILE_HEIGHT.div_ceil(crop.h.max(1));
+    let wide = MAX_TILE_WIDTH.max(w) / crop.w.max(1);
+    tall.min(wide).max(1)
+}
+
+/// `clips/index.json`.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ClipIndex {
+    /// The run folder's name.
+    pub run: String,
+    pub fps: u32,
+    pub heatmap_full_scale: f32,
+    pub clips: Vec<ClipEntry>,
+}
+
+/// One transition's clip.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ClipEntry {
+    pub name: String,
+    pub scene: String,
+    pub count: u32,
+    pub transition: u32,
+    pub lods: String,
+    pub first_frame: u32,
+    pub last_frame: u32,
+    /// The tiles in order: "reference", then the methods.
+    pub methods: Vec<String>,
+    pub frames: Vec<u32>,
+    /// Mean k of the instances in transition per frame (None where none is, or frames.csv lacks k_mean).
+    pub k: Vec<Option<f64>>,
+    pub t_instances: Vec<Option<u32>>,
+    /// Paths relative to `clips/`.
+    pub frame_images: Vec<String>,
+    pub error_images: Vec<String>,
+    /// The animated PNG (lossless; every current browser plays it).
+    pub apng: String,
+    /// With `--gif` (256 colours a frame, quantised by NeuQuant).
+    pub gif: Option<String>,
+    pub mp4: Option<String>,
+    /// Size of each frame and error image.
+    pub width: u32,
+    pub height: u32,
+    /// The part of the frames shown, `[x, y, width, height]` in the run's pixels.
+    pub crop: [u32; 4],
+    /// The nearest-neighbour upscaling factor of the shown part.
+    pub scale: u32,
+    /// Where each tile's picture lies in the frame and error images, `[x, y, width, height]`, in the order of
+    /// `methods`.
+    pub tiles: Vec<[u32; 4]>,
+}
+
+fn results_error(dir: &Path, problem: impl Into<String>) -> Error {
+    Error::Results {
+        path: dir.to_path_buf(),
+        problem: problem.into(),
+    }
+}
+
+fn image_error(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Image {
+        path: path.to_path_buf(),
+        problem: e.to_string(),
+    }
+}
+
+/// Per (scene, count, frame): k_mean and t_instances from frames.csv (of any method: they are the schedule's,
+/// the same for every method).
+type FrameFactsMap = BTreeMap<(String, u32, u32), (Option<f64>, Option<u32>)>;
+
+fn frame_facts(dir: &Path) -> Result<FrameFactsMap> {
+    let path = dir.join("frames.csv");
+    let mut map = BTreeMap::new();
+    if !path.is_file() {
+        return Ok(map);
+    }
+    let mut reader = csv::Reader::from_path(&path)?;
+    let headers = reader.headers()?.clone();
+    let at = |name: &str| headers.iter().position(|h| h == name);
+    let (Some(scene), Some(count), Some(frame)) = (at("scene"), at("count"), at("frame")) else {
+        return Err(results_error(
+            dir,
+            "frames.csv has no scene, count and frame columns",
+        ));
+    };
+    let (k, t) = (at("k_mean"), at("t_instances"));
+    for rec in reader.records() {
+        let rec = rec?;
+        let parse_u32 = |i: usize| rec.get(i).and_then(|v| v.parse::<u32>().ok());
+        let (Some(c), Some(f)) = (parse_u32(count), parse_u32(frame)) else {
+            return Err(results_error(
+                dir,
+                format!("frames.csv: a row without a count or frame: {rec:?}"),
+            ));
+        };
+        let key = (rec.get(scene).unwrap_or_default().to_string(), c, f);
+        map.entry(key).or_insert((
+            k.and_then(|i| rec.get(i))
+                .and_then(|v| v.parse::<f64>().ok()),
+            t.and_then(parse_u32),
+        ));
+    }
+    Ok(map)
+}
+
+/// Makes every clip of `dir` and returns the index written to `dir/clips/index.json`.
+pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
+    if !dir.is_dir() {
+        return Err(results_error(dir, "is not a folder"));
+    }
+    if dir.join("experiment.json").is_file() && !dir.join("transitions.csv").is_file() {
+        return Err(results_error(
+            dir,
+            "is an experiment's folder: give one of its run folders",
+        ));
+    }
+    let transitions_csv = dir.join("transitions.csv");
+    if !transitions_csv.is_file() {
+        return Err(results_error(
+            dir,
+            "has no transitions.csv (a complete lodbench run, made with this version?)",
+        ));
+    }
+    let frames_dir = dir.join("frames");
+    if !frames_dir.is_dir() {
+        return Err(results_error(
+            dir,
+            "has no frames/: run with --dump-frames --dump-transitions",
+        ));
+    }
+    if settings.columns == 0 || settings.fps == 0 || settings.scale == Some(0) {
+        return Err(Error::Config(
+            "clips: --columns, --fps and --scale must be at least 1".into(),
+        ));
+    }
+    let mut reader = csv::Reader::from_path(&transitions_csv)?;
+    let rows = reader
+        .deserialize::<TransitionRecord>()
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let mut run_methods: Vec<String> = Vec::new();
+    for r in &rows {
+        if r.method != "reference" && !run_methods.contains(&r.method) {
+            run_methods.push(r.method.clone());
+        }
+    }
+    let methods = match &settings.methods {
+        None => run_methods.clone(),
+        Some(list) => {
+            for m in list {
+                if !run_methods.contains(m) {
+                    return Err(results_error(
+                        dir,
+                        format!(
+                            "--methods {m}: not a method of this run (its methods: {})",
+                            run_methods.join(", ")
+                        ),
+                    ));
+                }
+            }
+            list.clone()
+        }
+    };
+    if methods.is_empty() {
+        return Err(results_error(
+            dir,
+            "has no method but the reference to show",
+        ));
+    }
+    // One transition of the path per (scene, count, index): the rows of every method share its frames.
+    let mut paths: Vec<&TransitionRecord> = Vec::new();
+    for r in &rows {
+        if !paths
+            .iter()
+            .any(|p| p.scene == r.scene && p.count == r.count && p.transition == r.transition)
+        {
+            paths.push(r);
+        }
+    }
+    if paths.is_empty() {
+        return Err(results_error(
+            dir,
+            "transitions.csv has no transition: nothing to show",
+        ));
+    }
+    let facts = frame_facts(dir)?;
+    let dump = |scene: &str, method: &str, count: u32, f: u32, kind: &str| -> PathBuf {
+        frames_dir.join(format!(
+            "{}_{kind}.png",
+            FrameDumper::stem(scene, method, count, f)
+        ))
+    };
+
+    let ffmpeg = match settings.mp4 {
+        Mp4::Off => false,
+        Mp4::Auto => ffmpeg_available(),
+        Mp4::On if ffmpeg_available() => true,
+        Mp4::On => {
+            return Err(Error::Config(
+                "clips --mp4 on: ffmpeg is not on the PATH (Debian: apt install ffmpeg)".into(),
+            ))
+        }
+    };
+
+    let out = dir.join(CLIPS_DIR);
+    let partial = dir.join(format!("{CLIPS_DIR}.partial"));
+    if partial.exists() {
+        std::fs::remove_dir_all(&partial).map_err(|e| Error::io(&partial, e))?;
+    }
+    std::fs::create_dir_all(&partial).map_err(|e| Error::io(&partial, e))?;
+    let mut index = ClipIndex {
+        run: dir
+            .canonicalize()
+            .ok()
+            .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .unwrap_or_default(),
+        fps: settings.fps,
+        heatmap_full_scale: HEATMAP_FULL_SCALE,
+        clips: Vec::new(),
+    };
+    let result = (|| -> Result<()> {
+        for t in paths {
+            // The methods shown that ran on this scene block, in the order shown.
+            let methods: Vec<String> = methods
+                .iter()
+                .filter(|m| {
+                    rows.iter()
+                        .any(|r| r.scene == t.scene && r.count == t.count && &r.method == *m)
+                })
+                .cloned()
+                .collect();
+            if methods.is_empty() {
+                continue;
+            }
+            let first = t.first_frame.saturating_sub(TRANSITION_LEAD);
+            let last = t.last_frame + TRANSITION_TAIL;
+            let mut frames: Vec<u32> = (first..=last)
+                .filter(|&f| {
+                    methods
+                        .iter()
+                        .all(|m| dump(&t.scene, m, t.count, f, "method").is_file())
+                })
+                .collect();
+            if frames.is_empty() {
+                return Err(results_error(
+                dir,
+                format!(
+                    "frames/ has no dumps of {} {} around transition {} (frames {}-{}) for every method shown: \
+                     run with --dump-frames --dump-transitions",
+                    t.scene,
+                    methods.join(","),
+                    t.transition,
+                    t.first_frame,
+                    t.last_frame
+                ),
+            ));
+            }
+            frames = spread(&frames, settings.max_frames);
+            let name = format!("{}_c{}_t{:02}", t.scene, t.count, t.transition);
+            let clip_dir = partial.join(&name);
+            std::fs::create_dir_all(&clip_dir).map_err(|e| Error::io(&clip_dir, e))?;
+            let mut tiles = vec!["reference".to_string()];
+            tiles.extend(methods.iter().cloned());
+            let mut entry = ClipEntry {
+                name: name.clone(),
+                scene: t.scene.clone(),
+                count: t.count,
+                transition: t.transition,
+                lods: t.lods.clone(),
+                first_frame: t.first_frame,
+                last_frame: t.last_frame,
+                methods: tiles.clone(),
+                frames: frames.clone(),
+                k: Vec::new(),
+                t_instances: Vec::new(),
+                frame_images: Vec::new(),
+                error_images: Vec::new(),
+                apng: format!("{name}.png"),
+                gif: settings.gif.then(|| format!("{name}.gif")),
+                mp4: None,
+                width: 0,
+                height: 0,
+                crop: [0, 0, 0, 0],
+                scale: 1,
+                tiles: Vec::new(),
+            };
+            // Every picture of the clip first: the crop box spans all of them.
+            let mut loaded: Vec<(Vec<RgbaImage>, Vec<RgbaImage>)> =
+                Vec::with_capacity(frames.len());
+            for &f in &frames {
+                let mut pictures =
+                    vec![load(&dump(&t.scene, &methods[0], t.count, f, "reference"))?];
+                let mut errors = Vec::new();
+                for m in &methods {
+                    let picture = load(&dump(&t.scene, m, t.count, f, "method"))?;
+                    let err_path = dump(&t.scene, m, t.count, f, "error");
+                    let error = if err_path.is_file() {
+                        load(&err_path)?
+                    } else {
+                        heatmap_of(&picture, &pictures[0])
+                    };
+                    pictures.push(picture);
+                    errors.push(error);
+                }
+                let size = pictures[0].dimensions();
+                if pictures
+                    .iter()
+                    .chain(&errors)
+                    .any(|p| p.dimensions() != size)
+                {
+                    return Err(results_error(
+                        dir,
+                        format!("the dumps of frame {f} of {} differ in size", t.scene),
+                    ));
+                }
+                loaded.push((pictures, errors));
+            }
+            let (w, h) = loaded[0].0[0].dimensions();
+            if loaded.iter().any(|(p, _)| p[0].dimensions() != (w, h)) {
+                return Err(results_error(
+                    dir,
+                    format!("the dumps of {} differ in size between frames", t.scene),
+                ));
+            }
+            let crop = if settings.full_frame {
+                Crop { x: 0, y: 0, w, h }
+            } else {
+                crop_box(loaded.iter().flat_map(|(p, _)| p.iter()), w, h)
+            };
+            let scale = settings.scale.unwrap_or_else(|| auto_scale(&crop, w));
+            entry.crop = [crop.x, crop.y, crop.w, crop.h];
+            entry.scale = scale;
+            let view = |img: &RgbaImage| {
+                upscale(
+                    &image::imageops::crop_imm(img, crop.x, crop.y, crop.w, crop.h).to_image(),
+                    scale,
+                )
+            };
+            let mut movie: Vec<RgbaImage> = Vec::with_capacity(frames.len());
+            for (&f, (pictures, errors)) in frames.iter().zip(&loaded) {
+                let (k, t_inst) = facts
+                    .get(&(t.scene.clone(), t.count, f))
+                    .copied()
+                    .unwrap_or((None, None));
+                let header = format!(
+                    "{} c{}  transition {} ({})  frame {f}  k {}  in transition {}",
+                    t.scene,
+                    t.count,
+                    t.transition,
+                    t.lods,
+                    k.map_or("-".to_string(), |k| format!("{k:.3}")),
+                    t_inst.map_or("-".to_string(), |n| n.to_string()),
+                );
+                let mut error_tiles = vec![legend(crop.w * scale, crop.h * scale)];
+                error_tiles.extend(errors.iter().map(view));
+                let (frame_grid, boxes) = grid(
+                    &format!("{header}  [frame]"),
+                    &tiles,
+                    &pictures.iter().map(view).collect::<Vec<_>>(),
+                    settings.columns,
+                );
+                // The same layout: the two headers are as long.
+                let (error_grid, _) = grid(
+                    &format!("{header}  [error]"),
+                    &tiles,
+                    &error_tiles,
+                    settings.columns,
+                );
+                let frame_file = format!("{name}/frame_{f:05}.png");
+                let error_file = format!("{name}/error_{f:05}.png");
+                save(&partial.join(&frame_file), &frame_grid)?;
+                save(&partial.join(&error_file), &error_grid)?;
+                entry.width = frame_grid.width();
+                entry.height = frame_grid.height();
+                entry.tiles = boxes;
+                entry.frame_images.push(frame_file);
+                entry.error_images.push(error_file);
+                entry.k.push(k);
+                entry.t_instances.push(t_inst);
+                movie.push(stack(&frame_grid, &error_grid));
+            }
+            write_apng(&partial.join(&entry.apng), &movie, settings.fps)?;
+            if let Some(gif) = &entry.gif {
+                write_gif(&partial.join(gif), &movie, settings.fps)?;
+            }
+            if ffmpeg {
+                let mp4 = format!("{name}.mp4");
+                write_mp4(&partial.join(&mp4), &movie, settings.fps)?;
+                entry.mp4 = Some(mp4);
+            }
+            index.clips.push(entry);
+        }
+        Ok(())
+    })();
+    if let Err(e) = result {
+        // No half-written folder stays behind.
+        let _ = std::fs::remove_dir_all(&partial);
+        return Err(e);
+    }
+    if index.clips.is_empty() {
+        let _ = std::fs::remove_dir_all(&partial);
+        return Err(results_error(
+            dir,
+            "no scene of the run has a method shown and a transition",
+        ));
+    }
+    let index_path = partial.join(INDEX_JSON);
+    let json = serde_json::to_string_pretty(&index)?;
+    std::fs::write(&index_path, json).map_err(|e| Error::io(&index_path, e))?;
+    if out.exists() {
+        std::fs::remove_dir_all(&out).map_err(|e| Error::io(&out, e))?;
+    }
+    std::fs::rename(&partial, &out).map_err(|e| Error::io(&out, e))?;
+    Ok(index)
+}
+
+/// At most `max` of `frames` (0: all), evenly spread, the first and the last always among them.
+pub fn spread(frames: &[u32], max: u32) -> Vec<u32> {
+    let n = frames.len();
+    let max = max as usize;
+    if max == 0 || n <= max {
+        return frames.to_vec();
+    }
+    if max == 1 {
+        return vec![frames[0]];
+    }
+    (0..max)
+        .map(|i| frames[(i * (n - 1) + (max - 1) / 2) / (max - 1)])
+        .collect()
+}
+
+fn load(path: &Path) -> Result<RgbaImage> {
+    Ok(image::open(path)
+        .map_err(|e| image_error(path, e))?
+        .to_rgba8())
+}
+
+/// PNG at the best compression: the grids are mostly flat colour and upscaled blocks, which it packs about 3x
+/// smaller than the default level.
+fn save(path: &Path, img: &RgbaImage) -> Result<()> {
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    use image::ImageEncoder;
+    let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+    PngEncoder::new_with_quality(
+        std::io::BufWriter::new(file),
+        CompressionType::Best,
+        FilterType::Adaptive,
+    )
+    .write_image(
+        img.as_raw(),
+        img.width(),
+        img.height(),
+        image::ExtendedColorType::Rgba8,
+    )
+    .map_err(|e| image_error(path, e))
+}
+
+/// The heat-map of `picture` against `reference`, for dumps made without their `_error.png`.
+fn heatmap_of(picture: &RgbaImage, reference: &RgbaImage) -> RgbaImage {
+    let diff = crate::metrics::difference_image(picture.as_raw(), reference.as_raw());
+    RgbaImage::from_raw(picture.width(), picture.height(), heatmap(&diff))
+        .unwrap_or_else(|| RgbaImage::new(picture.width(), picture.height()))
+}
+
+/// Nearest-neighbour upscaling by an integer factor.
+pub fn upscale(img: &RgbaImage, scale: u32) -> RgbaImage {
+    if scale == 1 {
+        return img.clone();
+    }
+    RgbaImage::from_fn(img.width() * scale, img.height() * scale, |x, y| {
+        *img.get_pixel(x / scale, y / scale)
+    })
+}
+
+/// The heat-map's colour bar from 0 to [`HEATMAP_FULL_SCALE`], for the reference's tile of the error grid.
+fn legend(w: u32, h: u32) -> RgbaImage {
+    let mut img = RgbaImage::from_pixel(w, h, BACKGROUND);
+    let (x0, x1) = (8.min(w), w.saturating_sub(8));
+    let (y0, y1) = (h / 3, h / 3 + (h / 8).max(6));
+    for x in x0..x1 {
+        let d = HEATMAP_FULL_SCALE * (x - x0) as f32 / (x1 - x0).max(1) as f32;
+        let c = heatmap(&[d]);
+        for y in y0..y1.min(h) {
+            img.put_pixel(x, y, Rgba([c[0], c[1], c[2], 255]));
+        }
+    }
+    let y = y1 + 4;
+    text(&mut img, x0, y, "0", 1, TEXT);
+    let top = format!("{HEATMAP_FULL_SCALE}");
+    text(
+        &mut img,
+        x1.saturating_sub(8 * top.len() as u32),
+        y,
+        &top,
+        1,
+        TEXT,
+    );
+    text(&mut img, x0, y + 12, "mean |RGB diff|", 1, TEXT);
+    text(&mut img, x0, y0.saturating_sub(14), "error scale", 1, TEXT);
+    img
+}
+
+const BACKGROUND: Rgba<u8> = Rgba([24, 24, 24, 255]);
+const TEXT: Rgba<u8> = Rgba([235, 235, 235, 255]);
+const GAP: u32 = 2;
+
+/// Text of the 8x8 public-domain font of `font8x8`, each pixel `size` x `size`; characters outside ASCII
+/// show as '?'.
+pub fn text(img: &mut RgbaImage, x: u32, y: u32, s: &str, size: u32, colour: Rgba<u8>) {
+    for (i, ch) in s.chars().enumerate() {
+        let code = if ch.is_ascii() {
+            ch as usize
+        } else {
+            '?' as usize
+        };
+        let glyph = font8x8::legacy::BASIC_LEGACY[code];
+        for (row, bits) in glyph.iter().enumerate() {
+            for col in 0..8u32 {
+                if bits >> col & 1 == 1 {
+                    for dy in 0..size {
+                        for dx in 0..size {
+                            let px = x + (i as u32 * 8 + col) * size + dx;
+                            let py = y + row as u32 * size + dy;
+                            if px < img.width() && py < img.height() {
+                                img.put_pixel(px, py, colour);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The largest text size (1 or 2) at which `s` fits in `width` pixels.
+fn text_size(s: &str, width: u32) -> u32 {
+    if s.len() as u32 * 16 + 8 <= width {
+        2
+    } else {
+        1
+    }
+}
+
+/// A labelled grid: a header line, then `pictures` (all one size) in rows of `columns`, each under its label;
+/// with each picture's box `[x, y, width, height]` in the grid.
+fn grid(
+    header: &str,
+    labels: &[String],
+    pictures: &[RgbaImage],
+    columns: u32,
+) -> (RgbaImage, Vec<[u32; 4]>) {
+    let (pw, ph) = pictures.first().map_or((1, 1), |p| p.dimensions());
+    let cols = columns.min(pictures.len() as u32).max(1);
+    let rows = (pictures.len() as u32).div_ceil(cols);
+    let label_size = labels.iter().map(|l| text_size(l, pw)).min().unwrap_or(1);
+    let label_h = 8 * label_size + 6;
+    let width = cols * pw + (cols + 1) * GAP;
+    let header_size = text_size(header, width);
+    let header_h = 8 * header_size + 8;
+    let height = header_h + rows * (label_h + ph + GAP) + GAP;
+    // Even sides, so the H.264 encoder takes the frames as they are.
+    let mut img = RgbaImage::from_pixel(width + width % 2, height + height % 2, BACKGROUND);
+    text(&mut img, GAP + 2, 4, header, header_size, TEXT);
+    let mut boxes = Vec::with_capacity(pictures.len());
+    for (i, (label, picture)) in labels.iter().zip(pictures).enumerate() {
+        let (c, r) = (i as u32 % cols, i as u32 / cols);
+        let x = GAP + c * (pw + GAP);
+        let y = header_h + r * (label_h + ph + GAP);
+        text(&mut img, x + 2, y + 3, label, label_size, TEXT);
+        image::imageops::replace(&mut img, picture, x as i64, (y + label_h) as i64);
+        boxes.push([x, y + label_h, pw, ph]);
+    }
+    (img, boxes)
+}
+
+fn stack(top: &RgbaImage, bottom: &RgbaImage) -> RgbaImage {
+    let mut img = RgbaImage::from_pixel(
+        top.width().max(bottom.width()),
+        top.height() + bottom.height(),
+        BACKGROUND,
+    );
+    image::imageops::replace(&mut img, top, 0, 0);
+    image::imageops::replace(&mut img, bottom, 0, top.height() as i64);
+    img
+}
+
+/// An animated PNG (APNG) of `frames` (all one size), looping, with the `png` crate.
+fn write_apng(path: &Path, frames: &[RgbaImage], fps: u32) -> Result<()> {
+    let Some(first) = frames.first() else {
+        return Ok(());
+    };
+    let png_error = |e: png::EncodingError| image_error(path, e);
+    let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+    let mut encoder =
+        png::Encoder::new(std::io::BufWriter::new(file), first.width(), first.height());
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::High);
+    encoder
+        .set_animated(frames.len() as u32, 0)
+        .map_err(png_error)?;
+    encoder
+        .set_frame_delay(1, fps.min(u16::MAX as u32) as u16)
+        .map_err(png_error)?;
+    let mut writer = encoder.write_header().map_err(png_error)?;
+    for f in frames {
+        writer.write_image_data(f.as_raw()).map_err(png_error)?;
+    }
+    writer.finish().map_err(png_error)
+}
+
+fn write_gif(path: &Path, frames: &[RgbaImage], fps: u32) -> Result<()> {
+    let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+    let mut encoder = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
+    encoder
+        .set_repeat(Repeat::Infinite)
+        .map_err(|e| image_error(path, e))?;
+    let delay = Delay::from_numer_denom_ms(1000, fps);
+    encoder
+        .encode_frames(
+            frames
+                .iter()
+                .map(|f| Frame::from_parts(f.clone(), 0, 0, delay)),
+        )
+        .map_err(|e| image_error(path, e))
+}
+
+fn ffmpeg_available() -> bool {
+    Command::new("ffmpeg")
+        .arg("-version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// H.264 (yuv420p, CRF 18) through `ffmpeg`, the frames piped in as raw RGBA.
+fn write_mp4(path: &Path, frames: &[RgbaImage], fps: u32) -> Result<()> {
+    let Some(first) = frames.first() else {
+        return Ok(());
+    };
+    let size = format!("{}x{}", first.width(), first.height());
+    let mut child = Command::new("ffmpeg")
+        .args([
+            "-loglevel",
+            "error",
+            "-y",
+            "-f",
+            "rawvideo",
+            "-pix_fmt",
+            "rgba",
+        ])
+        .args(["-s", &size, "-r", &fps.to_string(), "-i", "-"])
+        .args(["-c:v", "libx264", "-crf", "18", "-pix_fmt", "yuv420p"])
+        .args(["-movflags", "+faststart"])
+        .arg(path)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| Error::io(Path::new("ffmpeg"), e))?;
+    if let Some(mut stdin) = child.stdin.take() {
+        for f in frames {
+            stdin
+                .write_all(f.as_raw())
+                .map_err(|e| Error::io(path, e))?;
+        }
+    }
+    let output = child
+        .wait_with_output()
+        .map_err(|e| Error::io(Path::new("ffmpeg"), e))?;
+    if !output.status.success() {
+        return Err(image_error(
+            path,
+            format!(
+                "ffmpeg failed: {}",
+                String::from_utf8_lossy(&output.stderr).trim()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spread_keeps_ends_and_count() {
+        let frames: Vec<u32> = (10..30).collect();
+        assert_eq!(spread(&frames, 0), frames);
+        assert_eq!(spread(&frames, 50), frames);
+        let s = spread(&frames, 5);
+        assert_eq!(s.len(), 5);
+        assert_eq!(s[0], 10);
+        assert_eq!(s[4], 29);
+        assert!(s.windows(2).all(|w| w[0] < w[1]), "{s:?}");
+        assert_eq!(spread(&frames, 1), vec![10]);
+    }
+
+    #[test]
+    fn crop_box_spans_what_any_picture_draws() {
+        let bg = Rgba([10, 10, 10, 255]);
+        let mut a = RgbaImage::from_pixel(100, 80, bg);
+        let mut b = a.clone();
+        a.put_pixel(40, 30, Rgba([200, 0, 0, 255]));
+        b.put_pixel(50, 35, Rgba([0, 200, 0, 255]));
+        let c = crop_box([&a, &b].into_iter(), 100, 80);
+        assert_eq!(
+            c,
+            Crop {
+                x: 40 - CROP_MARGIN,
+                y: 30 - CROP_MARGIN,
+                w: 11 + 2 * CROP_MARGIN,
+                h: 6 + 2 * CROP_MARGIN
+            }
+        );
+        // Nothing drawn, or most of the frame drawn: the whole frame.
+        let empty = RgbaImage::from_pixel(100, 80, bg);
+        assert_eq!(crop_box([&empty].into_iter(), 100, 80).w, 100);
+        for x in 5..95 {
+            for y in 5..75 {
+                b.put_pixel(x, y, Rgba([0, 0, 200, 255]));
+            }
+        }
+        assert_eq!(crop_box([&a, &b].into_iter(), 100, 80).h, 80);
+        assert_eq!(auto_scale(&c, 100), MIN_TILE_HEIGHT.div_ceil(c.h));
+        assert_eq!(
+            auto_scale(
+                &Crop {
+                    x: 0,
+                    y: 0,
+                    w: 400,
+                    h: 10
+                },
+                100
+            ),
+            1
+        );
+    }
+
+    #[test]
+    fn upscale_is_nearest_neighbour() {
+        let mut img = RgbaImage::new(2, 1);
+        img.put_pixel(1, 0, Rgba([9, 8, 7, 255]));
+        let up = upscale(&img, 3);
+        assert_eq!(up.dimensions(), (6, 3));
+        assert_eq!(*up.get_pixel(2, 2), Rgba([0, 0, 0, 0]));
+        assert_eq!(*up.get_pixel(3, 0), Rgba([9, 8, 7, 255]));
+        assert_eq!(*up.get_pixel(5, 2), Rgba([9, 8, 7, 255]));
+    }
+
+    #[test]
+    fn text_draws_glyph_bits() {
+        let mut img = RgbaImage::from_pixel(16, 8, BACKGROUND);
+        text(&mut img, 0, 0, "1", 1, TEXT);
+        let lit = img.pixels().filter(|p| **p == TEXT).count();
+        let bits: u32 = font8x8::legacy::BASIC_LEGACY['1' as usize]
+            .iter()
+            .map(|b| b.count_ones())
+            .sum();
+        assert_eq!(lit as u32, bits);
+        assert!(bits > 0);
+    }
+
+    #[test]
+    fn grid_places_tiles_by_columns() {
+        let tile = |v: u8| RgbaImage::from_pixel(10, 6, Rgba([v, v, v, 255]));
+        let labels: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
+        let (g, boxes) = grid("a long header", &labels, &[tile(50), tile(100), tile(150)], 2);
+        // Two columns, two rows: the third tile starts the second row, under the first (labels and header
+        // too long for the 2x font: 1x, 8 pixels high).
+        let label_h = 8 + 6;
+        let header_h = 8 + 8;
+        let y2 = header_h + (label_h + 6 + GAP) + label_h;
+        assert_eq!(*g.get_pixel(GAP, y2), Rgba([150, 150, 150, 255]));
+        assert_eq!(
+            *g.get_pixel(GAP + 10 + GAP, header_h + label_h),
+            Rgba([100, 100, 100, 255])
+        );
+        assert_eq!(boxes[2], [GAP, y2, 10, 6]);
+        assert_eq!(g.width() % 2, 0);
+        assert_eq!(g.height() % 2, 0);
+    }
+}
