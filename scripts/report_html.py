@@ -198,7 +198,7 @@ def player(i: int, clip) -> str:
     heat = f"; error view: full scale at {esc(full)}" if full is not None else ""
     links = [f'<a href="{esc(clip[key])}">{what}</a>' for key, what in MEDIA if clip[key]]
     if not clip["mp4"]:
-        links.append("no MP4 (ffmpeg was not installed)")
+        links.append("no MP4 (made without ffmpeg, or with --mp4 off)")
     return f"""<section class="player" id="clip-{esc(anchor(clip['prefix'] + clip['name']))}" data-clip="{i}">
 <h4>{esc(title)}</h4>
 <p class="note">{esc(clip['name'])}: {n} frames of {esc(', '.join(methods)) or 'the methods'} (labelled in the

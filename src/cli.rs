@@ -70,6 +70,9 @@ pub struct ClipsArgs {
     /// At most this many frames per clip, spread evenly over the transition's dumped frames (0: all).
     #[arg(long, default_value_t = 0)]
     pub max_frames: u32,
+    /// Only these transitions, by their index along the path (transitions.csv's `transition`; default: all).
+    #[arg(long, value_delimiter = ',')]
+    pub transitions: Option<Vec<u32>>,
     /// Also a GIF of each clip (beside its animated PNG).
     #[arg(long)]
     pub gif: bool,
@@ -201,6 +204,9 @@ pub struct SceneArgs {
     /// reprojection).
     #[arg(long, value_enum, default_value_t = CameraMode::Fixed)]
     pub camera: CameraMode,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub taa: crate::taa::TaaArgs,
 }
 
 impl Default for SceneArgs {

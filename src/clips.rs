@@ -59,6 +59,8 @@ pub struct ClipSettings {
     pub fps: u32,
     /// At most this many frames per clip, spread evenly over its dumped frames (0: all of them).
     pub max_frames: u32,
+    /// Only these transitions (0-based indices along the path, transitions.csv's `transition`; None: all).
+    pub transitions: Option<Vec<u32>>,
     /// Also a GIF of each clip.
     pub gif: bool,
     pub mp4: Mp4,
@@ -72,6 +74,7 @@ impl Default for ClipSettings {
             scale: None,
             fps: 10,
             max_frames: 0,
+            transitions: None,
             full_frame: false,
             gif: false,
             mp4: Mp4::Auto,
@@ -318,6 +321,16 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
             dir,
             "transitions.csv has no transition: nothing to show",
         ));
+    }
+    if let Some(wanted) = &settings.transitions {
+        let last = paths.iter().map(|p| p.transition).max().unwrap_or_default();
+        if let Some(bad) = wanted.iter().find(|&&t| t > last) {
+            return Err(results_error(
+                dir,
+                format!("--transitions {bad}: the run's transitions are 0 to {last}"),
+            ));
+        }
+        paths.retain(|p| wanted.contains(&p.transition));
     }
     let facts = frame_facts(dir)?;
     let dump = |scene: &str, method: &str, count: u32, f: u32, kind: &str| -> PathBuf {
@@ -903,7 +916,12 @@ mod tests {
     fn grid_places_tiles_by_columns() {
         let tile = |v: u8| RgbaImage::from_pixel(10, 6, Rgba([v, v, v, 255]));
         let labels: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
-        let (g, boxes) = grid("a long header", &labels, &[tile(50), tile(100), tile(150)], 2);
+        let (g, boxes) = grid(
+            "a long header",
+            &labels,
+            &[tile(50), tile(100), tile(150)],
+            2,
+        );
         // Two columns, two rows: the third tile starts the second row, under the first (labels and header
         // too long for the 2x font: 1x, 8 pixels high).
         let label_h = 8 + 6;

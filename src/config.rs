@@ -88,6 +88,7 @@ impl SceneConfig {
             fov_deg: a.fov,
             schedule,
             camera: a.camera,
+            taa: a.taa.resolve()?,
         })
     }
 }

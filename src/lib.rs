@@ -38,6 +38,7 @@ pub mod runner;
 pub mod scene;
 pub mod schedule;
 pub mod stats;
+pub mod taa;
 pub mod terrain;
 
 pub use error::{Error, Result};

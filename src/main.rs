@@ -149,6 +149,7 @@ fn clips(args: &lodbench::cli::ClipsArgs) -> lodbench::Result<()> {
         scale: args.scale,
         fps: args.fps,
         max_frames: args.max_frames,
+        transitions: args.transitions.clone(),
         full_frame: args.full_frame,
         gif: args.gif,
         mp4: args.mp4,

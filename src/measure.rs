@@ -16,6 +16,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::diff::DiffKernel;
 use crate::gpu::metrics::MetricKernel;
+use crate::gpu::taa::{TaaResolve, TaaStream};
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::{DrawStats, GpuContext, RenderTarget, SceneGpu, TextureReadback};
 use crate::methods::{Build, FrameInput, Method, MethodEntry, MethodOptions, Registry};
@@ -305,6 +306,8 @@ pub struct BlockRunner<'a> {
     dump: bool,
     /// With `dump`: only frames with an instance in transition (`--dump-transitions`).
     dump_transitions_only: bool,
+    /// `--taa on`: the resolve, the method's image stream and the reference's.
+    taa: Option<(TaaResolve, TaaStream, TaaStream)>,
 }
 
 /// Keep at most this many quality-pass frames queued on the GPU.
@@ -359,8 +362,15 @@ impl<'a> BlockRunner<'a> {
                 TextureReadback::color(&ctx.device, "reference read-back", w, h),
             )
         });
+        let taa = scene.taa.map(|settings| {
+            let resolve = TaaResolve::new(ctx, settings);
+            let method = resolve.stream(ctx, "method", w, h);
+            let reference = resolve.stream(ctx, "reference", w, h);
+            (resolve, method, reference)
+        });
         ctx.check_errors()?;
         Ok(BlockRunner {
+            taa,
             ctx,
             scene,
             gpu,
@@ -677,10 +687,18 @@ impl<'a> BlockRunner<'a> {
             std::collections::VecDeque::with_capacity(depth + 1);
         let pass_start = Instant::now();
         let mut in_flight = std::collections::VecDeque::new();
+        if let Some((_, m, r)) = &mut self.taa {
+            m.reset();
+            r.reset();
+        }
         for f in 0..frames {
             check_interrupt()?;
             driver.advance(f);
             self.gpu.write_camera(&scene.camera(f));
+            if let Some((resolve, m, r)) = &self.taa {
+                resolve.begin_frame(ctx, m);
+                resolve.begin_frame(ctx, r);
+            }
             let input = driver.input(f);
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             if f == 0 {
@@ -690,6 +708,11 @@ impl<'a> BlockRunner<'a> {
             self.reference
                 .encode(&self.gpu, &input, &mut encoder, &self.reference_target);
             method.encode(&self.gpu, &input, &mut encoder, &self.method_target);
+            // TAA: both frames resolved in place (each against its own history) before anything reads them.
+            if let Some((resolve, m, r)) = &self.taa {
+                resolve.encode(ctx, &mut encoder, m, &self.method_target, true);
+                resolve.encode(ctx, &mut encoder, r, &self.reference_target, true);
+            }
             if let Some(t) = &self.metric_timer {
                 t.begin(&mut encoder, f);
             }
@@ -729,6 +752,9 @@ impl<'a> BlockRunner<'a> {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             let unlagged =
                 method.encode_unlagged(&self.gpu, &input, &mut encoder, &self.now_target);
+            if let (true, Some((resolve, m, _))) = (unlagged, &self.taa) {
+                resolve.encode(ctx, &mut encoder, m, &self.now_target, false);
+            }
             has_lag |= unlagged;
             if unlagged {
                 self.lag_kernel.encode(&ctx.queue, &mut encoder, f, 0);
@@ -749,6 +775,9 @@ impl<'a> BlockRunner<'a> {
                     &mut encoder,
                     &self.before_target,
                 );
+                if let Some((resolve, m, _)) = &self.taa {
+                    resolve.encode(ctx, &mut encoder, m, &self.before_target, false);
+                }
                 self.lodpop_kernel
                     .encode(&ctx.queue, &mut encoder, f, unlagged as usize);
             }
@@ -767,6 +796,10 @@ impl<'a> BlockRunner<'a> {
             }
             if unlagged || changed {
                 index = ctx.queue.submit([encoder.finish()]);
+            }
+            if let Some((_, m, r)) = &mut self.taa {
+                m.advance();
+                r.advance();
             }
 
             if let (true, Some((m, r))) = (read, &self.readback) {

@@ -111,7 +111,7 @@ def test_report_html_with_clips(folder):
         assert ("a", f"clips/{clip['gif']}") in page.refs and ("a", f"clips/{clip['apng']}") in page.refs
         assert f"clips/{clip['frame_images'][0]}" in imgs  # the first frame, shown before the script runs
     assert "frame 8 (1/6), k=n/a, t-instances 0" in text
-    assert "no MP4 (ffmpeg was not installed)" in text
+    assert "no MP4 (made without ffmpeg, or with --mp4 off)" in text
     # Self-contained: no network, every reference a file of the folder (or a place in the page).
     assert not re.search(r"(https?:)?//", " ".join(ref for _, ref in page.refs))
     assert "http://" not in text and "https://" not in text

@@ -42,6 +42,8 @@ pub struct SceneConfig {
     pub counts: Option<Vec<u32>>,
     pub fov_deg: f32,
     pub schedule: ScheduleParams,
+    /// `--taa on`: the jitter of every frame's camera and the resolve after it.
+    pub taa: Option<crate::taa::Taa>,
 }
 
 impl SceneConfig {
@@ -184,6 +186,8 @@ pub struct Scene {
     /// The unified-LOD scenes' blocks' mesh, seams and cluster DAG (every instance is a block at the identity
     /// transform); None elsewhere.
     pub unified: Option<Arc<unified::Unified>>,
+    /// `--taa on`: every frame's projection is jittered ([`Scene::camera`]) and resolved (`gpu/taa.rs`).
+    pub taa: Option<crate::taa::Taa>,
 }
 
 /// Scene-level facts that do not depend on the instance count: built once per scene name.
@@ -206,6 +210,7 @@ pub struct SceneDef {
     pub path: Option<BunnyPath>,
     /// The unified scenes' blocks, camera and frustum.
     pub unified: Option<Arc<UnifiedParts>>,
+    pub taa: Option<crate::taa::Taa>,
 }
 
 /// What a unified scene's blocks are built from, once per scene.
@@ -330,6 +335,7 @@ impl SceneDef {
             lod_generation_ms,
             path: Some(path),
             unified: None,
+            taa: cfg.taa,
         })
     }
 
@@ -370,6 +376,13 @@ impl SceneDef {
     }
 
     pub fn instantiate(&self, count: u32) -> Scene {
+        Scene {
+            taa: self.taa,
+            ..self.instantiate_without_taa(count)
+        }
+    }
+
+    fn instantiate_without_taa(&self, count: u32) -> Scene {
         if let Some(u) = &self.unified {
             return self.instantiate_unified(count, u);
         }
@@ -427,6 +440,7 @@ impl SceneDef {
             turntable: None,
             schedule: self.schedule,
             unified: None,
+            taa: None,
         }
     }
 
@@ -463,6 +477,7 @@ impl SceneDef {
             turntable,
             schedule: self.schedule,
             unified: Some(u.data.clone()),
+            taa: None,
         }
     }
 
@@ -522,6 +537,7 @@ impl SceneDef {
             turntable: None,
             schedule: self.schedule,
             unified: None,
+            taa: None,
         }
     }
 }
@@ -604,6 +620,7 @@ fn unified_def(
         mesh_source,
         lod_generation_ms: started.elapsed().as_secs_f64() * 1e3,
         path: None,
+        taa: cfg.taa,
         unified: Some(Arc::new(UnifiedParts {
             instances,
             data: u.unified,
@@ -695,6 +712,7 @@ fn procedural_def(
         lod_generation_ms,
         path: None,
         unified: None,
+        taa: cfg.taa,
     })
 }
 
@@ -870,12 +888,16 @@ impl Scene {
                 (eye, Mat4::look_at_rh(eye, target, Vec3::Y))
             }
         };
-        let proj = Mat4::perspective_rh(
+        let mut proj = Mat4::perspective_rh(
             self.fov_y,
             self.width as f32 / self.height as f32,
             self.near,
             self.far,
         );
+        if let Some(taa) = &self.taa {
+            let (x, y) = taa.jitter_ndc(frame, self.width, self.height);
+            proj = Mat4::from_translation(Vec3::new(x, y, 0.0)) * proj;
+        }
         Camera { eye, view, proj }
     }
 

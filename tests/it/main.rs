@@ -20,5 +20,6 @@ mod regress;
 mod render;
 mod shaders;
 mod sharding;
+mod taa;
 mod unified;
 mod variants;
