@@ -187,19 +187,20 @@ struct NoiseParams {
     // Side of the tiled threshold texture; 0 = interleaved gradient noise computed here.
     size: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // The pattern's offset in pixels this frame (--noise-temporal; 0 otherwise).
+    offset: vec2<f32>,
 };
 
 @group(1) @binding(0) var noise_tex: texture_2d<f32>;
 @group(1) @binding(1) var<uniform> noise: NoiseParams;
 
 fn threshold(p: vec2<f32>) -> f32 {
+    let at = floor(p) + noise.offset;
     if (noise.size == 0u) {
         // Jimenez 2014, interleaved gradient noise.
-        return fract(52.9829189 * fract(dot(floor(p), vec2<f32>(0.06711056, 0.00583715))));
+        return fract(52.9829189 * fract(dot(at, vec2<f32>(0.06711056, 0.00583715))));
     }
-    let q = vec2<u32>(floor(p)) % vec2<u32>(noise.size);
+    let q = vec2<u32>(at) % vec2<u32>(noise.size);
     return textureLoad(noise_tex, vec2<i32>(q), 0).r;
 }
 

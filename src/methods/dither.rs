@@ -17,6 +17,11 @@ pub struct DitherOptions {
     /// Threshold pattern of noise blending (`dither`).
     #[arg(long, value_enum, default_value_t = NoisePattern::White16)]
     pub noise: NoisePattern,
+    /// dither: move the pattern every frame, as engines do under TAA so the history averages the two LODs
+    /// (tiled patterns: shifted by the Halton (2, 3) point of the frame, times the tile; ign: Jimenez's
+    /// offset of 5.588238 pixels a frame along x and y, over 64 frames). Default: a fixed pattern (seed 003).
+    #[arg(long)]
+    pub noise_temporal: bool,
 }
 
 impl Default for DitherOptions {
@@ -36,6 +41,9 @@ pub struct Dither {
     steady: wgpu::RenderPipeline,
     dithered: wgpu::RenderPipeline,
     noise_group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    /// `--noise-temporal`: the tile size (0: ign), whose pattern moves every frame.
+    temporal: Option<u32>,
 }
 
 impl Dither {
@@ -78,6 +86,7 @@ impl Dither {
         });
         gpu.queue
             .write_buffer(&params, 0, bytemuck::cast_slice(&[size, 0u32, 0, 0]));
+        let temporal = options.noise_temporal.then_some(size);
         let view = texture.create_view(&Default::default());
         let noise_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("dither noise"),
@@ -113,8 +122,24 @@ impl Dither {
             steady: pipeline("dither steady", "fs_opaque"),
             dithered: pipeline("dither dithered", "fs_dither"),
             noise_group,
+            params,
+            temporal,
         }
     }
+}
+
+/// The pattern's offset on `frame` with `--noise-temporal`, in pixels: for a tile of `size` (0: ign).
+pub fn temporal_offset(size: u32, frame: u32) -> [f32; 2] {
+    if size == 0 {
+        let d = 5.588238 * (frame % 64) as f32;
+        return [d, d];
+    }
+    let i = frame % 16 + 1;
+    let s = size as f32;
+    [
+        (crate::taa::halton(i, 2) * s).floor(),
+        (crate::taa::halton(i, 3) * s).floor(),
+    ]
 }
 
 impl Method for Dither {
@@ -151,6 +176,12 @@ impl Method for Dither {
         }
         self.list.build();
         gpu.upload(&self.buffer, &self.list);
+        if let Some(size) = self.temporal {
+            let [x, y] = temporal_offset(size, input.frame);
+            let words = [size, 0, x.to_bits(), y.to_bits()];
+            gpu.queue
+                .write_buffer(&self.params, 0, bytemuck::cast_slice(&words));
+        }
         let mut pass = gpu.begin_clear_pass(encoder, target, "dither pass");
         pass.set_bind_group(1, &self.noise_group, &[]);
         gpu.draw(
