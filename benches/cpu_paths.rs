@@ -103,6 +103,8 @@ fn csv_export(c: &mut Criterion) {
             flip_mean: None,
             combine_gpu_ms: None,
             lag_rmse: None,
+            shadow_rmse: None,
+            shadow_lodpop: None,
             round: f / 360,
         })
         .collect();

@@ -17,9 +17,16 @@ struct Camera {
     eye: vec4<f32>,
     // xyz: unit vector towards the light; w: ambient term.
     light: vec4<f32>,
+    // --shadows on (src/shadow.rs): world to the shadow map's clip space.
+    light_view_proj: mat4x4<f32>,
+    // x: 1 with shadows; y: the shadow map's side in texels; z: depth bias.
+    shadow: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> camera: Camera;
+// The shadow map the draw is lit by (a 1x1 placeholder without shadows, never read then).
+@group(0) @binding(1) var shadow_map: texture_depth_2d;
+@group(0) @binding(2) var shadow_sampler: sampler_comparison;
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -46,6 +53,8 @@ struct VsOut {
     @location(4) @interpolate(flat) kind: f32,
     // Object-space position before any animation (FSI's visibility-texture lookup).
     @location(5) object: vec3<f32>,
+    // World-space position (the shadow lookup).
+    @location(6) world: vec3<f32>,
 };
 
 const KIND_LEAF: f32 = 1.0;
@@ -74,6 +83,7 @@ fn transform(position: vec3<f32>, normal: vec3<f32>, aux: vec4<f32>, inst: Insta
     out.uv = aux.xy;
     out.kind = aux.z;
     out.object = position;
+    out.world = world.xyz;
     return out;
 }
 
@@ -131,13 +141,37 @@ fn vs_morph(v: VertexIn, inst: InstanceIn, m: MorphIn) -> VsOut {
     return transform(mix(v.position, m.target_position, t), normal, v.aux, inst);
 }
 
+// The share of the light reaching `world`: a 3x3 percentage-closer filter of 2x2 bilinear depth comparisons
+// (16 texels), 1 outside the shadow map.
+fn lit(world: vec3<f32>) -> f32 {
+    let p = camera.light_view_proj * vec4<f32>(world, 1.0);
+    let ndc = p.xyz / p.w;
+    let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) || ndc.z > 1.0) {
+        return 1.0;
+    }
+    let texel = 1.0 / camera.shadow.y;
+    let depth = ndc.z - camera.shadow.z;
+    var sum = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let o = vec2<f32>(f32(dx), f32(dy)) * texel;
+            sum += textureSampleCompareLevel(shadow_map, shadow_sampler, uv + o, depth);
+        }
+    }
+    return sum / 9.0;
+}
+
 fn shade(in: VsOut, front: bool) -> vec3<f32> {
     var n = normalize(in.normal);
     // Two-sided lighting: scanned meshes have holes, so back faces can be seen.
     if (!front) {
         n = -n;
     }
-    let lambert = max(dot(n, camera.light.xyz), 0.0);
+    var lambert = max(dot(n, camera.light.xyz), 0.0);
+    if (camera.shadow.x > 0.5) {
+        lambert = lambert * lit(in.world);
+    }
     let ambient = camera.light.w;
     return in.color.rgb * (ambient + (1.0 - ambient) * lambert);
 }
@@ -148,6 +182,26 @@ fn fs_opaque(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4
         discard;
     }
     return vec4<f32>(shade(in, front), 1.0);
+}
+
+// The shadow pass (src/gpu/shadow.rs): the caster seen from the light.
+@vertex
+fn vs_shadow(v: VertexIn, inst: InstanceIn) -> VsOut {
+    var out = transform(v.position, v.normal, v.aux, inst);
+    out.clip = camera.light_view_proj * vec4<f32>(out.world, 1.0);
+    return out;
+}
+
+// A dithered caster (a t-instance of a blending method, src/shadow.rs): params.x = k, params.y = role (1 the
+// incoming LOD, 0 the outgoing); the incoming LOD keeps the texels where k exceeds interleaved gradient noise.
+@fragment
+fn fs_shadow_dither(in: VsOut) {
+    let p = floor(in.clip.xy);
+    let t = fract(52.9829189 * fract(dot(p, vec2<f32>(0.06711056, 0.00583715))));
+    let keep_incoming = in.params.x > t;
+    if (keep_incoming != (in.params.y > 0.5) || masked(in)) {
+        discard;
+    }
 }
 
 // Depth-only passes of scenes with alpha-tested geometry (the mask must cut the depth too).

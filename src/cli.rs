@@ -207,6 +207,9 @@ pub struct SceneArgs {
     #[command(flatten)]
     #[serde(flatten)]
     pub taa: crate::taa::TaaArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub shadow: crate::shadow::ShadowArgs,
 }
 
 impl Default for SceneArgs {

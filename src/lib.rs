@@ -37,6 +37,7 @@ pub mod rng;
 pub mod runner;
 pub mod scene;
 pub mod schedule;
+pub mod shadow;
 pub mod stats;
 pub mod taa;
 pub mod terrain;

@@ -16,6 +16,8 @@
 use crate::error::{Error, Result};
 use crate::gpu::diff::DiffKernel;
 use crate::gpu::metrics::MetricKernel;
+use crate::gpu::scene_gpu::{SHADOW_BEFORE, SHADOW_METHOD, SHADOW_REFERENCE};
+use crate::gpu::shadow::ShadowPass;
 use crate::gpu::taa::{TaaResolve, TaaStream};
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::{DrawStats, GpuContext, RenderTarget, SceneGpu, TextureReadback};
@@ -92,7 +94,9 @@ impl<'s> FrameDriver<'s> {
             let d = self.scene.instance_position(i, frame).distance(eye);
             let switches = &self.scene.models[inst.model as usize].switches;
             let s = self.schedule.update(i, d, switches);
-            lod_sum += s.lod_value() as f64;
+            if self.scene.ground != Some(i) {
+                lod_sum += s.lod_value() as f64;
+            }
             if s.in_transition() {
                 t += 1;
                 k_sum += s.k as f64;
@@ -103,7 +107,8 @@ impl<'s> FrameDriver<'s> {
             self.matrices.push(self.scene.instance_matrix(i, frame));
         }
         FrameFacts {
-            lod_mean: lod_sum / self.scene.instances.len().max(1) as f64,
+            lod_mean: lod_sum
+                / (self.scene.instances.len() - self.scene.ground.is_some() as usize).max(1) as f64,
             t_instances: t,
             k_mean: (t > 0).then(|| k_sum / t as f64),
             pair,
@@ -270,6 +275,8 @@ struct QualityPass {
     lodpop: Vec<f64>,
     /// Methods with a lag (FSI): lag_rmse per frame.
     lag: Option<Vec<f64>>,
+    /// `--shadows on`: (shadow_rmse, shadow_lodpop) per frame.
+    shadow: Option<(Vec<f64>, Vec<f64>)>,
     /// The method's own stage per frame (FSI's combination pass), when it has one: timed in the quality pass,
     /// so that its timestamps are never inside a timing-pass frame.
     stage_ms: Option<Vec<Option<f64>>>,
@@ -308,6 +315,18 @@ pub struct BlockRunner<'a> {
     dump_transitions_only: bool,
     /// `--taa on`: the resolve, the method's image stream and the reference's.
     taa: Option<(TaaResolve, TaaStream, TaaStream)>,
+    /// `--shadows on`: the shadow pass, and the shadow's own share of the error: the reference's LOD0 objects
+    /// lit by the method's shadow map (`now`) and by its counterfactual's (`before`), with their kernels
+    /// against the reference (shadow_rmse) and against each other (shadow_lodpop).
+    shadow: Option<ShadowPass>,
+    shadow_share: Option<ShadowShare>,
+}
+
+struct ShadowShare {
+    now: RenderTarget,
+    before: RenderTarget,
+    rmse: DiffKernel,
+    lodpop: DiffKernel,
 }
 
 /// Keep at most this many quality-pass frames queued on the GPU.
@@ -368,8 +387,34 @@ impl<'a> BlockRunner<'a> {
             let reference = resolve.stream(ctx, "reference", w, h);
             (resolve, method, reference)
         });
+        let shadow = scene
+            .shadows
+            .map(|_| ShadowPass::new(&gpu, scene.instances.len() as u32));
+        let shadow_share = match scene.shadows {
+            None => None,
+            Some(_) => {
+                let now = RenderTarget::new(&ctx.device, "shadow share now", w, h);
+                let before = RenderTarget::new(&ctx.device, "shadow share before", w, h);
+                let rmse = DiffKernel::new(
+                    ctx,
+                    "shadow rmse",
+                    &[(&now, &reference_target)],
+                    scene.frames,
+                )?;
+                let lodpop =
+                    DiffKernel::new(ctx, "shadow lodpop", &[(&now, &before)], scene.frames)?;
+                Some(ShadowShare {
+                    now,
+                    before,
+                    rmse,
+                    lodpop,
+                })
+            }
+        };
         ctx.check_errors()?;
         Ok(BlockRunner {
+            shadow,
+            shadow_share,
             taa,
             ctx,
             scene,
@@ -549,6 +594,8 @@ impl<'a> BlockRunner<'a> {
                     .as_ref()
                     .and_then(|s| s.get(f).copied().flatten()),
                 lag_rmse: quality.lag.as_ref().map(|l| l[f]),
+                shadow_rmse: quality.shadow.as_ref().map(|s| s.0[f]),
+                shadow_lodpop: quality.shadow.as_ref().map(|s| s.1[f]),
                 round: timed.round[f],
             })
             .collect::<Vec<_>>();
@@ -612,14 +659,21 @@ impl<'a> BlockRunner<'a> {
         check_interrupt()?;
         let ctx = self.ctx;
         self.gpu.write_camera(&self.scene.camera(f));
+        self.write_light(f);
+        self.gpu.use_shadow_map(SHADOW_METHOD);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        m.method.encode(
-            &self.gpu,
-            &m.driver.input(f),
-            &mut encoder,
-            &self.timing_target,
+        let input = m.driver.input(f);
+        m.method
+            .encode(&self.gpu, &input, &mut encoder, &self.timing_target);
+        let reference = is_reference(&m.label);
+        let shadow = self.shadow_commands(
+            m.method.as_ref(),
+            &input,
+            input.states,
+            (SHADOW_METHOD, false, reference),
         );
-        ctx.queue.submit([encoder.finish()]);
+        ctx.queue
+            .submit(shadow.into_iter().chain([encoder.finish()]));
         ctx.wait_idle()
     }
 
@@ -640,10 +694,15 @@ impl<'a> BlockRunner<'a> {
             m.facts.push(m.driver.advance(f));
             let t0 = Instant::now();
             self.gpu.write_camera(&scene.camera(f));
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            self.write_light(f);
+            self.gpu.use_shadow_map(SHADOW_METHOD);
+            // With --shadows on the shadow pass goes in a command buffer of its own, before the frame's (it
+            // draws what the method decided in `encode`); the method's timestamps open it.
+            let mut first = ctx.device.create_command_encoder(&Default::default());
             if let Some(t) = &m.timer {
-                t.begin(&mut encoder, f);
+                t.begin(&mut first, f);
             }
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
             let input = FrameInput {
                 timed: true,
                 ..m.driver.input(f)
@@ -655,7 +714,19 @@ impl<'a> BlockRunner<'a> {
             if let Some(t) = &m.timer {
                 t.end(&mut encoder, f);
             }
-            ctx.queue.submit([encoder.finish()]);
+            let reference = is_reference(&m.label);
+            let shadow = self.shadow_commands(
+                m.method.as_ref(),
+                &input,
+                input.states,
+                (SHADOW_METHOD, false, reference),
+            );
+            ctx.queue.submit(
+                [first.finish()]
+                    .into_iter()
+                    .chain(shadow)
+                    .chain([encoder.finish()]),
+            );
             ctx.wait_idle()?;
             m.cpu_ms.push(t0.elapsed().as_secs_f64() * 1e3);
             m.round.push(round);
@@ -666,6 +737,62 @@ impl<'a> BlockRunner<'a> {
         m.uploads.0 += after.0 - uploads_before.0;
         m.uploads.1 += after.1 - uploads_before.1;
         Ok(())
+    }
+
+    /// `--shadows on`: this frame's light, fitted to the casters' bounding spheres (every instance but the
+    /// ground), with room behind them for the receivers.
+    fn write_light(&self, f: u32) {
+        let scene = self.scene;
+        if scene.shadows.is_none() {
+            return;
+        }
+        let spheres: Vec<(glam::Vec3, f32)> = scene
+            .instances
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| scene.ground != Some(*i))
+            .map(|(i, inst)| {
+                (
+                    scene.instance_position(i, f),
+                    scene.models[inst.model as usize].radius,
+                )
+            })
+            .collect();
+        let r = spheres.iter().map(|s| s.1).fold(0.0f32, f32::max);
+        let (light, depth) =
+            crate::shadow::light_matrix(glam::Vec3::from(crate::gpu::LIGHT_DIR), &spheres, 3.0 * r);
+        self.gpu
+            .write_light(&light, crate::shadow::BIAS_OF_RADIUS * r / depth.max(1e-6));
+    }
+
+    /// `--shadows on`: a command buffer, to be submitted before the frame's, that draws into shadow map `map`
+    /// what `method` casts (asked after its `encode` of the frame; `states` this frame's, or the earlier
+    /// frame's for lodpop's counterfactual with `before`), under `--shadow-lod` unless `reference`.
+    fn shadow_commands(
+        &self,
+        method: &dyn Method,
+        input: &FrameInput<'_>,
+        states: &[InstanceState],
+        (map, before, reference): (usize, bool, bool),
+    ) -> Option<wgpu::CommandBuffer> {
+        let (pass, settings) = (self.shadow.as_ref()?, self.scene.shadows?);
+        let mut list = crate::gpu::DrawList::default();
+        let input = FrameInput { states, ..*input };
+        crate::methods::common::shadow_list(
+            &input,
+            |i| {
+                let own = method.shadow_caster(states, i, before);
+                if reference {
+                    own
+                } else {
+                    crate::shadow::Caster::with_policy(own, &states[i], settings.lod)
+                }
+            },
+            &mut list,
+        );
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        pass.encode(&self.gpu, &mut encoder, map, &list);
+        Some(encoder.finish())
     }
 
     fn quality_pass(
@@ -695,6 +822,7 @@ impl<'a> BlockRunner<'a> {
             check_interrupt()?;
             driver.advance(f);
             self.gpu.write_camera(&scene.camera(f));
+            self.write_light(f);
             if let Some((resolve, m, r)) = &self.taa {
                 resolve.begin_frame(ctx, m);
                 resolve.begin_frame(ctx, r);
@@ -704,14 +832,61 @@ impl<'a> BlockRunner<'a> {
             if f == 0 {
                 self.lodpop_kernel.clear(&mut encoder);
                 self.lag_kernel.clear(&mut encoder);
+                if let Some(share) = &self.shadow_share {
+                    share.rmse.clear(&mut encoder);
+                    share.lodpop.clear(&mut encoder);
+                }
             }
+            self.gpu.use_shadow_map(SHADOW_REFERENCE);
             self.reference
                 .encode(&self.gpu, &input, &mut encoder, &self.reference_target);
+            self.gpu.use_shadow_map(SHADOW_METHOD);
             method.encode(&self.gpu, &input, &mut encoder, &self.method_target);
+            // --shadows on: the frame's shadow maps (the reference's LOD0, the method's casters, and, for
+            // lodpop's counterfactual, what the method cast with the previous states), asked now that the
+            // method has decided its frame, submitted before the frame's commands.
+            let mut shadows: Vec<wgpu::CommandBuffer> = Vec::new();
+            shadows.extend(self.shadow_commands(
+                self.reference.as_ref(),
+                &input,
+                input.states,
+                (SHADOW_REFERENCE, false, true),
+            ));
+            shadows.extend(self.shadow_commands(
+                method,
+                &input,
+                input.states,
+                (SHADOW_METHOD, false, false),
+            ));
+            if let Some(previous) = history.front() {
+                shadows.extend(self.shadow_commands(
+                    method,
+                    &input,
+                    previous,
+                    (SHADOW_BEFORE, true, false),
+                ));
+            }
             // TAA: both frames resolved in place (each against its own history) before anything reads them.
             if let Some((resolve, m, r)) = &self.taa {
                 resolve.encode(ctx, &mut encoder, m, &self.method_target, true);
                 resolve.encode(ctx, &mut encoder, r, &self.reference_target, true);
+            }
+            // The shadow's own share: LOD0 objects lit by the method's shadow map now and by its
+            // counterfactual's (resolved against the reference's history under TAA, which they leave as it is).
+            if let Some(share) = &self.shadow_share {
+                for (map, target) in [(SHADOW_METHOD, &share.now), (SHADOW_BEFORE, &share.before)] {
+                    self.gpu.use_shadow_map(map);
+                    self.reference
+                        .encode(&self.gpu, &input, &mut encoder, target);
+                    if let Some((resolve, _, r)) = &self.taa {
+                        resolve.encode(ctx, &mut encoder, r, target, false);
+                    }
+                }
+                self.gpu.use_shadow_map(SHADOW_METHOD);
+                share.rmse.encode(&ctx.queue, &mut encoder, f, 0);
+                if f > 0 {
+                    share.lodpop.encode(&ctx.queue, &mut encoder, f, 0);
+                }
             }
             if let Some(t) = &self.metric_timer {
                 t.begin(&mut encoder, f);
@@ -745,7 +920,9 @@ impl<'a> BlockRunner<'a> {
             } else {
                 Vec::new()
             };
-            let mut index = ctx.queue.submit([encoder.finish()]);
+            let mut index = ctx
+                .queue
+                .submit(shadows.into_iter().chain([encoder.finish()]));
 
             // lodpop and lag: the counterfactual frames at this pose, in a submission of their own (the method
             // writes its instance data again through the queue, which must not reach the frame above).
@@ -768,6 +945,7 @@ impl<'a> BlockRunner<'a> {
             if changed {
                 let earlier: Vec<&[InstanceState]> =
                     history.iter().skip(1).map(Vec::as_slice).collect();
+                self.gpu.use_shadow_map(SHADOW_BEFORE);
                 method.encode_before(
                     &self.gpu,
                     &input,
@@ -775,6 +953,7 @@ impl<'a> BlockRunner<'a> {
                     &mut encoder,
                     &self.before_target,
                 );
+                self.gpu.use_shadow_map(SHADOW_METHOD);
                 if let Some((resolve, m, _)) = &self.taa {
                     resolve.encode(ctx, &mut encoder, m, &self.before_target, false);
                 }
@@ -844,6 +1023,13 @@ impl<'a> BlockRunner<'a> {
         } else {
             None
         };
+        let shadow = match &self.shadow_share {
+            Some(share) => Some((
+                share.rmse.read(ctx, frames)?,
+                share.lodpop.read(ctx, frames)?,
+            )),
+            None => None,
+        };
         let metric_gpu_ms_median = match &self.metric_timer {
             Some(t) => {
                 let ms: Vec<f64> = t.read(ctx)?.into_iter().flatten().collect();
@@ -856,6 +1042,7 @@ impl<'a> BlockRunner<'a> {
             flip,
             lodpop,
             lag,
+            shadow,
             stage_ms: method.stage_gpu_ms(ctx)?,
             ms_per_frame,
             metric_gpu_ms_median,

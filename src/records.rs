@@ -50,6 +50,12 @@ pub struct FrameRecord {
     /// `fsi*` only: RMS of the method's frame minus the same combination with every LOD buffer drawn at this
     /// frame's pose (its one-frame lag; 0 for fsi-sameframe).
     pub lag_rmse: Option<f64>,
+    /// `--shadows on`: RMS of the reference's LOD0 objects lit by the method's shadow map minus the reference
+    /// frame: the error the method's shadow alone makes (empty without shadows).
+    pub shadow_rmse: Option<f64>,
+    /// `--shadows on`: RMS of those objects lit by the method's shadow map minus the same lit by what the
+    /// method cast with the previous frame's schedule: the shadow's own popping (0 on frame 0).
+    pub shadow_lodpop: Option<f64>,
     /// The timing round the frame was timed in (0-based; `--rounds`).
     pub round: u32,
 }
@@ -101,6 +107,9 @@ pub struct SummaryRecord {
     /// `fsi*` only: mean and largest lag_rmse.
     pub lag_rmse_mean: Option<f64>,
     pub lag_rmse_max: Option<f64>,
+    /// `--shadows on`: mean shadow_rmse and largest shadow_lodpop (the shadow's own error and popping).
+    pub shadow_rmse_mean: Option<f64>,
+    pub shadow_lodpop_max: Option<f64>,
     /// `--baseline`: this method's time over the baseline's, paired round by round ([`PairedRatios`]).
     pub baseline: Option<String>,
     pub rounds: u32,
@@ -124,6 +133,8 @@ impl SummaryRecord {
     ) -> Option<SummaryRecord> {
         let first = rows.first()?;
         let lag: Option<Vec<f64>> = rows.iter().map(|r| r.lag_rmse).collect();
+        let shadow_rmse: Option<Vec<f64>> = rows.iter().map(|r| r.shadow_rmse).collect();
+        let shadow_lodpop: Option<Vec<f64>> = rows.iter().map(|r| r.shadow_lodpop).collect();
         let gpu: Vec<f64> = rows.iter().filter_map(|r| r.gpu_ms).collect();
         let cpu: Vec<f64> = rows.iter().map(|r| r.cpu_ms).collect();
         let pop: Vec<f64> = rows.iter().map(|r| r.pop).collect();
@@ -183,6 +194,8 @@ impl SummaryRecord {
             ),
             lag_rmse_mean: lag.as_ref().map(|v| mean(v.iter().copied())),
             lag_rmse_max: lag.map(|v| v.into_iter().fold(0.0, f64::max)),
+            shadow_rmse_mean: shadow_rmse.as_ref().map(|v| mean(v.iter().copied())),
+            shadow_lodpop_max: shadow_lodpop.map(|v| v.into_iter().fold(0.0, f64::max)),
             baseline: None,
             rounds: rows.iter().map(|r| r.round + 1).max().unwrap_or(0),
             ratio_to_baseline: None,
@@ -408,6 +421,9 @@ pub struct TransitionRecord {
     pub pop_max: f64,
     pub pop_max_frame: u32,
     pub rmse_max: f64,
+    /// `--shadows on`: the largest shadow_lodpop over the same frames (empty without shadows).
+    #[serde(default)]
+    pub shadow_lodpop_max: Option<f64>,
 }
 
 /// The transitions of one block: `rows` its frame records in frame order, `pairs` each frame's pair.
@@ -452,6 +468,11 @@ pub fn transitions(rows: &[FrameRecord], pairs: &[TransitionPair]) -> Vec<Transi
             pop_max,
             pop_max_frame,
             rmse_max: argmax(|r| r.rmse).0,
+            shadow_lodpop_max: window
+                .iter()
+                .map(|r| r.shadow_lodpop)
+                .collect::<Option<Vec<f64>>>()
+                .map(|v| v.into_iter().fold(0.0, f64::max)),
         });
     }
     out
@@ -609,6 +630,8 @@ pub(crate) mod tests {
             flip_mean: None,
             combine_gpu_ms: None,
             lag_rmse: None,
+            shadow_rmse: None,
+            shadow_lodpop: None,
             round: 0,
         }
     }

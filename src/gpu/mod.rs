@@ -10,6 +10,7 @@ pub mod metrics;
 pub mod pipelines;
 pub mod readback;
 pub mod scene_gpu;
+pub mod shadow;
 pub mod taa;
 pub mod targets;
 pub mod timing;

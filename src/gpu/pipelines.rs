@@ -82,6 +82,35 @@ pub(crate) fn mesh_pipeline(
     alpha_test: bool,
     d: &MeshPipeline<'_>,
 ) -> wgpu::RenderPipeline {
+    mesh_pipeline_from(device, shader, camera_layout, alpha_test, d, false)
+}
+
+/// The shadow pass's pipeline (src/gpu/shadow.rs): `vs_shadow`, depth only; `fragment` (the dithered
+/// caster's) discards without writing colour; None = plain depth (the mask's entry with alpha-tested
+/// geometry).
+pub(crate) fn shadow_pipeline(
+    device: &wgpu::Device,
+    shader: &wgpu::ShaderModule,
+    camera_layout: &wgpu::BindGroupLayout,
+    alpha_test: bool,
+    label: &str,
+    fragment: Option<&str>,
+) -> wgpu::RenderPipeline {
+    let d = MeshPipeline {
+        fragment,
+        ..MeshPipeline::opaque(label)
+    };
+    mesh_pipeline_from(device, shader, camera_layout, alpha_test, &d, true)
+}
+
+fn mesh_pipeline_from(
+    device: &wgpu::Device,
+    shader: &wgpu::ShaderModule,
+    camera_layout: &wgpu::BindGroupLayout,
+    alpha_test: bool,
+    d: &MeshPipeline<'_>,
+    shadow: bool,
+) -> wgpu::RenderPipeline {
     let mut layouts: Vec<Option<&wgpu::BindGroupLayout>> = vec![Some(camera_layout)];
     layouts.extend(d.extra_layouts.iter().map(|l| Some(*l)));
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -126,6 +155,7 @@ pub(crate) fn mesh_pipeline(
     // Depth-only passes need a fragment stage only to apply the alpha-test mask.
     let (fragment, targets): (Option<&str>, &[Option<wgpu::ColorTargetState>]) =
         match (d.fragment, alpha_test) {
+            (Some(f), _) if shadow => (Some(f), &[]),
             (Some(f), _) => (Some(f), &targets),
             (None, true) => (Some("fs_depth_masked"), &[]),
             (None, false) => (None, &[]),
@@ -135,7 +165,11 @@ pub(crate) fn mesh_pipeline(
         layout: Some(&layout),
         vertex: wgpu::VertexState {
             module: shader,
-            entry_point: Some(if d.morph { "vs_morph" } else { "vs_main" }),
+            entry_point: Some(match (shadow, d.morph) {
+                (true, _) => "vs_shadow",
+                (false, true) => "vs_morph",
+                (false, false) => "vs_main",
+            }),
             compilation_options: compilation_options.clone(),
             buffers: &buffers,
         },

@@ -22,7 +22,20 @@ struct CameraRaw {
     view_proj: [[f32; 4]; 4],
     eye: [f32; 4],
     light: [f32; 4],
+    /// `--shadows on`: world to the shadow map's clip space, and (on, side in texels, depth bias, 0).
+    light_view_proj: [[f32; 4]; 4],
+    shadow: [f32; 4],
 }
+
+/// Byte offset of `light_view_proj` in the camera uniform (what [`SceneGpu::write_camera`] leaves alone).
+const LIGHT_OFFSET: u64 = 64 + 16 + 16;
+
+/// The camera bind groups' shadow maps: a 1x1 placeholder (shadows off, and the shadow passes themselves),
+/// then with `--shadows on` the method's, the reference's and the one of lodpop's counterfactual frame.
+pub const SHADOW_NONE: usize = 0;
+pub const SHADOW_METHOD: usize = 1;
+pub const SHADOW_REFERENCE: usize = 2;
+pub const SHADOW_BEFORE: usize = 3;
 
 /// Where one LOD of one model lives in the shared vertex and index buffers.
 #[derive(Debug, Clone, Copy)]
@@ -51,7 +64,14 @@ pub struct SceneGpu {
     pub seam_base: u32,
     pub camera_buffer: wgpu::Buffer,
     pub camera_layout: wgpu::BindGroupLayout,
-    pub camera_bind_group: wgpu::BindGroup,
+    /// The camera's bind group (group 0) with each shadow map ([`SHADOW_NONE`] ...); draws use the active one.
+    pub camera_groups: Vec<wgpu::BindGroup>,
+    active_group: std::cell::Cell<usize>,
+    /// The shadow maps' depth views, indexed like `camera_groups` (`--shadows on`; only the placeholder
+    /// otherwise).
+    pub shadow_views: Vec<wgpu::TextureView>,
+    pub shadow_maps: Vec<wgpu::Texture>,
+    pub shadow_size: u32,
     pub shader: wgpu::ShaderModule,
     pub opaque_pipeline: wgpu::RenderPipeline,
     /// The scene has alpha-tested geometry: every mesh pipeline is built with `ALPHA_TEST` on.
@@ -158,25 +178,94 @@ impl SceneGpu {
         });
         let camera_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("camera layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
                 },
-                count: None,
-            }],
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+            ],
         });
-        let camera_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("camera bind group"),
-            layout: &camera_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: camera_buffer.as_entire_binding(),
-            }],
+        let shadow_size = scene.shadows.map_or(1, |s| s.size);
+        let maps = if scene.shadows.is_some() { 4 } else { 1 };
+        let shadow_maps: Vec<wgpu::Texture> = (0..maps)
+            .map(|i| {
+                let side = if i == SHADOW_NONE { 1 } else { shadow_size };
+                device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(&format!("shadow map {i}")),
+                    size: wgpu::Extent3d {
+                        width: side,
+                        height: side,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: crate::formats::DEPTH_FORMAT,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                        | wgpu::TextureUsages::TEXTURE_BINDING
+                        | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                })
+            })
+            .collect();
+        let shadow_views: Vec<wgpu::TextureView> = shadow_maps
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
+        let shadow_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow sampler"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
         });
+        let camera_groups = shadow_views
+            .iter()
+            .map(|view| {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("camera bind group"),
+                    layout: &camera_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: camera_buffer.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::TextureView(view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: wgpu::BindingResource::Sampler(&shadow_sampler),
+                        },
+                    ],
+                })
+            })
+            .collect();
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("mesh.wgsl"),
             source: wgpu::ShaderSource::Wgsl(MESH_WGSL.into()),
@@ -210,7 +299,11 @@ impl SceneGpu {
             seam_base,
             camera_buffer,
             camera_layout,
-            camera_bind_group,
+            camera_groups,
+            active_group: std::cell::Cell::new(SHADOW_NONE),
+            shadow_views,
+            shadow_maps,
+            shadow_size,
             shader,
             opaque_pipeline,
             alpha_test,
@@ -239,9 +332,41 @@ impl SceneGpu {
             view_proj: camera.view_proj().to_cols_array_2d(),
             eye: camera.eye.extend(1.0).to_array(),
             light: [l.x, l.y, l.z, AMBIENT],
+            light_view_proj: [[0.0; 4]; 4],
+            shadow: [0.0; 4],
         };
+        let bytes = bytemuck::bytes_of(&raw);
         self.queue
-            .write_buffer(&self.camera_buffer, 0, bytemuck::bytes_of(&raw));
+            .write_buffer(&self.camera_buffer, 0, &bytes[..LIGHT_OFFSET as usize]);
+    }
+
+    /// `--shadows on`: this frame's light matrix (every shadow map of the frame shares it); shading reads the
+    /// shadow map from then on.
+    pub fn write_light(&self, light_view_proj: &glam::Mat4, depth_bias: f32) {
+        let mut words = [0f32; 20];
+        words[..16].copy_from_slice(&light_view_proj.to_cols_array());
+        words[16..].copy_from_slice(&[1.0, self.shadow_size as f32, depth_bias, 0.0]);
+        self.queue.write_buffer(
+            &self.camera_buffer,
+            LIGHT_OFFSET,
+            bytemuck::cast_slice(&words),
+        );
+    }
+
+    /// The camera bind group draws use from now on: the one with shadow map `index` ([`SHADOW_METHOD`] ...).
+    pub fn use_shadow_map(&self, index: usize) {
+        self.active_group
+            .set(index.min(self.camera_groups.len().saturating_sub(1)));
+    }
+
+    /// Which shadow map draws are lit by ([`SHADOW_NONE`] ...).
+    pub fn active_shadow_map(&self) -> usize {
+        self.active_group.get()
+    }
+
+    /// The camera bind group of the shadow map in use.
+    pub fn camera_group(&self) -> &wgpu::BindGroup {
+        &self.camera_groups[self.active_group.get()]
     }
 
     /// A `side` x `side` R32Float texture holding `values` (row-major): the screen-space thresholds of
@@ -350,7 +475,7 @@ impl SceneGpu {
         lod: u32,
         pipeline: &wgpu::RenderPipeline,
     ) -> DrawStats {
-        pass.set_bind_group(0, &self.camera_bind_group, &[]);
+        pass.set_bind_group(0, self.camera_group(), &[]);
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, buffer.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
@@ -383,7 +508,7 @@ impl SceneGpu {
         if list.draws.is_empty() {
             return stats;
         }
-        pass.set_bind_group(0, &self.camera_bind_group, &[]);
+        pass.set_bind_group(0, self.camera_group(), &[]);
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, buffer.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);

@@ -92,7 +92,7 @@ impl ClusterLod {
     ) -> DrawStats {
         let dag = &self.unified.dag;
         let mut pass = gpu.begin_clear_pass(encoder, target, "clusterlod pass");
-        pass.set_bind_group(0, &gpu.camera_bind_group, &[]);
+        pass.set_bind_group(0, gpu.camera_group(), &[]);
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, self.instance.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);

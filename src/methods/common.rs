@@ -5,6 +5,7 @@ use crate::error::Result;
 use crate::gpu::{DrawList, DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 use crate::schedule::InstanceState;
+use crate::shadow::Caster;
 use glam::Mat4;
 
 /// What a method gets for one frame.
@@ -99,6 +100,50 @@ pub trait Method {
     ) -> bool {
         false
     }
+
+    /// `--shadows on`, `--shadow-lod follow`: what instance `i` casts into the frame's shadow map given the
+    /// states `states` (this frame's after `encode`; the earlier frame's for lodpop's counterfactual,
+    /// `before` true). Called after `encode` of the frame. The default, the blending methods' choice: the LOD
+    /// out of transition, both LODs dithered at k in one (src/shadow.rs).
+    fn shadow_caster(&self, states: &[InstanceState], i: usize, _before: bool) -> Caster {
+        Caster::blended(&states[i])
+    }
+}
+
+/// The shadow map's draw list of one frame: each instance's caster (`caster(i)`; the ground casts nothing),
+/// pipelines `gpu::shadow::CAST_WHOLE` and `CAST_DITHERED` (params: k, then 1 for the incoming LOD, 0 for the
+/// outgoing).
+pub fn shadow_list(input: &FrameInput<'_>, caster: impl Fn(usize) -> Caster, list: &mut DrawList) {
+    use crate::gpu::shadow::{CAST_DITHERED, CAST_WHOLE};
+    list.clear();
+    for (i, inst) in input.scene.instances.iter().enumerate() {
+        if input.scene.ground == Some(i) {
+            continue;
+        }
+        match caster(i) {
+            Caster::Lod(lod) => list.push(
+                CAST_WHOLE,
+                inst.model,
+                lod,
+                instance_raw(input, i, 0.0, 1.0, lod),
+            ),
+            Caster::Dither { from, to, k } => {
+                list.push(
+                    CAST_DITHERED,
+                    inst.model,
+                    to,
+                    instance_raw(input, i, k, 1.0, to),
+                );
+                list.push(
+                    CAST_DITHERED,
+                    inst.model,
+                    from,
+                    instance_raw(input, i, k, 0.0, from),
+                );
+            }
+        }
+    }
+    list.build();
 }
 
 /// The Giegl-Wimmer "unpopping" schedule (seed 000 Fig. 2, seed 001 Fig. 1b): one LOD is always opaque. For

@@ -5,6 +5,8 @@
 use super::common::{FrameInput, Method, OpaqueInstances};
 use crate::gpu::{DrawStats, RenderTarget, SceneGpu};
 use crate::scene::Scene;
+use crate::schedule::InstanceState;
+use crate::shadow::Caster;
 
 pub struct Discrete {
     draw: OpaqueInstances,
@@ -38,5 +40,10 @@ impl Method for Discrete {
             .encode(gpu, input, encoder, target, "discrete pass", |s| {
                 s.discrete_lod()
             })
+    }
+
+    /// The LOD it shows.
+    fn shadow_caster(&self, states: &[InstanceState], i: usize, _before: bool) -> Caster {
+        Caster::Lod(states[i].discrete_lod())
     }
 }

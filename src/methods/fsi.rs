@@ -57,6 +57,7 @@ use crate::noise::VisTexture;
 use crate::noise::{visibility_texture, VIS_TEXTURE_SIZE};
 use crate::scene::{Camera, Scene};
 use crate::schedule::InstanceState;
+use crate::shadow::Caster;
 use glam::{DMat4, Mat4};
 
 pub const COMBINE_WGSL: &str = include_str!("../../shaders/fsi_combine.wgsl");
@@ -381,6 +382,8 @@ pub struct Fsi {
     combined_view: wgpu::TextureView,
     /// What each LOD buffer drew last (per buffer), and the last two quality-pass frames' choices.
     choices: [Vec<Choice>; 2],
+    /// The LOD buffer the last `encode` rendered at its frame's pose (its newer).
+    last_newer: usize,
     recent: std::collections::VecDeque<FrameChoices>,
     scratch: Option<Scratch>,
     /// Texture repeats per object-space unit, per model (1 / object-space radius).
@@ -566,6 +569,7 @@ impl Fsi {
             id_format: format,
             combine_layout,
             combined_view,
+            last_newer: 0,
             choices: [Vec::new(), Vec::new()],
             recent: std::collections::VecDeque::new(),
             scratch: None,
@@ -864,6 +868,20 @@ impl Fsi {
 }
 
 impl Method for Fsi {
+    /// The LODs of the LOD buffer rendered this frame (the older buffer's, from when it was rendered, for
+    /// lodpop's counterfactual of the previous schedule): each buffer is lit by the shadow of its own LODs.
+    fn shadow_caster(&self, states: &[InstanceState], i: usize, before: bool) -> Caster {
+        let slot = if before {
+            1 - self.last_newer
+        } else {
+            self.last_newer
+        };
+        match self.choices[slot].get(i) {
+            Some(c) => Caster::Lod(c.lod),
+            None => Caster::blended(&states[i]),
+        }
+    }
+
     fn encode(
         &mut self,
         gpu: &SceneGpu,
@@ -921,6 +939,7 @@ impl Method for Fsi {
         };
         self.prepare(gpu, input, newer, new_toggle);
         stats += self.render(gpu, encoder, newer, newer, n);
+        self.last_newer = newer;
         self.previous = Some((f, camera));
         if !input.timed {
             // The quality pass keeps what the combination used, for lodpop's counterfactuals.

@@ -4,6 +4,8 @@
 use super::common::{FrameInput, Method, OpaqueInstances};
 use crate::gpu::{DrawStats, RenderTarget, SceneGpu};
 use crate::scene::Scene;
+use crate::schedule::InstanceState;
+use crate::shadow::Caster;
 
 pub struct Reference {
     draw: OpaqueInstances,
@@ -27,5 +29,10 @@ impl Method for Reference {
     ) -> DrawStats {
         self.draw
             .encode(gpu, input, encoder, target, "reference pass", |_| 0)
+    }
+
+    /// LOD0, always.
+    fn shadow_caster(&self, _states: &[InstanceState], _i: usize, _before: bool) -> Caster {
+        Caster::Lod(0)
     }
 }

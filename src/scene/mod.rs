@@ -44,6 +44,8 @@ pub struct SceneConfig {
     pub schedule: ScheduleParams,
     /// `--taa on`: the jitter of every frame's camera and the resolve after it.
     pub taa: Option<crate::taa::Taa>,
+    /// `--shadows on`: the shadow map (and a ground under the bunny scenes).
+    pub shadows: Option<crate::shadow::Shadows>,
 }
 
 impl SceneConfig {
@@ -188,6 +190,11 @@ pub struct Scene {
     pub unified: Option<Arc<unified::Unified>>,
     /// `--taa on`: every frame's projection is jittered ([`Scene::camera`]) and resolved (`gpu/taa.rs`).
     pub taa: Option<crate::taa::Taa>,
+    /// `--shadows on`: the shadow map's settings (src/shadow.rs).
+    pub shadows: Option<crate::shadow::Shadows>,
+    /// The instance that is the bunny scenes' ground with `--shadows on`: static, always LOD0, receives
+    /// shadows and casts none, left out of `lod_mean`.
+    pub ground: Option<usize>,
 }
 
 /// Scene-level facts that do not depend on the instance count: built once per scene name.
@@ -211,6 +218,9 @@ pub struct SceneDef {
     /// The unified scenes' blocks, camera and frustum.
     pub unified: Option<Arc<UnifiedParts>>,
     pub taa: Option<crate::taa::Taa>,
+    pub shadows: Option<crate::shadow::Shadows>,
+    /// `--shadows on` in the bunny scenes: the ground's model and position.
+    pub ground: Option<(u32, Vec3)>,
 }
 
 /// What a unified scene's blocks are built from, once per scene.
@@ -321,9 +331,17 @@ impl SceneDef {
             fov_y,
         );
         let lod_generation_ms = started.elapsed().as_secs_f64() * 1e3;
+        let mut models = vec![model];
+        let ground =
+            cfg.shadows
+                .map(|_| ground_model(&models[0], path.far))
+                .map(|(m, position)| {
+                    models.push(m);
+                    (1, position)
+                });
         Ok(SceneDef {
             kind,
-            models: Arc::from(vec![model]),
+            models: Arc::from(models),
             frames: pv.frames,
             width: pv.width,
             height: pv.height,
@@ -336,6 +354,8 @@ impl SceneDef {
             path: Some(path),
             unified: None,
             taa: cfg.taa,
+            shadows: cfg.shadows,
+            ground,
         })
     }
 
@@ -376,10 +396,20 @@ impl SceneDef {
     }
 
     pub fn instantiate(&self, count: u32) -> Scene {
-        Scene {
+        let mut scene = Scene {
             taa: self.taa,
+            shadows: self.shadows,
             ..self.instantiate_without_taa(count)
+        };
+        if let Some((model, position)) = self.ground {
+            scene.ground = Some(scene.instances.len());
+            scene.instances.push(Instance {
+                model,
+                position,
+                yaw: 0.0,
+            });
         }
+        scene
     }
 
     fn instantiate_without_taa(&self, count: u32) -> Scene {
@@ -441,6 +471,8 @@ impl SceneDef {
             schedule: self.schedule,
             unified: None,
             taa: None,
+            shadows: None,
+            ground: None,
         }
     }
 
@@ -478,6 +510,8 @@ impl SceneDef {
             schedule: self.schedule,
             unified: Some(u.data.clone()),
             taa: None,
+            shadows: None,
+            ground: None,
         }
     }
 
@@ -538,6 +572,8 @@ impl SceneDef {
             schedule: self.schedule,
             unified: None,
             taa: None,
+            shadows: None,
+            ground: None,
         }
     }
 }
@@ -621,6 +657,8 @@ fn unified_def(
         lod_generation_ms: started.elapsed().as_secs_f64() * 1e3,
         path: None,
         taa: cfg.taa,
+        shadows: cfg.shadows,
+        ground: None,
         unified: Some(Arc::new(UnifiedParts {
             instances,
             data: u.unified,
@@ -713,6 +751,8 @@ fn procedural_def(
         path: None,
         unified: None,
         taa: cfg.taa,
+        shadows: cfg.shadows,
+        ground: None,
     })
 }
 
@@ -770,6 +810,52 @@ fn bunny_model(
     })
 }
 
+/// The bunny scenes' ground with `--shadows on`: a grey quad under the bunny's lowest point, from behind the
+/// camera (at the origin, looking along +x) to past the path's far end, as wide as half its length; one LOD,
+/// no switches. Returns the model and its position.
+fn ground_model(bunny: &Model, far: f32) -> (Model, Vec3) {
+    let r = bunny.radius;
+    let lowest = bunny.chain.lods[0]
+        .mesh
+        .positions
+        .iter()
+        .map(|p| (p[1] - bunny.center.y) * bunny.scale)
+        .fold(0.0f32, f32::min);
+    let (hx, x_mid) = ((far + 3.0 * r) * 0.5, (far + r) * 0.5);
+    let hz = (hx * 0.5).max(3.0 * r);
+    let positions = vec![
+        [-hx, 0.0, -hz],
+        [hx, 0.0, -hz],
+        [hx, 0.0, hz],
+        [-hx, 0.0, hz],
+    ];
+    let mesh = Mesh {
+        normals: vec![[0.0, 1.0, 0.0]; 4],
+        aux: vec![[0.0; 4]; 4],
+        indices: vec![0, 2, 1, 0, 3, 2],
+        positions,
+    };
+    let model = Model {
+        name: "ground".into(),
+        color: [0.45, 0.45, 0.45],
+        lod_colors: Vec::new(),
+        spin_per_frame: 0.0,
+        chain: LodChain {
+            lods: vec![crate::lod::Lod {
+                mesh,
+                target_fraction: 1.0,
+                error_abs: 0.0,
+            }],
+        },
+        switches: Vec::new(),
+        switch_source: "none (the ground)",
+        center: Vec3::ZERO,
+        radius: (hx * hx + hz * hz).sqrt(),
+        scale: 1.0,
+    };
+    (model, Vec3::new(x_mid, lowest, 0.0))
+}
+
 impl SceneDef {
     /// The scene's name (the CSVs' `scene` column).
     pub fn name(&self) -> &'static str {
@@ -807,6 +893,9 @@ impl Scene {
     /// Where instance `i`'s centre is on `frame`.
     pub fn instance_position(&self, i: usize, frame: u32) -> Vec3 {
         let inst = &self.instances[i];
+        if self.ground == Some(i) {
+            return inst.position;
+        }
         match self.motion {
             Motion::Static => inst.position,
             Motion::SweepX { near, far } => {

@@ -19,6 +19,7 @@ mod registry;
 mod regress;
 mod render;
 mod shaders;
+mod shadows;
 mod sharding;
 mod taa;
 mod unified;

@@ -1,0 +1,79 @@
+//! The shadow pass of `--shadows on` (src/shadow.rs): the casters' depth from the light into one of the
+//! scene's shadow maps (`SceneGpu::shadow_views`), drawn with the placeholder's camera bind group so the map
+//! being written is never the one bound.
+
+use crate::gpu::draw_list::{DrawList, DrawStats, PipelineIndex};
+use crate::gpu::instances::InstanceBuffer;
+use crate::gpu::pipelines::shadow_pipeline;
+use crate::gpu::scene_gpu::{SceneGpu, SHADOW_NONE};
+
+/// Pipeline indices of a shadow draw list: a caster drawn whole, and one LOD of a dithered caster.
+pub const CAST_WHOLE: PipelineIndex = 0;
+pub const CAST_DITHERED: PipelineIndex = 1;
+
+pub struct ShadowPass {
+    whole: wgpu::RenderPipeline,
+    dithered: wgpu::RenderPipeline,
+    /// One instance buffer per shadow map, so maps drawn in one submission keep their own instances.
+    buffers: Vec<InstanceBuffer>,
+}
+
+impl ShadowPass {
+    pub fn new(gpu: &SceneGpu, instances: u32) -> ShadowPass {
+        let p = |label, fragment| {
+            shadow_pipeline(
+                &gpu.device,
+                &gpu.shader,
+                &gpu.camera_layout,
+                gpu.alpha_test,
+                label,
+                fragment,
+            )
+        };
+        ShadowPass {
+            whole: p("shadow caster", None),
+            dithered: p("shadow caster, dithered", Some("fs_shadow_dither")),
+            buffers: (0..gpu.shadow_views.len())
+                .map(|i| {
+                    gpu.create_instance_buffer(
+                        &format!("shadow map {i} casters"),
+                        2 * instances.max(1),
+                    )
+                })
+                .collect(),
+        }
+    }
+
+    /// Uploads `list` (built, pipelines [`CAST_WHOLE`] / [`CAST_DITHERED`]) and records the depth of its
+    /// casters into shadow map `map`.
+    pub fn encode(
+        &self,
+        gpu: &SceneGpu,
+        encoder: &mut wgpu::CommandEncoder,
+        map: usize,
+        list: &DrawList,
+    ) -> DrawStats {
+        let buffer = &self.buffers[map];
+        gpu.upload(buffer, list);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shadow pass"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &gpu.shadow_views[map],
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let active = gpu.active_shadow_map();
+        gpu.use_shadow_map(SHADOW_NONE);
+        let stats = gpu.draw(&mut pass, buffer, 0, list, &[&self.whole, &self.dithered]);
+        gpu.use_shadow_map(active);
+        stats
+    }
+}
