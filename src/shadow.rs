@@ -17,6 +17,7 @@
 //!   casts, each frame, the LODs of the LOD buffer it renders that frame (so each of its two buffers is lit by
 //!   the shadow of its own LODs). geomorph's casters are not morphed (said in docs/methods.md).
 //! - `lod-from`, `lod-to`: every t-instance casts that one LOD, whatever the method draws.
+//!
 //! The reference always casts LOD0.
 
 use crate::error::{Error, Result};
