@@ -211,3 +211,37 @@ fn shadows_darken_the_ground_and_discrete_at_lod0_matches_the_reference() {
         .iter()
         .all(|&r| r == 0.0));
 }
+
+/// The unified scenes refuse `--shadows on`, and a shadow map out of range is named: one error each.
+#[test]
+fn bad_shadow_flags_are_refused() {
+    use clap::Parser;
+    use lodbench::cli::{Cli, Command};
+    for (args, needle) in [
+        (
+            vec!["--scene", "terrain", "--shadows", "on"],
+            "--shadows on",
+        ),
+        (
+            vec![
+                "--scene",
+                "bunny-sweep",
+                "--shadows",
+                "on",
+                "--shadow-size",
+                "8",
+            ],
+            "--shadow-size",
+        ),
+    ] {
+        let mut argv = vec!["lodbench", "run"];
+        argv.extend(args);
+        let Command::Run(a) = Cli::try_parse_from(argv).unwrap().command else {
+            unreachable!()
+        };
+        let err = lodbench::config::RunConfig::from_args(&a)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(needle), "{err}");
+    }
+}
