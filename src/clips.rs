@@ -21,6 +21,7 @@
 //! folder named `clips/` is always complete.
 
 use crate::error::{Error, Result};
+use crate::export::csv::read_transitions;
 use crate::export::png::{heatmap, FrameDumper, HEATMAP_FULL_SCALE};
 use crate::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
 use image::codecs::gif::{GifEncoder, Repeat};
@@ -190,20 +191,6 @@ pub struct ClipEntry {
     pub tiles: Vec<[u32; 4]>,
 }
 
-fn results_error(dir: &Path, problem: impl Into<String>) -> Error {
-    Error::Results {
-        path: dir.to_path_buf(),
-        problem: problem.into(),
-    }
-}
-
-fn image_error(path: &Path, e: impl std::fmt::Display) -> Error {
-    Error::Image {
-        path: path.to_path_buf(),
-        problem: e.to_string(),
-    }
-}
-
 /// Per (scene, count, frame): k_mean and t_instances from frames.csv (of any method: they are the schedule's,
 /// the same for every method).
 type FrameFactsMap = BTreeMap<(String, u32, u32), (Option<f64>, Option<u32>)>;
@@ -218,7 +205,7 @@ fn frame_facts(dir: &Path) -> Result<FrameFactsMap> {
     let headers = reader.headers()?.clone();
     let at = |name: &str| headers.iter().position(|h| h == name);
     let (Some(scene), Some(count), Some(frame)) = (at("scene"), at("count"), at("frame")) else {
-        return Err(results_error(
+        return Err(Error::results(
             dir,
             "frames.csv has no scene, count and frame columns",
         ));
@@ -228,7 +215,7 @@ fn frame_facts(dir: &Path) -> Result<FrameFactsMap> {
         let rec = rec?;
         let parse_u32 = |i: usize| rec.get(i).and_then(|v| v.parse::<u32>().ok());
         let (Some(c), Some(f)) = (parse_u32(count), parse_u32(frame)) else {
-            return Err(results_error(
+            return Err(Error::results(
                 dir,
                 format!("frames.csv: a row without a count or frame: {rec:?}"),
             ));
@@ -246,37 +233,21 @@ fn frame_facts(dir: &Path) -> Result<FrameFactsMap> {
 /// Makes every clip of `dir` and returns the index written to `dir/clips/index.json`.
 pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
     if !dir.is_dir() {
-        return Err(results_error(dir, "is not a folder"));
+        return Err(Error::results(dir, "is not a folder"));
     }
     if dir.join("experiment.json").is_file() && !dir.join("transitions.csv").is_file() {
-        return Err(results_error(
+        return Err(Error::results(
             dir,
             "is an experiment's folder: give one of its run folders",
         ));
     }
-    let transitions_csv = dir.join("transitions.csv");
-    if !transitions_csv.is_file() {
-        return Err(results_error(
-            dir,
-            "has no transitions.csv (a complete lodbench run, made with this version?)",
-        ));
-    }
-    let frames_dir = dir.join("frames");
-    if !frames_dir.is_dir() {
-        return Err(results_error(
-            dir,
-            "has no frames/: run with --dump-frames --dump-transitions",
-        ));
-    }
+    let rows = read_transitions(dir)?;
+    let frames_dir = FrameDumper::dumps_of(dir)?;
     if settings.columns == 0 || settings.fps == 0 || settings.scale == Some(0) {
         return Err(Error::Config(
             "clips: --columns, --fps and --scale must be at least 1".into(),
         ));
     }
-    let mut reader = csv::Reader::from_path(&transitions_csv)?;
-    let rows = reader
-        .deserialize::<TransitionRecord>()
-        .collect::<std::result::Result<Vec<_>, _>>()?;
     let mut run_methods: Vec<String> = Vec::new();
     for r in &rows {
         if r.method != "reference" && !run_methods.contains(&r.method) {
@@ -288,7 +259,7 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
         Some(list) => {
             for m in list {
                 if !run_methods.contains(m) {
-                    return Err(results_error(
+                    return Err(Error::results(
                         dir,
                         format!(
                             "--methods {m}: not a method of this run (its methods: {})",
@@ -301,7 +272,7 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
         }
     };
     if methods.is_empty() {
-        return Err(results_error(
+        return Err(Error::results(
             dir,
             "has no method but the reference to show",
         ));
@@ -317,7 +288,7 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
         }
     }
     if paths.is_empty() {
-        return Err(results_error(
+        return Err(Error::results(
             dir,
             "transitions.csv has no transition: nothing to show",
         ));
@@ -325,7 +296,7 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
     if let Some(wanted) = &settings.transitions {
         let last = paths.iter().map(|p| p.transition).max().unwrap_or_default();
         if let Some(bad) = wanted.iter().find(|&&t| t > last) {
-            return Err(results_error(
+            return Err(Error::results(
                 dir,
                 format!("--transitions {bad}: the run's transitions are 0 to {last}"),
             ));
@@ -334,10 +305,7 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
     }
     let facts = frame_facts(dir)?;
     let dump = |scene: &str, method: &str, count: u32, f: u32, kind: &str| -> PathBuf {
-        frames_dir.join(format!(
-            "{}_{kind}.png",
-            FrameDumper::stem(scene, method, count, f)
-        ))
+        FrameDumper::path(&frames_dir, (scene, method, count, f), kind)
     };
 
     let ffmpeg = match settings.mp4 {
@@ -391,7 +359,7 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
                 })
                 .collect();
             if frames.is_empty() {
-                return Err(results_error(
+                return Err(Error::results(
                 dir,
                 format!(
                     "frames/ has no dumps of {} {} around transition {} (frames {}-{}) for every method shown: \
@@ -457,7 +425,7 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
                     .chain(&errors)
                     .any(|p| p.dimensions() != size)
                 {
-                    return Err(results_error(
+                    return Err(Error::results(
                         dir,
                         format!("the dumps of frame {f} of {} differ in size", t.scene),
                     ));
@@ -466,7 +434,7 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
             }
             let (w, h) = loaded[0].0[0].dimensions();
             if loaded.iter().any(|(p, _)| p[0].dimensions() != (w, h)) {
-                return Err(results_error(
+                return Err(Error::results(
                     dir,
                     format!("the dumps of {} differ in size between frames", t.scene),
                 ));
@@ -548,7 +516,7 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
     }
     if index.clips.is_empty() {
         let _ = std::fs::remove_dir_all(&partial);
-        return Err(results_error(
+        return Err(Error::results(
             dir,
             "no scene of the run has a method shown and a transition",
         ));
@@ -580,7 +548,7 @@ pub fn spread(frames: &[u32], max: u32) -> Vec<u32> {
 
 fn load(path: &Path) -> Result<RgbaImage> {
     Ok(image::open(path)
-        .map_err(|e| image_error(path, e))?
+        .map_err(|e| Error::image(path, e))?
         .to_rgba8())
 }
 
@@ -601,7 +569,7 @@ fn save(path: &Path, img: &RgbaImage) -> Result<()> {
         img.height(),
         image::ExtendedColorType::Rgba8,
     )
-    .map_err(|e| image_error(path, e))
+    .map_err(|e| Error::image(path, e))
 }
 
 /// The heat-map of `picture` against `reference`, for dumps made without their `_error.png`.
@@ -738,7 +706,7 @@ fn write_apng(path: &Path, frames: &[RgbaImage], fps: u32) -> Result<()> {
     let Some(first) = frames.first() else {
         return Ok(());
     };
-    let png_error = |e: png::EncodingError| image_error(path, e);
+    let png_error = |e: png::EncodingError| Error::image(path, e);
     let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
     let mut encoder =
         png::Encoder::new(std::io::BufWriter::new(file), first.width(), first.height());
@@ -763,7 +731,7 @@ fn write_gif(path: &Path, frames: &[RgbaImage], fps: u32) -> Result<()> {
     let mut encoder = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
     encoder
         .set_repeat(Repeat::Infinite)
-        .map_err(|e| image_error(path, e))?;
+        .map_err(|e| Error::image(path, e))?;
     let delay = Delay::from_numer_denom_ms(1000, fps);
     encoder
         .encode_frames(
@@ -771,7 +739,7 @@ fn write_gif(path: &Path, frames: &[RgbaImage], fps: u32) -> Result<()> {
                 .iter()
                 .map(|f| Frame::from_parts(f.clone(), 0, 0, delay)),
         )
-        .map_err(|e| image_error(path, e))
+        .map_err(|e| Error::image(path, e))
 }
 
 fn ffmpeg_available() -> bool {
@@ -819,7 +787,7 @@ fn write_mp4(path: &Path, frames: &[RgbaImage], fps: u32) -> Result<()> {
         .wait_with_output()
         .map_err(|e| Error::io(Path::new("ffmpeg"), e))?;
     if !output.status.success() {
-        return Err(image_error(
+        return Err(Error::image(
             path,
             format!(
                 "ffmpeg failed: {}",

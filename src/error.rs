@@ -51,6 +51,22 @@ impl Error {
         }
     }
 
+    /// A results folder that is not what a command needs (`lodbench perceptual`, `lodbench clips`).
+    pub fn results(path: impl Into<PathBuf>, problem: impl Into<String>) -> Self {
+        Error::Results {
+            path: path.into(),
+            problem: problem.into(),
+        }
+    }
+
+    /// An image that cannot be read or written.
+    pub fn image(path: impl Into<PathBuf>, problem: impl std::fmt::Display) -> Self {
+        Error::Image {
+            path: path.into(),
+            problem: problem.to_string(),
+        }
+    }
+
     pub fn unknown(kind: &'static str, name: &str, valid: &[&str]) -> Self {
         Error::UnknownName {
             kind,

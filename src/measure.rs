@@ -320,6 +320,8 @@ pub struct BlockRunner<'a> {
     /// against the reference (shadow_rmse) and against each other (shadow_lodpop).
     shadow: Option<ShadowPass>,
     shadow_share: Option<ShadowShare>,
+    /// `--shadows on`: each frame's light matrix and depth bias ([`frame_lights`]).
+    lights: Vec<(Mat4, f32)>,
 }
 
 struct ShadowShare {
@@ -413,6 +415,7 @@ impl<'a> BlockRunner<'a> {
         };
         ctx.check_errors()?;
         Ok(BlockRunner {
+            lights: frame_lights(scene),
             shadow,
             shadow_share,
             taa,
@@ -655,23 +658,31 @@ impl<'a> BlockRunner<'a> {
         Ok(())
     }
 
+    /// `--shadows on`, outside the quality pass: what `m` casts this frame, into its shadow map.
+    fn own_shadow(
+        &self,
+        m: &TimedMethod<'_>,
+        input: &FrameInput<'_>,
+    ) -> Option<wgpu::CommandBuffer> {
+        let reference = is_reference(&m.label);
+        self.shadow_commands(
+            m.method.as_ref(),
+            input,
+            input.states,
+            (SHADOW_METHOD, false, reference),
+        )
+    }
+
     fn render_untimed(&self, m: &mut TimedMethod<'_>, f: u32) -> Result<()> {
         check_interrupt()?;
         let ctx = self.ctx;
-        self.gpu.write_camera(&self.scene.camera(f));
-        self.write_light(f);
+        self.write_frame(f);
         self.gpu.use_shadow_map(SHADOW_METHOD);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let input = m.driver.input(f);
         m.method
             .encode(&self.gpu, &input, &mut encoder, &self.timing_target);
-        let reference = is_reference(&m.label);
-        let shadow = self.shadow_commands(
-            m.method.as_ref(),
-            &input,
-            input.states,
-            (SHADOW_METHOD, false, reference),
-        );
+        let shadow = self.own_shadow(m, &input);
         ctx.queue
             .submit(shadow.into_iter().chain([encoder.finish()]));
         ctx.wait_idle()
@@ -686,15 +697,14 @@ impl<'a> BlockRunner<'a> {
         frames: std::ops::Range<u32>,
         progress: &ProgressBar,
     ) -> Result<()> {
-        let (scene, ctx) = (self.scene, self.ctx);
+        let ctx = self.ctx;
         let uploads_before = self.gpu.uploads.get();
         let start = Instant::now();
         for f in frames {
             check_interrupt()?;
             m.facts.push(m.driver.advance(f));
             let t0 = Instant::now();
-            self.gpu.write_camera(&scene.camera(f));
-            self.write_light(f);
+            self.write_frame(f);
             self.gpu.use_shadow_map(SHADOW_METHOD);
             // With --shadows on the shadow pass goes in a command buffer of its own, before the frame's (it
             // draws what the method decided in `encode`); the method's timestamps open it.
@@ -714,13 +724,7 @@ impl<'a> BlockRunner<'a> {
             if let Some(t) = &m.timer {
                 t.end(&mut encoder, f);
             }
-            let reference = is_reference(&m.label);
-            let shadow = self.shadow_commands(
-                m.method.as_ref(),
-                &input,
-                input.states,
-                (SHADOW_METHOD, false, reference),
-            );
+            let shadow = self.own_shadow(m, &input);
             ctx.queue.submit(
                 [first.finish()]
                     .into_iter()
@@ -739,30 +743,12 @@ impl<'a> BlockRunner<'a> {
         Ok(())
     }
 
-    /// `--shadows on`: this frame's light, fitted to the casters' bounding spheres (every instance but the
-    /// ground), with room behind them for the receivers.
-    fn write_light(&self, f: u32) {
-        let scene = self.scene;
-        if scene.shadows.is_none() {
-            return;
+    /// The frame's camera, and with `--shadows on` its light (`lights`), into the camera uniform.
+    fn write_frame(&self, f: u32) {
+        self.gpu.write_camera(&self.scene.camera(f));
+        if let Some((light, bias)) = self.lights.get(f as usize) {
+            self.gpu.write_light(light, *bias);
         }
-        let spheres: Vec<(glam::Vec3, f32)> = scene
-            .instances
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| scene.ground != Some(*i))
-            .map(|(i, inst)| {
-                (
-                    scene.instance_position(i, f),
-                    scene.models[inst.model as usize].radius,
-                )
-            })
-            .collect();
-        let r = spheres.iter().map(|s| s.1).fold(0.0f32, f32::max);
-        let (light, depth) =
-            crate::shadow::light_matrix(glam::Vec3::from(crate::gpu::LIGHT_DIR), &spheres, 3.0 * r);
-        self.gpu
-            .write_light(&light, crate::shadow::BIAS_OF_RADIUS * r / depth.max(1e-6));
     }
 
     /// `--shadows on`: a command buffer, to be submitted before the frame's, that draws into shadow map `map`
@@ -821,8 +807,7 @@ impl<'a> BlockRunner<'a> {
         for f in 0..frames {
             check_interrupt()?;
             driver.advance(f);
-            self.gpu.write_camera(&scene.camera(f));
-            self.write_light(f);
+            self.write_frame(f);
             if let Some((resolve, m, r)) = &self.taa {
                 resolve.begin_frame(ctx, m);
                 resolve.begin_frame(ctx, r);
@@ -1048,6 +1033,38 @@ impl<'a> BlockRunner<'a> {
             metric_gpu_ms_median,
         })
     }
+}
+
+/// `--shadows on`: every frame's light and depth bias, fitted to the casters' bounding spheres (every instance
+/// but the ground) with room behind them for the receivers; the same for every method, so computed once per
+/// block. Empty without shadows.
+fn frame_lights(scene: &Scene) -> Vec<(Mat4, f32)> {
+    if scene.shadows.is_none() {
+        return Vec::new();
+    }
+    (0..scene.frames)
+        .map(|f| {
+            let spheres: Vec<(glam::Vec3, f32)> = scene
+                .instances
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| scene.ground != Some(*i))
+                .map(|(i, inst)| {
+                    (
+                        scene.instance_position(i, f),
+                        scene.models[inst.model as usize].radius,
+                    )
+                })
+                .collect();
+            let r = spheres.iter().map(|s| s.1).fold(0.0f32, f32::max);
+            let (light, depth) = crate::shadow::light_matrix(
+                glam::Vec3::from(crate::gpu::LIGHT_DIR),
+                &spheres,
+                3.0 * r,
+            );
+            (light, crate::shadow::BIAS_OF_RADIUS * r / depth.max(1e-6))
+        })
+        .collect()
 }
 
 fn build<'b>(gpu: &'b SceneGpu, scene: &'b Scene, setup: &'b MethodSetup) -> Build<'b> {

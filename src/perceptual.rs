@@ -7,6 +7,7 @@
 //! writes `perceptual.csv` beside them with each transition's lodpop for comparison.
 
 use crate::error::{Error, Result};
+use crate::export::csv::read_transitions;
 use crate::export::png::FrameDumper;
 use crate::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
 use colorvideovdp::{Color, Cvvdp, DisplayModel, Execution, Image, Options};
@@ -41,20 +42,10 @@ pub struct PerceptualSettings {
     pub fps: f32,
 }
 
-fn results_error(dir: &Path, problem: impl Into<String>) -> Error {
-    Error::Results {
-        path: dir.to_path_buf(),
-        problem: problem.into(),
-    }
-}
-
 /// A dumped PNG as ColorVideoVDP's input: interleaved RGB, the stored sRGB-encoded values in [0, 1].
 fn load(path: &Path) -> Result<Image> {
     let img = image::open(path)
-        .map_err(|e| Error::Image {
-            path: path.to_path_buf(),
-            problem: e.to_string(),
-        })?
+        .map_err(|e| Error::image(path, e))?
         .to_rgb8();
     let (w, h) = img.dimensions();
     let data = img
@@ -67,24 +58,8 @@ fn load(path: &Path) -> Result<Image> {
 
 /// Scores every method's clip of every transition in `dir` and writes `dir/perceptual.csv`.
 pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<PerceptualRecord>> {
-    let transitions_csv = dir.join("transitions.csv");
-    if !transitions_csv.is_file() {
-        return Err(results_error(
-            dir,
-            "has no transitions.csv (a complete lodbench run, made with this version?)",
-        ));
-    }
-    let frames_dir = dir.join("frames");
-    if !frames_dir.is_dir() {
-        return Err(results_error(
-            dir,
-            "has no frames/: run with --dump-frames --dump-transitions",
-        ));
-    }
-    let mut reader = csv::Reader::from_path(&transitions_csv)?;
-    let transitions = reader
-        .deserialize::<TransitionRecord>()
-        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let transitions = read_transitions(dir)?;
+    let frames_dir = FrameDumper::dumps_of(dir)?;
     let display = DisplayModel::from_name(&settings.display).map_err(|e| {
         let names = DisplayModel::names().unwrap_or_default().join(", ");
         Error::Perceptual(format!(
@@ -107,10 +82,7 @@ pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<Perceptual
             .unwrap_or(t.last_frame)
     };
     let path_of = |t: &TransitionRecord, method: &str, f: u32, kind: &str| -> PathBuf {
-        frames_dir.join(format!(
-            "{}_{kind}.png",
-            FrameDumper::stem(&t.scene, method, t.count, f)
-        ))
+        FrameDumper::path(&frames_dir, (&t.scene, method, t.count, f), kind)
     };
     let mut out = Vec::new();
     for t in transitions.iter().filter(|t| t.method != "reference") {
@@ -125,7 +97,7 @@ pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<Perceptual
         for f in first..=last {
             let m = path_of(t, &t.method, f, "method");
             if !m.is_file() {
-                return Err(results_error(
+                return Err(Error::results(
                     dir,
                     format!(
                         "{} is missing: the clip of transition {} needs every frame from {first} to {last} \

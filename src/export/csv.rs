@@ -76,6 +76,21 @@ pub fn write_transitions(dir: &Path, rows: &[TransitionRecord]) -> Result<PathBu
 }
 
 /// Writes rounds.csv (whole or not at all).
+/// The transitions.csv of the run folder `dir` (what `lodbench perceptual` and `lodbench clips` start from);
+/// its absence is one error naming the folder.
+pub fn read_transitions(dir: &Path) -> Result<Vec<TransitionRecord>> {
+    let path = dir.join(TRANSITIONS_CSV);
+    if !path.is_file() {
+        return Err(Error::results(
+            dir,
+            "has no transitions.csv (a complete lodbench run, made with this version?)",
+        ));
+    }
+    Ok(::csv::Reader::from_path(&path)?
+        .deserialize::<TransitionRecord>()
+        .collect::<std::result::Result<Vec<_>, _>>()?)
+}
+
 pub fn write_rounds(dir: &Path, rows: &[RoundRecord]) -> Result<PathBuf> {
     write_whole(dir, ROUNDS_CSV, rows)
 }

@@ -24,6 +24,30 @@ impl FrameDumper {
         format!("{scene}_{method}_c{count}_f{frame:05}")
     }
 
+    /// The dumps folder of the run folder `dir`; its absence is one error saying how to make it.
+    pub fn dumps_of(dir: &Path) -> Result<PathBuf> {
+        let frames = dir.join("frames");
+        if !frames.is_dir() {
+            return Err(Error::results(
+                dir,
+                "has no frames/: run with --dump-frames --dump-transitions",
+            ));
+        }
+        Ok(frames)
+    }
+
+    /// In the dumps folder `frames`, the image `kind` (`method`, `reference`, `error`, ...) of one frame.
+    pub fn path(
+        frames: &Path,
+        (scene, method, count, frame): (&str, &str, u32, u32),
+        kind: &str,
+    ) -> PathBuf {
+        frames.join(format!(
+            "{}_{kind}.png",
+            Self::stem(scene, method, count, frame)
+        ))
+    }
+
     #[allow(
         clippy::too_many_arguments,
         reason = "a frame's images and their identity: grouping them would only add a struct used once"
@@ -40,44 +64,21 @@ impl FrameDumper {
         reference_rgba: &[u8],
         extras: &[(&str, Vec<u8>)],
     ) -> Result<()> {
-        let stem = Self::stem(scene, method, count, frame);
+        let id = (scene, method, count, frame);
+        let at = |kind: &str| Self::path(&self.dir, id, kind);
         for (name, rgba) in extras {
-            save(
-                &self.dir.join(format!("{stem}_{name}.png")),
-                width,
-                height,
-                rgba,
-            )?;
+            save(&at(name), width, height, rgba)?;
         }
-        save(
-            &self.dir.join(format!("{stem}_method.png")),
-            width,
-            height,
-            method_rgba,
-        )?;
-        save(
-            &self.dir.join(format!("{stem}_reference.png")),
-            width,
-            height,
-            reference_rgba,
-        )?;
+        save(&at("method"), width, height, method_rgba)?;
+        save(&at("reference"), width, height, reference_rgba)?;
         let heat = heatmap(&difference_image(method_rgba, reference_rgba));
-        save(
-            &self.dir.join(format!("{stem}_error.png")),
-            width,
-            height,
-            &heat,
-        )
+        save(&at("error"), width, height, &heat)
     }
 }
 
 fn save(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
-    image::save_buffer(path, rgba, width, height, image::ExtendedColorType::Rgba8).map_err(|e| {
-        Error::Image {
-            path: path.to_path_buf(),
-            problem: e.to_string(),
-        }
-    })
+    image::save_buffer(path, rgba, width, height, image::ExtendedColorType::Rgba8)
+        .map_err(|e| Error::image(path, e))
 }
 
 /// Black (no difference) through red and yellow to white (HEATMAP_FULL_SCALE or more).

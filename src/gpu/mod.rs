@@ -21,4 +21,4 @@ pub use instances::{changed_runs, InstanceBuffer, UploadCounters};
 pub use pipelines::{vertex_layouts, MeshPipeline, Vertex, MESH_WGSL};
 pub use readback::{read_texture, TextureReadback};
 pub use scene_gpu::{LodRange, SceneGpu, AMBIENT, LIGHT_DIR};
-pub use targets::RenderTarget;
+pub use targets::{texture_2d, RenderTarget, ATTACHMENT_READ};

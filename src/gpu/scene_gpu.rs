@@ -6,7 +6,7 @@ use crate::gpu::context::GpuContext;
 use crate::gpu::draw_list::{DrawList, DrawStats, PipelineIndex};
 use crate::gpu::instances::{InstanceBuffer, UploadCounters};
 use crate::gpu::pipelines::{mesh_pipeline, MeshPipeline, Vertex, MESH_WGSL};
-use crate::gpu::targets::RenderTarget;
+use crate::gpu::targets::{texture_2d, RenderTarget, ATTACHMENT_READ};
 use crate::scene::{Camera, Scene, BACKGROUND};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -212,22 +212,13 @@ impl SceneGpu {
         let shadow_maps: Vec<wgpu::Texture> = (0..maps)
             .map(|i| {
                 let side = if i == SHADOW_NONE { 1 } else { shadow_size };
-                device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(&format!("shadow map {i}")),
-                    size: wgpu::Extent3d {
-                        width: side,
-                        height: side,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: crate::formats::DEPTH_FORMAT,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                        | wgpu::TextureUsages::TEXTURE_BINDING
-                        | wgpu::TextureUsages::COPY_SRC,
-                    view_formats: &[],
-                })
+                texture_2d(
+                    device,
+                    &format!("shadow map {i}"),
+                    (side, side),
+                    crate::formats::DEPTH_FORMAT,
+                    ATTACHMENT_READ,
+                )
             })
             .collect();
         let shadow_views: Vec<wgpu::TextureView> = shadow_maps
@@ -373,20 +364,13 @@ impl SceneGpu {
     /// `dither`, the visibility texture of FSI. Read with `textureLoad` (no sampler).
     pub fn create_value_texture(&self, label: &str, side: u32, values: &[f32]) -> wgpu::Texture {
         debug_assert_eq!(values.len(), (side * side) as usize);
-        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width: side,
-                height: side,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+        let texture = texture_2d(
+            &self.device,
+            label,
+            (side, side),
+            wgpu::TextureFormat::R32Float,
+            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        );
         self.queue.write_texture(
             texture.as_image_copy(),
             bytemuck::cast_slice(values),
@@ -411,6 +395,30 @@ impl SceneGpu {
     }
 
     /// Begins a pass on a colour and a depth view, clearing both (`clear`) or keeping what they hold.
+    /// A depth-only pass into `depth`, cleared to 1 (alpha-2pass's nearest surface, the shadow pass).
+    pub fn begin_depth_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        depth: &wgpu::TextureView,
+        label: &str,
+    ) -> wgpu::RenderPass<'e> {
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+    }
+
     pub fn begin_pass<'e>(
         &self,
         encoder: &'e mut wgpu::CommandEncoder,

@@ -55,21 +55,7 @@ impl ShadowPass {
     ) -> DrawStats {
         let buffer = &self.buffers[map];
         gpu.upload(buffer, list);
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("shadow pass"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &gpu.shadow_views[map],
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = gpu.begin_depth_pass(encoder, &gpu.shadow_views[map], "shadow pass");
         let active = gpu.active_shadow_map();
         gpu.use_shadow_map(SHADOW_NONE);
         let stats = gpu.draw(&mut pass, buffer, 0, list, &[&self.whole, &self.dithered]);

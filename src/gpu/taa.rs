@@ -5,7 +5,7 @@
 
 use crate::formats::COLOR_FORMAT;
 use crate::gpu::context::GpuContext;
-use crate::gpu::targets::RenderTarget;
+use crate::gpu::targets::{texture_2d, RenderTarget, ATTACHMENT_READ};
 use crate::taa::Taa;
 
 pub const TAA_WGSL: &str = include_str!("../../shaders/taa.wgsl");
@@ -30,31 +30,6 @@ pub struct TaaStream {
     first: bool,
     width: u32,
     height: u32,
-}
-
-fn texture(
-    device: &wgpu::Device,
-    label: &str,
-    w: u32,
-    h: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
 }
 
 impl TaaResolve {
@@ -90,37 +65,22 @@ impl TaaResolve {
 
     pub fn stream(&self, ctx: &GpuContext, label: &str, width: u32, height: u32) -> TaaStream {
         let d = &ctx.device;
+        let texture = |name: &str, format| {
+            texture_2d(
+                d,
+                &format!("{label} taa {name}"),
+                (width, height),
+                format,
+                ATTACHMENT_READ,
+            )
+        };
         TaaStream {
             history: [
-                texture(
-                    d,
-                    &format!("{label} taa history 0"),
-                    width,
-                    height,
-                    HISTORY_FORMAT,
-                ),
-                texture(
-                    d,
-                    &format!("{label} taa history 1"),
-                    width,
-                    height,
-                    HISTORY_FORMAT,
-                ),
+                texture("history 0", HISTORY_FORMAT),
+                texture("history 1", HISTORY_FORMAT),
             ],
-            scratch_history: texture(
-                d,
-                &format!("{label} taa scratch"),
-                width,
-                height,
-                HISTORY_FORMAT,
-            ),
-            resolved: texture(
-                d,
-                &format!("{label} taa resolved"),
-                width,
-                height,
-                COLOR_FORMAT,
-            ),
+            scratch_history: texture("scratch", HISTORY_FORMAT),
+            resolved: texture("resolved", COLOR_FORMAT),
             params: d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(&format!("{label} taa params")),
                 size: 16,

@@ -2,6 +2,35 @@
 
 use crate::formats::{COLOR_FORMAT, DEPTH_FORMAT};
 
+/// A `width` x `height` 2D texture, one mip level, one sample: every texture lodbench makes.
+pub fn texture_2d(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// What an attachment that is also read (a shader's texture) and read back is made for.
+pub const ATTACHMENT_READ: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
+    .union(wgpu::TextureUsages::TEXTURE_BINDING)
+    .union(wgpu::TextureUsages::COPY_SRC);
+
 /// Colour (sRGB) and depth attachments of one viewport. The colour texture can also be viewed as plain
 /// Rgba8Unorm, which is how the metric kernels read the stored sRGB-encoded bytes.
 pub struct RenderTarget {
@@ -34,18 +63,13 @@ impl RenderTarget {
                 | wgpu::TextureUsages::COPY_DST,
             view_formats: &[wgpu::TextureFormat::Rgba8Unorm],
         });
-        let depth = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(&format!("{label} depth")),
-            size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let depth = texture_2d(
+            device,
+            &format!("{label} depth"),
+            (width, height),
+            DEPTH_FORMAT,
+            ATTACHMENT_READ,
+        );
         RenderTarget {
             width,
             height,

@@ -27,7 +27,7 @@
 use super::alpha::OVER;
 use super::common::{BlendLists, FrameInput, Method};
 use crate::formats::DEPTH_FORMAT;
-use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
+use crate::gpu::{texture_2d, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 use crate::schedule::InstanceState;
 
@@ -93,20 +93,13 @@ impl AlphaTwoPass {
                         count: None,
                     }],
                 });
-        let object_depth = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("alpha-2pass object depth"),
-            size: wgpu::Extent3d {
-                width: scene.width,
-                height: scene.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
+        let object_depth = texture_2d(
+            &gpu.device,
+            "alpha-2pass object depth",
+            (scene.width, scene.height),
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
         AlphaTwoPass {
             weights,
             lists: BlendLists::default(),
@@ -194,21 +187,11 @@ impl Method for AlphaTwoPass {
             for j in 0..d.instance_count {
                 let at = n_opaque + d.first_instance + j;
                 {
-                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some("alpha-2pass nearest surface"),
-                        color_attachments: &[],
-                        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                            view: &self.object_depth_view,
-                            depth_ops: Some(wgpu::Operations {
-                                load: wgpu::LoadOp::Clear(1.0),
-                                store: wgpu::StoreOp::Store,
-                            }),
-                            stencil_ops: None,
-                        }),
-                        timestamp_writes: None,
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    });
+                    let mut pass = gpu.begin_depth_pass(
+                        encoder,
+                        &self.object_depth_view,
+                        "alpha-2pass nearest surface",
+                    );
                     stats += gpu.draw_instances(
                         &mut pass,
                         &self.buffer,

@@ -51,7 +51,8 @@ use crate::error::Result;
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::GpuContext;
 use crate::gpu::{
-    read_texture, DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu,
+    read_texture, texture_2d, DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget,
+    SceneGpu, ATTACHMENT_READ,
 };
 use crate::noise::VisTexture;
 use crate::noise::{visibility_texture, VIS_TEXTURE_SIZE};
@@ -237,22 +238,13 @@ pub struct LodBufferImage {
 impl LodBuffer {
     fn new(gpu: &SceneGpu, label: &str, w: u32, h: u32, format: wgpu::TextureFormat) -> Self {
         let target = RenderTarget::new(&gpu.device, label, w, h);
-        let id = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(&format!("{label} id")),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
+        let id = texture_2d(
+            &gpu.device,
+            &format!("{label} id"),
+            (w, h),
             format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+            ATTACHMENT_READ,
+        );
         LodBuffer {
             id_view: id.create_view(&Default::default()),
             id,
@@ -507,20 +499,13 @@ impl Fsi {
             compilation_options: Default::default(),
             cache: None,
         });
-        let combined = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("fsi combined frame"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba8Unorm,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let combined = texture_2d(
+            device,
+            "fsi combined frame",
+            (w, h),
+            wgpu::TextureFormat::Rgba8Unorm,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        );
         let combined_view = combined.create_view(&Default::default());
         let combine_uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("fsi combine uniform"),
