@@ -8,15 +8,15 @@
 )]
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use lodbench::export::csv::FramesWriter;
-use lodbench::lod::{LodChain, DEFAULT_TARGETS};
-use lodbench::mesh::Mesh;
-use lodbench::metrics::SequenceMetrics;
-use lodbench::morph;
-use lodbench::records::FrameRecord;
+use lodbench::geometry::lod::{LodChain, DEFAULT_TARGETS};
+use lodbench::geometry::mesh::Mesh;
+use lodbench::geometry::morph;
+use lodbench::measure::metrics::SequenceMetrics;
+use lodbench::measure::records::FrameRecord;
+use lodbench::results::csv::FramesWriter;
 use lodbench::rng::SplitMix64;
+use lodbench::scene::schedule::{LodSchedule, ScheduleParams};
 use lodbench::scene::BUNNY_OBJ;
-use lodbench::schedule::{LodSchedule, ScheduleParams};
 use std::hint::black_box;
 
 fn lod_generation(c: &mut Criterion) {

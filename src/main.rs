@@ -1,10 +1,11 @@
 //! The `lodbench` binary: parse flags, dispatch, print one line on error.
 
 use clap::Parser;
+use lodbench::cli::config::RunConfig;
 use lodbench::cli::{Cli, Command, DescribeArgs};
-use lodbench::config::RunConfig;
+use lodbench::commands::run as runner;
 use lodbench::scene::{SceneConfig, SceneDef, SceneKind};
-use lodbench::{gpu, methods, runner, Error};
+use lodbench::{gpu, methods, Error};
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
 
@@ -72,7 +73,7 @@ fn run(args: &lodbench::cli::RunArgs) -> lodbench::Result<()> {
 }
 
 fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
-    let mut e = lodbench::experiment::Experiment::load_with(&args.file, &args.set)?;
+    let mut e = lodbench::commands::experiment::Experiment::load_with(&args.file, &args.set)?;
     if let Some(a) = &args.adapter {
         for r in &mut e.runs {
             r.config.adapter = Some(a.clone());
@@ -91,7 +92,7 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
     let shard = args
         .shard
         .as_deref()
-        .map(lodbench::experiment::Shard::parse)
+        .map(lodbench::commands::experiment::Shard::parse)
         .transpose()?;
     if args.check || args.list {
         let n = shard.map_or(1, |s| s.count);
@@ -124,7 +125,7 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| runner::default_out_dir(&[e.name.as_str()]));
-    let options = lodbench::experiment::RunOptions {
+    let options = lodbench::commands::experiment::RunOptions {
         shard,
         resume: args.resume,
     };
@@ -134,7 +135,7 @@ fn experiment(args: &lodbench::cli::ExperimentArgs) -> lodbench::Result<()> {
 }
 
 fn merge(args: &lodbench::cli::MergeArgs) -> lodbench::Result<()> {
-    let m = lodbench::merge::merge(&args.dirs, &args.out, args.allow_partial)?;
+    let m = lodbench::commands::merge::merge(&args.dirs, &args.out, args.allow_partial)?;
     for l in &m.left_out {
         eprintln!("note: left out {l}");
     }
@@ -143,7 +144,7 @@ fn merge(args: &lodbench::cli::MergeArgs) -> lodbench::Result<()> {
 }
 
 fn clips(args: &lodbench::cli::ClipsArgs) -> lodbench::Result<()> {
-    let settings = lodbench::clips::ClipSettings {
+    let settings = lodbench::commands::clips::ClipSettings {
         methods: args.methods.clone(),
         columns: args.columns,
         scale: args.scale,
@@ -154,7 +155,7 @@ fn clips(args: &lodbench::cli::ClipsArgs) -> lodbench::Result<()> {
         gif: args.gif,
         mp4: args.mp4,
     };
-    let index = lodbench::clips::make(&args.dir, &settings)?;
+    let index = lodbench::commands::clips::make(&args.dir, &settings)?;
     for c in &index.clips {
         outln!(
             "{}: {} frames ({}-{}), {}{}",
@@ -172,23 +173,25 @@ fn clips(args: &lodbench::cli::ClipsArgs) -> lodbench::Result<()> {
     outln!(
         "{} clips in {}",
         index.clips.len(),
-        args.dir.join(lodbench::clips::CLIPS_DIR).display()
+        args.dir
+            .join(lodbench::commands::clips::CLIPS_DIR)
+            .display()
     );
     Ok(())
 }
 
 fn perceptual(args: &lodbench::cli::PerceptualArgs) -> lodbench::Result<()> {
-    let settings = lodbench::perceptual::PerceptualSettings {
+    let settings = lodbench::commands::perceptual::PerceptualSettings {
         display: args.display.clone(),
         fps: args.fps,
     };
-    let records = lodbench::perceptual::check(&args.dir, &settings)?;
-    out!("{}", lodbench::perceptual::table(&records));
+    let records = lodbench::commands::perceptual::check(&args.dir, &settings)?;
+    out!("{}", lodbench::commands::perceptual::table(&records));
     outln!(
         "{} clips scored; {}",
         records.len(),
         args.dir
-            .join(lodbench::perceptual::PERCEPTUAL_CSV)
+            .join(lodbench::commands::perceptual::PERCEPTUAL_CSV)
             .display()
     );
     Ok(())

@@ -3,15 +3,13 @@
 //! the scene's data (`crate::scene`), never the methods, the configuration or the runner.
 
 pub mod context;
-pub mod diff;
 pub mod draw_list;
 pub mod instances;
-pub mod metrics;
 pub mod pipelines;
 pub mod readback;
 pub mod scene_gpu;
-pub mod shadow;
-pub mod taa;
+pub mod shadow_pass;
+pub mod taa_resolve;
 pub mod targets;
 pub mod timing;
 

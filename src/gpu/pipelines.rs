@@ -11,7 +11,7 @@ use bytemuck::{Pod, Zeroable};
 pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
-    /// (u, v, kind, hub_y), see [`crate::mesh::Mesh::aux`].
+    /// (u, v, kind, hub_y), see [`crate::geometry::mesh::Mesh::aux`].
     pub aux: [f32; 4],
 }
 

@@ -263,10 +263,10 @@ impl SceneGpu {
         });
         let alpha_test = scene.models.iter().any(|m| {
             m.chain.lods.iter().any(|l| {
-                l.mesh
-                    .aux
-                    .iter()
-                    .any(|a| a[2] == crate::mesh::AUX_LEAF || a[2] == crate::mesh::AUX_LEAF_CLUSTER)
+                l.mesh.aux.iter().any(|a| {
+                    a[2] == crate::geometry::mesh::AUX_LEAF
+                        || a[2] == crate::geometry::mesh::AUX_LEAF_CLUSTER
+                })
             })
         });
         let cull = scene.unified.is_some().then_some(wgpu::Face::Back);

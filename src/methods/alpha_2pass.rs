@@ -28,8 +28,8 @@ use super::alpha::OVER;
 use super::common::{BlendLists, FrameInput, Method};
 use crate::formats::DEPTH_FORMAT;
 use crate::gpu::{texture_2d, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
+use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
-use crate::schedule::InstanceState;
 
 /// How a t-instance's two LODs are weighted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

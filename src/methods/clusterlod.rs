@@ -1,16 +1,16 @@
 //! `clusterlod`: the Nanite-style cluster DAG of meshoptimizer 1.x (`meshopt::clod_build`) on a unified
-//! scene's whole mesh, with the per-frame cut at `--pixel-error` ([`crate::clusterlod`]). Clusters are drawn
+//! scene's whole mesh, with the per-frame cut at `--pixel-error` ([`crate::geometry::cluster_dag`]). Clusters are drawn
 //! where the cut selects them, opaque; a cut change is a hard switch. The shared schedule's block states are
 //! not used: the cut is this method's own selection, and lodpop's counterfactual is the previous frame's cut
 //! drawn at this frame's pose ([`Method::selection_changed`]).
 
 use super::common::{FrameInput, Method};
-use crate::clusterlod::CutCamera;
 use crate::error::{Error, Result};
+use crate::geometry::cluster_dag::CutCamera;
 use crate::gpu::{DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu, Vertex};
+use crate::scene::schedule::InstanceState;
 use crate::scene::unified::Unified;
 use crate::scene::Scene;
-use crate::schedule::InstanceState;
 use glam::Mat4;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;

@@ -1,11 +1,11 @@
 //! What every method shares: the frame input, the `Method` trait, and the drawing helpers several methods use
 //! (the unpopping schedule and its draw lists, opaque one-LOD-per-instance drawing, per-instance data).
 
+use crate::effects::shadow::Caster;
 use crate::error::Result;
 use crate::gpu::{DrawList, DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu};
+use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
-use crate::schedule::InstanceState;
-use crate::shadow::Caster;
 use glam::Mat4;
 
 /// What a method gets for one frame.
@@ -106,7 +106,7 @@ pub trait Method {
     /// `before` true). Called after `encode` of the frame. The default, the blending methods' choice: the LOD
     /// out of transition, both LODs dithered at k in one (src/shadow.rs).
     fn shadow_caster(&self, states: &[InstanceState], i: usize, _before: bool) -> Caster {
-        Caster::blended(&states[i])
+        states[i].blended_caster()
     }
 }
 
@@ -114,7 +114,7 @@ pub trait Method {
 /// pipelines `gpu::shadow::CAST_WHOLE` and `CAST_DITHERED` (params: k, then 1 for the incoming LOD, 0 for the
 /// outgoing).
 pub fn shadow_list(input: &FrameInput<'_>, caster: impl Fn(usize) -> Caster, list: &mut DrawList) {
-    use crate::gpu::shadow::{CAST_DITHERED, CAST_WHOLE};
+    use crate::gpu::shadow_pass::{CAST_DITHERED, CAST_WHOLE};
     list.clear();
     for (i, inst) in input.scene.instances.iter().enumerate() {
         if input.scene.ground == Some(i) {

@@ -3,10 +3,10 @@
 //! switch distance itself).
 
 use super::common::{FrameInput, Method, OpaqueInstances};
+use crate::effects::shadow::Caster;
 use crate::gpu::{DrawStats, RenderTarget, SceneGpu};
+use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
-use crate::schedule::InstanceState;
-use crate::shadow::Caster;
 
 pub struct Discrete {
     draw: OpaqueInstances,

@@ -6,8 +6,8 @@
 
 use super::common::{instance_raw, FrameInput, Method};
 use crate::gpu::{DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
-use crate::noise::threshold_texture;
-use crate::noise::NoisePattern;
+use crate::methods::noise::threshold_texture;
+use crate::methods::noise::NoisePattern;
 use crate::scene::Scene;
 
 /// `dither`'s flags.
@@ -137,8 +137,8 @@ pub fn temporal_offset(size: u32, frame: u32) -> [f32; 2] {
     let i = frame % 16 + 1;
     let s = size as f32;
     [
-        (crate::taa::halton(i, 2) * s).floor(),
-        (crate::taa::halton(i, 3) * s).floor(),
+        (crate::effects::taa::halton(i, 2) * s).floor(),
+        (crate::effects::taa::halton(i, 3) * s).floor(),
     ]
 }
 

@@ -47,6 +47,7 @@
 //!   sequencing.
 
 use super::common::{instance_raw_with, FrameInput, Method};
+use crate::effects::shadow::Caster;
 use crate::error::Result;
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::GpuContext;
@@ -54,11 +55,10 @@ use crate::gpu::{
     read_texture, texture_2d, DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget,
     SceneGpu, ATTACHMENT_READ,
 };
-use crate::noise::VisTexture;
-use crate::noise::{visibility_texture, VIS_TEXTURE_SIZE};
+use crate::methods::noise::VisTexture;
+use crate::methods::noise::{visibility_texture, VIS_TEXTURE_SIZE};
+use crate::scene::schedule::InstanceState;
 use crate::scene::{Camera, Scene};
-use crate::schedule::InstanceState;
-use crate::shadow::Caster;
 use glam::{DMat4, Mat4};
 
 pub const COMBINE_WGSL: &str = include_str!("../../shaders/fsi_combine.wgsl");
@@ -863,7 +863,7 @@ impl Method for Fsi {
         };
         match self.choices[slot].get(i) {
             Some(c) => Caster::Lod(c.lod),
-            None => Caster::blended(&states[i]),
+            None => states[i].blended_caster(),
         }
     }
 

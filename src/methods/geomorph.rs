@@ -6,11 +6,11 @@
 //! once per LOD pair and cached.
 
 use super::common::{instance_raw, FrameInput, Method};
+use crate::geometry::morph::morph_targets;
+use crate::geometry::morph::Correspondence;
 use crate::gpu::{
     DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu, Vertex,
 };
-use crate::morph::morph_targets;
-use crate::morph::Correspondence;
 use crate::scene::Scene;
 use wgpu::util::DeviceExt;
 

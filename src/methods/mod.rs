@@ -15,6 +15,7 @@ pub mod discrete;
 pub mod dither;
 pub mod fsi;
 pub mod geomorph;
+pub mod noise;
 pub mod reference;
 
 pub use common::{instance_raw, instance_raw_with, FrameInput, Method, OpaqueInstances};

@@ -2,10 +2,10 @@
 //! compares every method against this.
 
 use super::common::{FrameInput, Method, OpaqueInstances};
+use crate::effects::shadow::Caster;
 use crate::gpu::{DrawStats, RenderTarget, SceneGpu};
+use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
-use crate::schedule::InstanceState;
-use crate::shadow::Caster;
 
 pub struct Reference {
     draw: OpaqueInstances,

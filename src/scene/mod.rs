@@ -8,19 +8,20 @@
 //!   others are still drawn (the paper turns occlusion culling off).
 
 use crate::error::{Error, Result};
-use crate::lod::{self, LodChain, LodInfo, DEFAULT_TARGETS};
-use crate::mesh::Mesh;
-use crate::schedule::ScheduleParams;
+use crate::geometry::lod::{self, LodChain, LodInfo, DEFAULT_TARGETS};
+use crate::geometry::mesh::Mesh;
+use crate::scene::schedule::ScheduleParams;
 use glam::{Mat4, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
 pub mod kind;
+pub mod schedule;
 pub mod unified;
 
 pub use kind::{CameraMode, Profile, ProfileValues, SceneKind, SweepStart, PAPER_COUNTS};
 
-/// Scene-defining settings after the profile is applied (built from the flags by `crate::config`).
+/// Scene-defining settings after the profile is applied (built from the flags by `crate::cli::config`).
 #[derive(Debug, Clone, Serialize)]
 pub struct SceneConfig {
     pub profile: Profile,
@@ -36,16 +37,16 @@ pub struct SceneConfig {
     pub sweep_start: Option<SweepStart>,
     pub switch_distances: Option<Vec<f32>>,
     /// `--partition` (bunny-halves, terrain).
-    pub partition: crate::blocks::PartitionMode,
+    pub partition: crate::geometry::blocks::PartitionMode,
     /// `--blocks`; None = the profile's.
     pub blocks: Option<u32>,
     pub counts: Option<Vec<u32>>,
     pub fov_deg: f32,
     pub schedule: ScheduleParams,
     /// `--taa on`: the jitter of every frame's camera and the resolve after it.
-    pub taa: Option<crate::taa::Taa>,
+    pub taa: Option<crate::effects::taa::Taa>,
     /// `--shadows on`: the shadow map (and a ground under the bunny scenes).
-    pub shadows: Option<crate::shadow::Shadows>,
+    pub shadows: Option<crate::effects::shadow::Shadows>,
 }
 
 impl SceneConfig {
@@ -189,9 +190,9 @@ pub struct Scene {
     /// transform); None elsewhere.
     pub unified: Option<Arc<unified::Unified>>,
     /// `--taa on`: every frame's projection is jittered ([`Scene::camera`]) and resolved (`gpu/taa.rs`).
-    pub taa: Option<crate::taa::Taa>,
+    pub taa: Option<crate::effects::taa::Taa>,
     /// `--shadows on`: the shadow map's settings (src/shadow.rs).
-    pub shadows: Option<crate::shadow::Shadows>,
+    pub shadows: Option<crate::effects::shadow::Shadows>,
     /// The instance that is the bunny scenes' ground with `--shadows on`: static, always LOD0, receives
     /// shadows and casts none, left out of `lod_mean`.
     pub ground: Option<usize>,
@@ -217,8 +218,8 @@ pub struct SceneDef {
     pub path: Option<BunnyPath>,
     /// The unified scenes' blocks, camera and frustum.
     pub unified: Option<Arc<UnifiedParts>>,
-    pub taa: Option<crate::taa::Taa>,
-    pub shadows: Option<crate::shadow::Shadows>,
+    pub taa: Option<crate::effects::taa::Taa>,
+    pub shadows: Option<crate::effects::shadow::Shadows>,
     /// `--shadows on` in the bunny scenes: the ground's model and position.
     pub ground: Option<(u32, Vec3)>,
 }
@@ -602,7 +603,7 @@ fn unified_def(
             "scenes/bunny.obj (npm bunny@1.0.1, built in)".to_string(),
         ),
         (None, _) => (
-            crate::terrain::terrain_mesh(SCENE_SEED, quads)?,
+            crate::geometry::terrain::terrain_mesh(SCENE_SEED, quads)?,
             format!("procedural (src/terrain.rs, seed SCENE_SEED = 2008, {quads} x {quads} cells)"),
         ),
     };
@@ -671,7 +672,7 @@ fn unified_def(
 }
 
 /// The models of a procedural scene, built once: SIMPLE's sphere and box, the windmill, the tree
-/// (`crate::procgen`). Switch distances: from the measured LOD errors and `--pixel-error` like the bunny's,
+/// (`crate::geometry::procgen`). Switch distances: from the measured LOD errors and `--pixel-error` like the bunny's,
 /// except SIMPLE, whose box is no approximation of the sphere at any distance: it switches at 12 sphere
 /// radii (at 320x240 and 60 degrees the sphere is then about 17 pixels across), or at `--switch-distances`.
 fn procedural_def(
@@ -686,17 +687,17 @@ fn procedural_def(
     let name = kind.name();
     let (chain, spin, source) = match kind {
         SceneKind::Simple => (
-            crate::procgen::simple_chain()?,
+            crate::geometry::procgen::simple_chain()?,
             0.0,
             "procedural (src/procgen.rs: sphere and box)",
         ),
         SceneKind::Windmills => (
-            crate::procgen::windmill_chain()?,
+            crate::geometry::procgen::windmill_chain()?,
             WINDMILL_SPIN_PER_FRAME,
             "procedural (src/procgen.rs: windmill)",
         ),
         _ => (
-            crate::procgen::tree_chain(SCENE_SEED)?,
+            crate::geometry::procgen::tree_chain(SCENE_SEED)?,
             0.0,
             "procedural (src/procgen.rs: tree, seed SCENE_SEED = 2008)",
         ),
@@ -841,7 +842,7 @@ fn ground_model(bunny: &Model, far: f32) -> (Model, Vec3) {
         lod_colors: Vec::new(),
         spin_per_frame: 0.0,
         chain: LodChain {
-            lods: vec![crate::lod::Lod {
+            lods: vec![crate::geometry::lod::Lod {
                 mesh,
                 target_fraction: 1.0,
                 error_abs: 0.0,

@@ -1,5 +1,5 @@
 //! The unified-LOD scenes (seeds 001 and 004): one large mesh divided into a 3D grid of blocks
-//! ([`crate::blocks`]), each block a model of its own with its own LOD chain and one instance at the identity
+//! ([`crate::geometry::blocks`]), each block a model of its own with its own LOD chain and one instance at the identity
 //! transform, so the shared schedule selects and fades each block on its own; the seams between neighbouring
 //! blocks, cross-referenced into every pair of their LODs; and the same mesh's cluster DAG for `clusterlod`.
 //!
@@ -16,16 +16,16 @@
 //!
 //! Switch distances of a block: where the LOD's error projects to `--pixel-error` pixels at the distance from
 //! the camera to the block's bounding sphere (distance to the centre minus the radius, the rule
-//! `clusterlod`'s cut uses too), i.e. [`crate::lod::switch_distance`] plus the radius, spread so that
+//! `clusterlod`'s cut uses too), i.e. [`crate::geometry::lod::switch_distance`] plus the radius, spread so that
 //! consecutive transition bands never overlap.
 
 use super::kind::SceneKind;
-use crate::blocks::{BlockLod, Grid, Partition, PartitionMode};
-use crate::clusterlod::ClusterDag;
 use crate::error::{Error, Result};
-use crate::lod::{Lod, LodChain};
-use crate::mesh::Mesh;
-use crate::schedule::ScheduleParams;
+use crate::geometry::blocks::{BlockLod, Grid, Partition, PartitionMode};
+use crate::geometry::cluster_dag::ClusterDag;
+use crate::geometry::lod::{Lod, LodChain};
+use crate::geometry::mesh::Mesh;
+use crate::scene::schedule::ScheduleParams;
 use glam::{DVec3, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
@@ -244,7 +244,7 @@ pub fn build(input: UnifiedInput<'_>) -> Result<UnifiedDef> {
             .zip(targets)
             .map(|(l, &f)| {
                 Ok(Lod {
-                    mesh: crate::lod::compact(&block_name, &full, &l.indices)?,
+                    mesh: crate::geometry::lod::compact(&block_name, &full, &l.indices)?,
                     target_fraction: f,
                     error_abs: l.error_abs,
                 })
@@ -338,9 +338,13 @@ pub fn build(input: UnifiedInput<'_>) -> Result<UnifiedDef> {
             UnifiedCamera::Flight(..) => {
                 let mut out: Vec<f32> = Vec::new();
                 for lod in &m.chain.lods[1..] {
-                    let d =
-                        crate::lod::switch_distance(lod.error_abs, 1.0, pixel_error, height, fov_y)
-                            + m.radius;
+                    let d = crate::geometry::lod::switch_distance(
+                        lod.error_abs,
+                        1.0,
+                        pixel_error,
+                        height,
+                        fov_y,
+                    ) + m.radius;
                     let d = match out.last() {
                         Some(&prev) if d < prev * band_ratio => prev * band_ratio,
                         _ => d,
@@ -396,7 +400,7 @@ pub fn build(input: UnifiedInput<'_>) -> Result<UnifiedDef> {
 fn seam_mesh(
     partition: &Partition,
     normals: &[Vec<[f32; 3]>],
-    pair: &crate::blocks::SeamPair,
+    pair: &crate::geometry::blocks::SeamPair,
     a: &BlockLod,
     b: &BlockLod,
 ) -> SeamMesh {

@@ -1,11 +1,66 @@
-//! The module graph of src/ has no circle: every file's imports (its `use` items and the paths it names through
-//! `crate::`, `super::` or a child module) point to files that never import it back, directly or through
-//! others. Test modules (`#[cfg(test)]`) are left out: they may import anything. docs/ARCHITECTURE.md shows the
-//! listing; `cargo test --test architecture -- --nocapture` prints it.
+//! The module graph of src/ follows the data path: every file's imports (its `use` items and the paths it names
+//! through `crate::`, `super::` or a child module) point to files of its own layer or of a layer below it in
+//! [`LAYERS`], and never form a circle. Test modules (`#[cfg(test)]`) are left out: they may import anything.
+//! docs/ARCHITECTURE.md shows the listing; `cargo test --test it architecture:: -- --nocapture` prints it.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use syn::visit::Visit;
+
+/// The layers of src/, top to bottom, each a list of folders (ending in `/`) and files. A file may import files of
+/// its own layer and of the layers after it, never of a layer before it. Every file of src/ must be in a layer.
+pub const LAYERS: &[(&str, &[&str])] = &[
+    ("commands", &["commands/"]),
+    ("results", &["results/"]),
+    ("cli", &["cli/"]),
+    ("measure", &["measure/"]),
+    ("methods", &["methods/"]),
+    ("gpu", &["gpu/"]),
+    ("scene", &["scene/"]),
+    ("effects", &["effects/"]),
+    ("geometry", &["geometry/"]),
+    (
+        "base",
+        &["lib.rs", "error.rs", "defaults.rs", "formats.rs", "rng.rs"],
+    ),
+];
+
+/// The index in `layers` of the layer holding `file` (relative to src/).
+fn layer_of(layers: &[(&str, &[&str])], file: &str) -> Option<usize> {
+    layers.iter().position(|(_, members)| {
+        members.iter().any(|m| {
+            if m.ends_with('/') {
+                file.starts_with(m)
+            } else {
+                file == *m
+            }
+        })
+    })
+}
+
+/// The imports against the layer order (`file -> dep (layer -> layer)`), and the files in no layer.
+fn against_layers(
+    layers: &[(&str, &[&str])],
+    edges: &BTreeMap<String, BTreeSet<String>>,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for (file, deps) in edges {
+        let Some(me) = layer_of(layers, file) else {
+            out.push(format!("{file} is in no layer"));
+            continue;
+        };
+        for dep in deps {
+            match layer_of(layers, dep) {
+                Some(l) if l < me => out.push(format!(
+                    "{file} -> {dep} ({} imports {}, a layer above it)",
+                    layers[me].0, layers[l].0
+                )),
+                _ => {}
+            }
+        }
+    }
+    out
+}
 
 /// A file's module path: src/gpu/mod.rs -> [gpu], src/gpu/targets.rs -> [gpu, targets].
 fn module_path(rel: &Path) -> Vec<String> {
@@ -218,13 +273,56 @@ fn circles(edges: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
     t.out
 }
 
+fn src_dir() -> PathBuf {
+    // ARCHITECTURE_SRC points the check at another tree (e.g. an older commit's src/, to compare).
+    std::env::var_os("ARCHITECTURE_SRC")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("src"))
+}
+
+#[test]
+fn imports_follow_the_layer_order() {
+    let against = against_layers(LAYERS, &imports(&src_dir()));
+    assert!(
+        against.is_empty(),
+        "imports against the layer order:\n{}",
+        against.join("\n")
+    );
+}
+
+#[test]
+fn an_import_against_the_layers_is_found() {
+    // The checker itself: a low layer importing a high one, a file in no layer, and an import downwards that
+    // is allowed.
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path();
+    std::fs::create_dir_all(src.join("top")).unwrap();
+    std::fs::create_dir_all(src.join("low")).unwrap();
+    std::fs::write(
+        src.join("lib.rs"),
+        "pub mod low;\npub mod top;\npub mod stray;\n",
+    )
+    .unwrap();
+    std::fs::write(src.join("top/mod.rs"), "pub fn f() { crate::low::g(); }\n").unwrap();
+    std::fs::write(
+        src.join("low/mod.rs"),
+        "use crate::top::f;\npub fn g() {}\n",
+    )
+    .unwrap();
+    std::fs::write(src.join("stray.rs"), "pub fn h() {}\n").unwrap();
+    let layers: &[(&str, &[&str])] = &[("top", &["top/"]), ("low", &["low/", "lib.rs"])];
+    assert_eq!(
+        against_layers(layers, &imports(src)),
+        vec![
+            "low/mod.rs -> top/mod.rs (low imports top, a layer above it)".to_string(),
+            "stray.rs is in no layer".to_string(),
+        ]
+    );
+}
+
 #[test]
 fn module_imports_form_no_circle() {
-    // ARCHITECTURE_SRC points the check at another tree (e.g. an older commit's src/, to compare).
-    let src = std::env::var_os("ARCHITECTURE_SRC")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("src"));
-    let edges = imports(&src);
+    let edges = imports(&src_dir());
     for (file, deps) in &edges {
         let deps: Vec<&str> = deps.iter().map(String::as_str).collect();
         println!("{file:<24} -> {}", deps.join(", "));

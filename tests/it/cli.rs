@@ -108,7 +108,7 @@ fn bad_meshes_name_the_file_and_the_problem() {
 /// The built-in bunny written as a binary glTF (one mesh, one node translated by (5, 0, 0), positions and
 /// indices only): the smallest GLB the spec allows, made here so the test needs no generator.
 fn bunny_glb() -> Vec<u8> {
-    let m = lodbench::mesh::Mesh::parse_obj("bunny", lodbench::scene::BUNNY_OBJ).unwrap();
+    let m = lodbench::geometry::mesh::Mesh::parse_obj("bunny", lodbench::scene::BUNNY_OBJ).unwrap();
     let mut bin: Vec<u8> = m
         .positions
         .iter()
@@ -186,7 +186,7 @@ fn gltf_mesh_gives_the_scene_the_obj_gives() {
     assert!(from_glb["mesh"].as_str().unwrap().ends_with("bunny.glb"));
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
     for f in ["tetra.gltf", "tetra.glb"] {
-        let m = lodbench::mesh::Mesh::load(&data.join(f)).unwrap();
+        let m = lodbench::geometry::mesh::Mesh::load(&data.join(f)).unwrap();
         assert_eq!((m.vertex_count(), m.triangle_count()), (8, 8), "{f}");
     }
 }

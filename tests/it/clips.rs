@@ -3,9 +3,9 @@
 
 use crate::cli::{fails_with, lodbench};
 use crate::regress::regress_run;
-use lodbench::clips::{make, ClipSettings, Mp4};
-use lodbench::export::png::FrameDumper;
-use lodbench::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use lodbench::commands::clips::{make, ClipSettings, Mp4};
+use lodbench::measure::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use lodbench::results::png::FrameDumper;
 use std::path::Path;
 
 fn transitions(dir: &Path) -> Vec<TransitionRecord> {

@@ -3,8 +3,8 @@
 
 use clap::Parser;
 use glam::Vec3;
+use lodbench::cli::config::RunConfig;
 use lodbench::cli::{Cli, Command, RunArgs};
-use lodbench::config::RunConfig;
 use lodbench::scene::{Motion, Scene, SceneConfig, SceneDef, SceneKind};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -29,7 +29,7 @@ pub fn run_config(args: &[&str]) -> RunConfig {
 pub fn run_into(out: &Path, args: &[&str]) -> PathBuf {
     let mut argv = args.to_vec();
     argv.extend_from_slice(&["--out", out.to_str().expect("a UTF-8 path")]);
-    lodbench::runner::run(&run_config(&argv)).expect("the run completes");
+    lodbench::commands::run::run(&run_config(&argv)).expect("the run completes");
     out.to_path_buf()
 }
 
@@ -175,7 +175,7 @@ pub fn snapshot_problem(actual: &image::RgbaImage, snap: &Path) -> Option<String
 /// triangles), each new vertex moved off the face by up to +-`amplitude` / 2 along its normal (a fixed hash of
 /// its index), as OBJ text: a denser mesh of the same shape with a scan's fine noise, which its LODs lose.
 pub fn subdivided_bunny_obj(levels: u32, amplitude: f32) -> String {
-    let m = lodbench::mesh::Mesh::parse_obj("bunny", lodbench::scene::BUNNY_OBJ).unwrap();
+    let m = lodbench::geometry::mesh::Mesh::parse_obj("bunny", lodbench::scene::BUNNY_OBJ).unwrap();
     let mut positions: Vec<Vec3> = m.positions.iter().map(|p| Vec3::from(*p)).collect();
     let mut indices = m.indices.clone();
     for _ in 0..levels {

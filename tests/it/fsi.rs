@@ -519,6 +519,6 @@ fn e_static_transitions_toggle_out_of_phase() {
     );
     // The first frame draws the scene twice.
     assert!(tris[0] > tris[1] * 3 / 2, "{tris:?}");
-    let alternation = lodbench::records::tri_alternation_max(&out.rows);
+    let alternation = lodbench::measure::records::tri_alternation_max(&out.rows);
     assert!(alternation < 0.02, "{alternation} {tris:?}");
 }

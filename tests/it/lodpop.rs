@@ -146,7 +146,10 @@ fn gpu_lodpop_and_lag_match_the_cpu_oracle() {
         };
         let now = load(&stem, "lodpop-now");
         if let Some(before) = load(&stem, "lodpop-before") {
-            let cpu = lodbench::metrics::rms_difference(now.as_ref().unwrap_or(&method), &before);
+            let cpu = lodbench::measure::metrics::rms_difference(
+                now.as_ref().unwrap_or(&method),
+                &before,
+            );
             let gpu: f64 = r["lodpop"].parse().unwrap();
             assert!(
                 (cpu - gpu).abs() < 1e-5,
@@ -155,7 +158,7 @@ fn gpu_lodpop_and_lag_match_the_cpu_oracle() {
             lodpop_checked += 1;
         }
         if let Some(now) = &now {
-            let cpu = lodbench::metrics::rms_difference(&method, now);
+            let cpu = lodbench::measure::metrics::rms_difference(&method, now);
             let gpu: f64 = r["lag_rmse"].parse().unwrap();
             assert!((cpu - gpu).abs() < 1e-5, "{stem}: lag gpu {gpu} cpu {cpu}");
             lag_checked += 1;

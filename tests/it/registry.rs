@@ -5,7 +5,7 @@
 
 use crate::common::read_csv;
 
-use lodbench::config::RunConfig;
+use lodbench::cli::config::RunConfig;
 use lodbench::gpu::{DrawStats, RenderTarget, SceneGpu};
 use lodbench::methods::{FrameInput, Method, MethodEntry, OpaqueInstances, Registry};
 use lodbench::scene::Scene;
@@ -69,7 +69,7 @@ fn a_method_added_with_one_registry_line_runs_like_a_builtin() {
     let err = RunConfig::from_args(&args).unwrap_err().to_string();
     assert!(err.contains("lod-to"), "{err}");
     let cfg = RunConfig::from_args_in(&args, &registry).unwrap();
-    lodbench::runner::run_with(&cfg, &registry).unwrap();
+    lodbench::commands::run::run_with(&cfg, &registry).unwrap();
 
     let rows = read_csv(&dir.path().join("frames.csv"));
     let of = |m: &str| -> Vec<&HashMap<String, String>> {

@@ -3,10 +3,10 @@
 use crate::common::{col, read_csv, run_config, snapshot_problem};
 
 use indicatif::ProgressBar;
+use lodbench::commands::run;
 use lodbench::gpu::GpuContext;
+use lodbench::measure::metrics::SequenceMetrics;
 use lodbench::measure::{BlockRunner, QualityOptions};
-use lodbench::metrics::SequenceMetrics;
-use lodbench::runner;
 use lodbench::scene::SceneKind;
 use std::path::Path;
 
@@ -27,7 +27,7 @@ fn ci_sweep_reference_and_discrete() {
         "--out",
         out_s,
     ]);
-    runner::run(&cfg).expect("run completes");
+    run::run(&cfg).expect("run completes");
     for f in ["frames.csv", "summary.csv", "run.json"] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
@@ -123,7 +123,7 @@ fn same_flags_same_metrics() {
             "--out",
             out.to_str().unwrap(),
         ]);
-        runner::run(&cfg).unwrap();
+        run::run(&cfg).unwrap();
         read_csv(&out.join("frames.csv"))
     };
     let a = run_once("a");
@@ -348,7 +348,7 @@ fn flip_metric_on_request() {
             "--out",
             out.to_str().unwrap(),
         ]);
-        runner::run(&cfg).unwrap();
+        run::run(&cfg).unwrap();
         read_csv(&out.join("frames.csv"))
     };
     let rows = run_with("flip", "rmse,pop,de2000,flip");
@@ -383,7 +383,7 @@ fn experiment_sweep_runs_and_merges() {
          frames = 4\nwarmup = 0\n[sweep]\nvariable = \"viewport\"\nvalues = [[64, 48], [96, 72]]\n",
     )
     .unwrap();
-    let e = lodbench::experiment::Experiment::load(&file).unwrap();
+    let e = lodbench::commands::experiment::Experiment::load(&file).unwrap();
     let out = dir.path().join("out");
     let folders = e.run(&out).unwrap();
     assert_eq!(folders.len(), 2);
@@ -421,7 +421,7 @@ fn snapshot_scenes_every_method() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    runner::run(&cfg).expect("every scene and method renders");
+    run::run(&cfg).expect("every scene and method renders");
     let snaps = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots/scenes");
     let bless = std::env::var_os("LODBENCH_BLESS").is_some();
     let mut problems = Vec::new();
@@ -484,7 +484,7 @@ fn timing_run(
         "--out",
         out.to_str().unwrap(),
     ]);
-    runner::run(&cfg).unwrap();
+    run::run(&cfg).unwrap();
     out
 }
 

@@ -2,16 +2,16 @@
 //! the shadow in the frames.
 
 use crate::common::{col, read_csv, run_into, scene_config};
+use lodbench::effects::shadow::{light_matrix, Caster};
 use lodbench::gpu::readback::read_texture;
 use lodbench::gpu::scene_gpu::SHADOW_METHOD;
-use lodbench::gpu::shadow::ShadowPass;
+use lodbench::gpu::shadow_pass::ShadowPass;
 use lodbench::gpu::{DrawList, GpuContext, SceneGpu};
 use lodbench::measure::FrameDriver;
 use lodbench::methods::common::{shadow_list, FrameInput, Method};
 use lodbench::methods::{alpha::Alpha, discrete::Discrete};
+use lodbench::scene::schedule::InstanceState;
 use lodbench::scene::{SceneDef, SceneKind};
-use lodbench::schedule::InstanceState;
-use lodbench::shadow::{light_matrix, Caster};
 
 /// Shadow map `SHADOW_METHOD` as `method` casts with the bunny at `state`, as read-back depth bytes.
 fn shadow_map(
@@ -239,7 +239,7 @@ fn bad_shadow_flags_are_refused() {
         let Command::Run(a) = Cli::try_parse_from(argv).unwrap().command else {
             unreachable!()
         };
-        let err = lodbench::config::RunConfig::from_args(&a)
+        let err = lodbench::cli::config::RunConfig::from_args(&a)
             .unwrap_err()
             .to_string();
         assert!(err.contains(needle), "{err}");

@@ -4,8 +4,8 @@
 use crate::common::{read_csv, run_into, scene_config};
 use indicatif::ProgressBar;
 use lodbench::gpu::{GpuContext, SceneGpu};
+use lodbench::measure::metrics::SequenceMetrics;
 use lodbench::measure::{BlockRunner, QualityOptions};
-use lodbench::metrics::SequenceMetrics;
 use lodbench::scene::{SceneDef, SceneKind};
 
 /// The turntable of bunny-halves (320x240, 24 frames, 15 degrees a frame): with the seam (`blocks`,

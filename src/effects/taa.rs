@@ -13,6 +13,7 @@
 //!   Unreal's `r.TemporalAACurrentFrameWeight` is 0.04);
 //! - 3x3 min/max clamp of the history: Karis 2014 (O3DE clips to the 3x3 mean +- 1 standard deviation).
 
+use super::OnOff;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -38,13 +39,6 @@ impl Default for TaaArgs {
     fn default() -> Self {
         crate::defaults::clap_defaults()
     }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Deserialize, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum OnOff {
-    On,
-    Off,
 }
 
 /// A validated TAA setting (present only with `--taa on`).

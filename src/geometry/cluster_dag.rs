@@ -11,7 +11,7 @@
 //! either is drawn or not: cut changes are hard switches, there is no transition between them.
 
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use crate::geometry::mesh::Mesh;
 use glam::Vec3;
 
 /// Triangles per cluster at most (meshoptimizer's default configuration for rasterisation at this size).
@@ -184,7 +184,7 @@ mod tests {
     /// terminal groups' clusters; farther or more tolerant never draws more.
     #[test]
     fn the_cut_runs_from_the_mesh_to_the_coarsest_clusters() {
-        let mesh = crate::terrain::terrain_mesh(3, 64).unwrap();
+        let mesh = crate::geometry::terrain::terrain_mesh(3, 64).unwrap();
         let dag = ClusterDag::build("terrain", &mesh).unwrap();
         assert!(dag.levels() > 2, "{} levels", dag.levels());
         let mut cut = Vec::new();

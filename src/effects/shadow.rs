@@ -21,7 +21,6 @@
 //! The reference always casts LOD0.
 
 use crate::error::{Error, Result};
-use crate::schedule::InstanceState;
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -34,8 +33,8 @@ pub const BIAS_OF_RADIUS: f32 = 0.02;
 #[serde(default, rename_all = "kebab-case")]
 pub struct ShadowArgs {
     /// One directional shadow map in every scene but the unified ones: on or off.
-    #[arg(long, value_enum, default_value_t = crate::taa::OnOff::Off)]
-    pub shadows: crate::taa::OnOff,
+    #[arg(long, value_enum, default_value_t = crate::effects::OnOff::Off)]
+    pub shadows: crate::effects::OnOff,
     /// With --shadows on: the shadow map's side in texels.
     #[arg(long, default_value_t = 1024)]
     pub shadow_size: u32,
@@ -68,7 +67,7 @@ pub struct Shadows {
 
 impl ShadowArgs {
     pub fn resolve(&self) -> Result<Option<Shadows>> {
-        if self.shadows == crate::taa::OnOff::Off {
+        if self.shadows == crate::effects::OnOff::Off {
             return Ok(None);
         }
         if !(16..=8192).contains(&self.shadow_size) {
@@ -94,30 +93,6 @@ pub enum Caster {
         to: u32,
         k: f32,
     },
-}
-
-impl Caster {
-    /// The blending methods' caster: the instance's LOD, or both LODs dithered in a transition.
-    pub fn blended(s: &InstanceState) -> Caster {
-        if s.in_transition() {
-            Caster::Dither {
-                from: s.lod_from,
-                to: s.lod_to,
-                k: s.k,
-            }
-        } else {
-            Caster::Lod(s.lod_from)
-        }
-    }
-
-    /// `--shadow-lod`'s choice for a method whose own (`follow`) caster is `own`.
-    pub fn with_policy(own: Caster, s: &InstanceState, lod: ShadowLod) -> Caster {
-        match (lod, s.in_transition()) {
-            (ShadowLod::Follow, _) | (_, false) => own,
-            (ShadowLod::LodFrom, true) => Caster::Lod(s.lod_from),
-            (ShadowLod::LodTo, true) => Caster::Lod(s.lod_to),
-        }
-    }
 }
 
 /// The light's view-projection: orthographic along `-to_light`, its square side and depth fitted to the
@@ -172,37 +147,5 @@ mod tests {
         let a = m.project_point3(Vec3::new(0.0, 1.0, 0.0));
         let b = m.project_point3(Vec3::new(0.0, 1.0, 0.0) - d * 0.3);
         assert!(b.z > a.z);
-    }
-
-    #[test]
-    fn policy_overrides_only_transitions() {
-        let t = InstanceState {
-            lod_from: 1,
-            lod_to: 2,
-            k: 0.3,
-        };
-        let own = Caster::blended(&t);
-        assert_eq!(
-            own,
-            Caster::Dither {
-                from: 1,
-                to: 2,
-                k: 0.3
-            }
-        );
-        assert_eq!(
-            Caster::with_policy(own, &t, ShadowLod::LodTo),
-            Caster::Lod(2)
-        );
-        assert_eq!(
-            Caster::with_policy(own, &t, ShadowLod::LodFrom),
-            Caster::Lod(1)
-        );
-        assert_eq!(Caster::with_policy(own, &t, ShadowLod::Follow), own);
-        let steady = InstanceState::steady(3);
-        assert_eq!(
-            Caster::with_policy(Caster::blended(&steady), &steady, ShadowLod::LodTo),
-            Caster::Lod(3)
-        );
     }
 }

@@ -1,7 +1,7 @@
 //! `--dump-frames`: the method frame, the reference frame and an error heat-map as PNGs.
 
 use crate::error::{Error, Result};
-use crate::metrics::difference_image;
+use crate::measure::metrics::difference_image;
 use std::path::{Path, PathBuf};
 
 /// Difference (mean over R, G, B of |a - b|, encoded values) that maps to the top of the heat-map's scale.

@@ -1,9 +1,9 @@
 //! run.json: what was run, on what, by which build, and whether it finished.
 
-use crate::config::RunConfig;
+use crate::cli::config::RunConfig;
 use crate::error::{Error, Result};
 use crate::gpu::{AdapterSummary, TimingSource};
-use crate::records::{BlockInfo, BlockRounds};
+use crate::measure::records::{BlockInfo, BlockRounds};
 use crate::scene::SceneDescription;
 use serde::Serialize;
 use std::path::Path;

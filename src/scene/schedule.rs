@@ -4,6 +4,7 @@
 //! a small band around the switch distance, 0.95-1.05). Methods never select LODs themselves; they only decide
 //! how to draw a state, so every method sees the same transitions on the same frames.
 
+use crate::effects::shadow::{Caster, ShadowLod};
 use crate::error::{Error, Result};
 use serde::Serialize;
 
@@ -120,6 +121,28 @@ impl InstanceState {
     /// A t-instance in the papers' words: one that is between two LODs.
     pub fn in_transition(&self) -> bool {
         self.lod_from != self.lod_to
+    }
+
+    /// The blending methods' shadow caster: the instance's LOD, or both LODs dithered in a transition.
+    pub fn blended_caster(&self) -> Caster {
+        if self.in_transition() {
+            Caster::Dither {
+                from: self.lod_from,
+                to: self.lod_to,
+                k: self.k,
+            }
+        } else {
+            Caster::Lod(self.lod_from)
+        }
+    }
+
+    /// `--shadow-lod`'s choice for a method whose own (`follow`) caster is `own`.
+    pub fn caster_under(&self, own: Caster, lod: ShadowLod) -> Caster {
+        match (lod, self.in_transition()) {
+            (ShadowLod::Follow, _) | (_, false) => own,
+            (ShadowLod::LodFrom, true) => Caster::Lod(self.lod_from),
+            (ShadowLod::LodTo, true) => Caster::Lod(self.lod_to),
+        }
     }
 
     /// The continuous LOD value `lod_from + k (lod_to - lod_from)`, the same for every method.
@@ -417,5 +440,31 @@ mod tests {
         assert!(ScheduleParams::default()
             .check_switches("m", &[f32::NAN])
             .is_err());
+    }
+
+    #[test]
+    fn policy_overrides_only_transitions() {
+        let t = InstanceState {
+            lod_from: 1,
+            lod_to: 2,
+            k: 0.3,
+        };
+        let own = t.blended_caster();
+        assert_eq!(
+            own,
+            Caster::Dither {
+                from: 1,
+                to: 2,
+                k: 0.3
+            }
+        );
+        assert_eq!(t.caster_under(own, ShadowLod::LodTo), Caster::Lod(2));
+        assert_eq!(t.caster_under(own, ShadowLod::LodFrom), Caster::Lod(1));
+        assert_eq!(t.caster_under(own, ShadowLod::Follow), own);
+        let steady = InstanceState::steady(3);
+        assert_eq!(
+            steady.caster_under(steady.blended_caster(), ShadowLod::LodTo),
+            Caster::Lod(3)
+        );
     }
 }

@@ -10,7 +10,7 @@
 //!
 //! Each LOD pair is computed once per process and cached (keyed by both meshes' contents).
 
-use crate::mesh::Mesh;
+use crate::geometry::mesh::Mesh;
 use glam::Vec3;
 use serde::Serialize;
 use std::collections::HashMap;
@@ -346,7 +346,7 @@ pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, [
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lod::{LodChain, DEFAULT_TARGETS};
+    use crate::geometry::lod::{LodChain, DEFAULT_TARGETS};
     use crate::scene::BUNNY_OBJ;
 
     fn chain() -> LodChain {

@@ -3,10 +3,10 @@
 //! counterfactual frames of the same pose (lodpop's, FSI's lag) are resolved against the same previous history
 //! without changing it.
 
+use crate::effects::taa::Taa;
 use crate::formats::COLOR_FORMAT;
 use crate::gpu::context::GpuContext;
 use crate::gpu::targets::{texture_2d, RenderTarget, ATTACHMENT_READ};
-use crate::taa::Taa;
 
 pub const TAA_WGSL: &str = include_str!("../../shaders/taa.wgsl");
 const HISTORY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

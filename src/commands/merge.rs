@@ -47,7 +47,7 @@ struct Found {
 
 /// The folder planned run `value` of `variable` has under `dir` (as `Experiment::run_folder` names it).
 fn run_folder(dir: &Path, variable: &Value, value: &Value) -> PathBuf {
-    crate::experiment::run_folder_of(dir, variable.as_str(), value.as_str())
+    crate::commands::experiment::run_folder_of(dir, variable.as_str(), value.as_str())
 }
 
 /// Merges the experiment folders `inputs` into `out`; see the module docs.
@@ -188,13 +188,13 @@ pub fn merge(inputs: &[PathBuf], out: &Path, allow_partial: bool) -> Result<Merg
         }
     }
 
-    crate::runner::prepare_output(out)?;
+    crate::commands::run::prepare_output(out)?;
     for (_, f) in &runs {
         copy_run(&f.folder, &destination(out, f))?;
     }
     let mut lead_header: Vec<&str> = variable.as_str().into_iter().collect();
     lead_header.push("adapter");
-    for file in crate::experiment::RUN_CSVS {
+    for file in crate::commands::experiment::RUN_CSVS {
         let parts: Vec<(Vec<String>, PathBuf)> = runs
             .iter()
             .filter(|(_, f)| f.folder.join(file).is_file())
@@ -209,7 +209,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path, allow_partial: bool) -> Result<Merg
                 (lead, f.folder.join(file))
             })
             .collect();
-        crate::experiment::concat_csv(&out.join(file), &lead_header, &parts)?;
+        crate::commands::experiment::concat_csv(&out.join(file), &lead_header, &parts)?;
     }
     let mut record = first.clone();
     record["shard"] = Value::Null;

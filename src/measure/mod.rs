@@ -13,21 +13,27 @@
 //!   two targets and the metric kernel reduces their difference to scalars on the GPU; the scalars of all
 //!   frames are read back once at the end. FSI's combination pass is timed here.
 
+pub mod diff_kernel;
+pub mod metric_kernel;
+pub mod metrics;
+pub mod records;
+pub mod stats;
+
 use crate::error::{Error, Result};
-use crate::gpu::diff::DiffKernel;
-use crate::gpu::metrics::MetricKernel;
 use crate::gpu::scene_gpu::{SHADOW_BEFORE, SHADOW_METHOD, SHADOW_REFERENCE};
-use crate::gpu::shadow::ShadowPass;
-use crate::gpu::taa::{TaaResolve, TaaStream};
+use crate::gpu::shadow_pass::ShadowPass;
+use crate::gpu::taa_resolve::{TaaResolve, TaaStream};
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::{DrawStats, GpuContext, RenderTarget, SceneGpu, TextureReadback};
-use crate::methods::{Build, FrameInput, Method, MethodEntry, MethodOptions, Registry};
-use crate::metrics::{FrameMetrics, Metric, MetricReduction};
-use crate::records::{
+use crate::measure::diff_kernel::DiffKernel;
+use crate::measure::metric_kernel::MetricKernel;
+use crate::measure::metrics::{FrameMetrics, Metric, MetricReduction};
+use crate::measure::records::{
     near_transitions, transitions, BlockInfo, FrameRecord, TransitionPair, TransitionRecord,
 };
+use crate::methods::{Build, FrameInput, Method, MethodEntry, MethodOptions, Registry};
+use crate::scene::schedule::{InstanceState, LodSchedule};
 use crate::scene::Scene;
-use crate::schedule::{InstanceState, LodSchedule};
 use glam::Mat4;
 use indicatif::ProgressBar;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -155,7 +161,7 @@ impl Default for MethodSetup {
 }
 
 /// The order of one timing round: which frames it covers and the order the methods were timed in.
-pub use crate::records::{BlockRounds, Round};
+pub use crate::measure::records::{BlockRounds, Round};
 
 /// One method of a block from its creation through the timing rounds: the method (kept for its quality pass),
 /// its own walk along the path, and what its timed frames measured.
@@ -771,7 +777,7 @@ impl<'a> BlockRunner<'a> {
                 if reference {
                     own
                 } else {
-                    crate::shadow::Caster::with_policy(own, &states[i], settings.lod)
+                    states[i].caster_under(own, settings.lod)
                 }
             },
             &mut list,
@@ -970,7 +976,7 @@ impl<'a> BlockRunner<'a> {
                 let method_rgba = m.read(ctx)?;
                 let reference_rgba = r.read(ctx)?;
                 if self.flip {
-                    flip[f as usize] = Some(crate::metrics::flip_mean(
+                    flip[f as usize] = Some(crate::measure::metrics::flip_mean(
                         &method_rgba,
                         &reference_rgba,
                         scene.width,
@@ -1018,7 +1024,7 @@ impl<'a> BlockRunner<'a> {
         let metric_gpu_ms_median = match &self.metric_timer {
             Some(t) => {
                 let ms: Vec<f64> = t.read(ctx)?.into_iter().flatten().collect();
-                crate::stats::percentile(&ms, 50.0)
+                crate::measure::stats::percentile(&ms, 50.0)
             }
             None => None,
         };
@@ -1057,12 +1063,15 @@ fn frame_lights(scene: &Scene) -> Vec<(Mat4, f32)> {
                 })
                 .collect();
             let r = spheres.iter().map(|s| s.1).fold(0.0f32, f32::max);
-            let (light, depth) = crate::shadow::light_matrix(
+            let (light, depth) = crate::effects::shadow::light_matrix(
                 glam::Vec3::from(crate::gpu::LIGHT_DIR),
                 &spheres,
                 3.0 * r,
             );
-            (light, crate::shadow::BIAS_OF_RADIUS * r / depth.max(1e-6))
+            (
+                light,
+                crate::effects::shadow::BIAS_OF_RADIUS * r / depth.max(1e-6),
+            )
         })
         .collect()
 }

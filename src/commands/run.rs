@@ -1,17 +1,17 @@
 //! A run: validates the output folder, writes run.json, opens the GPU, and measures every scene block x method
 //! (`crate::measure`), writing frames.csv as blocks finish and summary.csv at the end.
 
-use crate::config::RunConfig;
+use crate::cli::config::RunConfig;
 use crate::error::{Error, Result};
-use crate::export::csv::{write_rounds, write_summary, write_transitions, FramesWriter};
-use crate::export::manifest::{now_rfc3339, RunManifest, RunStatus};
-use crate::export::png::FrameDumper;
 use crate::gpu::GpuContext;
+use crate::measure::records::{round_records, BlockInfo, FrameRecord, SummaryRecord};
 use crate::measure::{
     is_reference, reference_ms_per_frame, BlockRunner, MethodSetup, QualityOptions,
 };
 use crate::methods::Registry;
-use crate::records::{round_records, BlockInfo, FrameRecord, SummaryRecord};
+use crate::results::csv::{write_rounds, write_summary, write_transitions, FramesWriter};
+use crate::results::manifest::{now_rfc3339, RunManifest, RunStatus};
+use crate::results::png::FrameDumper;
 use crate::scene::SceneDef;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};

@@ -9,7 +9,7 @@
 //! The chain goes through [`LodChain::from_meshes`] with a *measured* `error_abs` per LOD (0 for LOD0): a
 //! sampled symmetric Hausdorff distance, the larger of
 //! - the largest distance from a deterministic sample of LOD0's vertices (every k-th vertex, at most
-//!   [`ERROR_SAMPLES`]) to the closest point on LOD k's surface ([`crate::morph::closest_surface`]), and
+//!   [`ERROR_SAMPLES`]) to the closest point on LOD k's surface ([`crate::geometry::morph::closest_surface`]), and
 //! - the same from LOD k's vertices to LOD0's surface ([`measure_error`] gives either direction).
 //!
 //! The second direction matters for foliage: LOD0's leaves lie within about 0.15-0.2 of *any* coarser
@@ -19,7 +19,7 @@
 //! decides (a coarse LOD's vertices lie on or near LOD0's surface), except SIMPLE's box corners (0.39).
 //!
 //! Object space: y up, the model's base (ground contact) at y = 0, centred on x = z = 0. Per-vertex `aux` is
-//! `[u, v, kind, hub_y]` (kinds in [`crate::mesh`]); `hub_y` is only set on [`AUX_BLADE`] vertices (0
+//! `[u, v, kind, hub_y]` (kinds in [`crate::geometry::mesh`]); `hub_y` is only set on [`AUX_BLADE`] vertices (0
 //! elsewhere).
 //!
 //! ## Colours: `lod_colors`
@@ -82,9 +82,11 @@
 //! while other builds share the cores).
 
 use crate::error::{Error, Result};
-use crate::lod::LodChain;
-use crate::mesh::{vertex_normals, Mesh, AUX_BLADE, AUX_LEAF, AUX_LEAF_CLUSTER, AUX_SOLID};
-use crate::morph::closest_surface;
+use crate::geometry::lod::LodChain;
+use crate::geometry::mesh::{
+    vertex_normals, Mesh, AUX_BLADE, AUX_LEAF, AUX_LEAF_CLUSTER, AUX_SOLID,
+};
+use crate::geometry::morph::closest_surface;
 use crate::rng::SplitMix64;
 use glam::{Quat, Vec3};
 use std::f32::consts::{PI, TAU};

@@ -487,7 +487,7 @@ impl Partition {
     /// border: without the lock, a block that reduces its border corner there leaves a notch beside the seam,
     /// measured on the terrain's skyline as up to 9 crack pixels a frame at 320x240).
     pub fn lod_chains(&self, targets: &[f32]) -> Result<Vec<Vec<BlockLod>>> {
-        crate::lod::check_targets("the blocks", targets)?;
+        crate::geometry::lod::check_targets("the blocks", targets)?;
         // A key is locked where seams meet: in three or more blocks, or where a block's seam edges do not run
         // on through it (a chain's end, on the mesh's own open border, or a fork).
         let mut blocks_of_key: HashMap<VertexKey, u32> = HashMap::new();
@@ -528,7 +528,8 @@ impl Partition {
                         let (indices, error_abs) = if fraction == 1.0 {
                             (b.indices.clone(), 0.0)
                         } else {
-                            let target = crate::lod::target_index_count(b.indices.len(), fraction);
+                            let target =
+                                crate::geometry::lod::target_index_count(b.indices.len(), fraction);
                             let mut error = 0.0f32;
                             let indices = meshopt::simplify_with_locks(
                                 &b.indices,
@@ -1043,7 +1044,7 @@ mod tests {
     /// every seam vertex reduced away is drawn at a vertex its LOD still uses, on the cut.
     #[test]
     fn the_halves_reduce_their_cut_and_cross_reference_it() {
-        let m = crate::mesh::Mesh::parse_obj("bunny", crate::scene::BUNNY_OBJ).unwrap();
+        let m = crate::geometry::mesh::Mesh::parse_obj("bunny", crate::scene::BUNNY_OBJ).unwrap();
         let (lo, hi) = m.bounds();
         let cell = ((hi - lo).max_element() * 1.01) as f64;
         let centre = ((lo.x + hi.x) * 0.5) as f64;
@@ -1242,7 +1243,7 @@ mod tests {
     /// the test fails.
     #[test]
     fn seams_stay_closed_where_a_cut_meets_the_mesh_border() {
-        let m = crate::terrain::terrain_mesh(5, 24).unwrap();
+        let m = crate::geometry::terrain::terrain_mesh(5, 24).unwrap();
         let g = Grid::covering(&m.positions, 100.0 / 3.0 * (1.0 + 1e-6)).unwrap();
         assert_eq!((g.dims[0], g.dims[2]), (3, 3));
         let on_border = |p: [f32; 3]| p[0] == 0.0 || p[0] == 100.0 || p[2] == 0.0 || p[2] == 100.0;
@@ -1285,7 +1286,7 @@ mod tests {
     /// two sides are at the same positions (degenerate at full resolution).
     #[test]
     fn the_bunny_clipped_keeps_its_area_and_its_seams_close() {
-        let m = crate::mesh::Mesh::parse_obj("bunny", crate::scene::BUNNY_OBJ).unwrap();
+        let m = crate::geometry::mesh::Mesh::parse_obj("bunny", crate::scene::BUNNY_OBJ).unwrap();
         let (lo, hi) = m.bounds();
         let cell = ((hi - lo).max_element() / 2.9) as f64;
         let g = Grid::covering(&m.positions, cell).unwrap();

@@ -7,9 +7,9 @@
 //! writes `perceptual.csv` beside them with each transition's lodpop for comparison.
 
 use crate::error::{Error, Result};
-use crate::export::csv::read_transitions;
-use crate::export::png::FrameDumper;
-use crate::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use crate::measure::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use crate::results::csv::read_transitions;
+use crate::results::png::FrameDumper;
 use colorvideovdp::{Color, Cvvdp, DisplayModel, Execution, Image, Options};
 use serde::Serialize;
 use std::path::{Path, PathBuf};

@@ -4,7 +4,7 @@
 use crate::error::Result;
 use crate::gpu::context::GpuContext;
 use crate::gpu::targets::RenderTarget;
-use crate::metrics::{FrameMetrics, MetricReduction};
+use crate::measure::metrics::{FrameMetrics, MetricReduction};
 
 pub const METRICS_WGSL: &str = include_str!("../../shaders/metrics.wgsl");
 

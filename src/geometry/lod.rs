@@ -1,7 +1,7 @@
 //! LOD chains built with meshoptimizer's `simplify`, and switch distances derived from their errors.
 
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use crate::geometry::mesh::Mesh;
 use serde::Serialize;
 
 /// Default triangle targets, as fractions of LOD0 (issue 2: 100 / 50 / 25 / 10 %).

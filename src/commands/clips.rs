@@ -21,9 +21,9 @@
 //! folder named `clips/` is always complete.
 
 use crate::error::{Error, Result};
-use crate::export::csv::read_transitions;
-use crate::export::png::{heatmap, FrameDumper, HEATMAP_FULL_SCALE};
-use crate::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use crate::measure::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use crate::results::csv::read_transitions;
+use crate::results::png::{heatmap, FrameDumper, HEATMAP_FULL_SCALE};
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, Rgba, RgbaImage};
 use serde::Serialize;
@@ -35,15 +35,7 @@ use std::process::{Command, Stdio};
 pub const CLIPS_DIR: &str = "clips";
 pub const INDEX_JSON: &str = "index.json";
 
-/// Whether to write MP4s with ffmpeg.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
-pub enum Mp4 {
-    /// When `ffmpeg` is on the PATH.
-    Auto,
-    /// Always; an error when `ffmpeg` is missing.
-    On,
-    Off,
-}
+pub use crate::cli::Mp4;
 
 /// The settings of `lodbench clips`.
 #[derive(Debug, Clone)]
@@ -574,7 +566,7 @@ fn save(path: &Path, img: &RgbaImage) -> Result<()> {
 
 /// The heat-map of `picture` against `reference`, for dumps made without their `_error.png`.
 fn heatmap_of(picture: &RgbaImage, reference: &RgbaImage) -> RgbaImage {
-    let diff = crate::metrics::difference_image(picture.as_raw(), reference.as_raw());
+    let diff = crate::measure::metrics::difference_image(picture.as_raw(), reference.as_raw());
     RgbaImage::from_raw(picture.width(), picture.height(), heatmap(&diff))
         .unwrap_or_else(|| RgbaImage::new(picture.width(), picture.height()))
 }

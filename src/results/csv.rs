@@ -1,9 +1,9 @@
-//! frames.csv and summary.csv: serialisation only (the records are `crate::records`). frames.csv is written as
+//! frames.csv and summary.csv: serialisation only (the records are `crate::measure::records`). frames.csv is written as
 //! `frames.csv.partial`, flushed after each block, and renamed to `frames.csv` only when the run completes, so
 //! an interrupted run keeps what it measured without leaving a file that looks complete.
 
 use crate::error::{Error, Result};
-use crate::records::{FrameRecord, RoundRecord, SummaryRecord, TransitionRecord};
+use crate::measure::records::{FrameRecord, RoundRecord, SummaryRecord, TransitionRecord};
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
@@ -98,7 +98,7 @@ pub fn write_rounds(dir: &Path, rows: &[RoundRecord]) -> Result<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::records::tests::row;
+    use crate::measure::records::tests::row;
 
     #[test]
     fn frames_csv_appears_only_when_finished() {

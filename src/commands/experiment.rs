@@ -16,8 +16,8 @@
 //! validated by `RunConfig::from_args` as on the command line. An unknown key, or a value of the wrong type, is
 //! an error naming the key and its line.
 
+use crate::cli::config::RunConfig;
 use crate::cli::RunArgs;
-use crate::config::RunConfig;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -302,7 +302,7 @@ impl Experiment {
     /// complete with the same configuration. The merged CSVs cover the runs this folder holds. Returns the run
     /// folders of this shard (the skipped ones too).
     pub fn run_with(&self, out: &Path, options: &RunOptions) -> Result<Vec<PathBuf>> {
-        crate::runner::prepare_output(out)?;
+        crate::commands::run::prepare_output(out)?;
         let record = ExperimentRecord {
             experiment: self,
             shard: options.shard,
@@ -323,7 +323,7 @@ impl Experiment {
             if options.resume && completed(&folder, &cfg) {
                 eprintln!("{}: complete, skipped (--resume)", folder.display());
             } else {
-                crate::runner::run(&cfg)?;
+                crate::commands::run::run(&cfg)?;
             }
             folders.push(folder);
         }
@@ -464,7 +464,7 @@ mod tests {
         assert!(e
             .runs
             .iter()
-            .all(|r| r.config.scene.schedule.fade == crate::schedule::FadeMode::Time));
+            .all(|r| r.config.scene.schedule.fade == crate::scene::schedule::FadeMode::Time));
         for (bad, needle) in [
             ("framez=7", "framez"),
             ("band=0.1", "swept"),

@@ -1,8 +1,8 @@
 //! The records lodbench writes: a row per frame (frames.csv) and a row per block (summary.csv). A frame record
 //! is built once, by the runner, when every figure of its frame is known; a summary record is computed here
-//! from a block's frame records with `crate::stats`. The exporters only serialise them.
+//! from a block's frame records with `crate::measure::stats`. The exporters only serialise them.
 
-use crate::stats::{bootstrap_ci, mean, percentile};
+use crate::measure::stats::{bootstrap_ci, mean, percentile};
 use serde::Serialize;
 
 /// One row of frames.csv: one frame of one method on one scene block.
@@ -284,7 +284,7 @@ pub fn round_medians(rows: &[FrameRecord], set: FrameSet, gpu: bool) -> Vec<Opti
 }
 
 /// A paired ratio: the geometric mean over rounds of (method's round median / baseline's round median), and
-/// its Student-t 95 % interval over rounds ([`crate::stats::paired_log_ratio`]).
+/// its Student-t 95 % interval over rounds ([`crate::measure::stats::paired_log_ratio`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ratio {
     pub ratio: f64,
@@ -315,7 +315,7 @@ impl PairedRatios {
                 .filter_map(|(m, b)| Some((m.as_ref()? / b.as_ref()?).ln()))
                 .filter(|x| x.is_finite())
                 .collect();
-            let (mean, ci) = crate::stats::paired_log_ratio(&logs)?;
+            let (mean, ci) = crate::measure::stats::paired_log_ratio(&logs)?;
             Some(Ratio {
                 ratio: mean.exp(),
                 ci95: ci.map(|(lo, hi)| (lo.exp(), hi.exp())),

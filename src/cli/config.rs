@@ -5,10 +5,10 @@
 use crate::cli::{RunArgs, SceneArgs};
 use crate::error::{Error, Result};
 use crate::formats::{COLOR_FORMAT, DEPTH_FORMAT, MAX_SIDE, MSAA_SAMPLES};
+use crate::measure::metrics::{Metric, MetricReduction};
 use crate::methods::{MethodOptions, Registry};
-use crate::metrics::{Metric, MetricReduction};
+use crate::scene::schedule::ScheduleParams;
 use crate::scene::{ProfileValues, SceneConfig, SceneKind};
-use crate::schedule::ScheduleParams;
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -144,7 +144,7 @@ impl RunConfig {
             return Err(Error::Config("--rounds must be at least 1".into()));
         }
         let methods_given = !a.method.is_empty();
-        if a.scene_args.shadow.shadows == crate::taa::OnOff::On {
+        if a.scene_args.shadow.shadows == crate::effects::OnOff::On {
             if let Some(scene) = scenes.iter().find(|k| k.is_unified()) {
                 return Err(Error::Config(format!(
                     "--shadows on: not built for the unified scenes yet (scene {}: its blocks and seams, and \

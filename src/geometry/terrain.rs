@@ -14,7 +14,7 @@
 //! 2,000,000 triangles; 280 at ci, 156,800; 160 at quick, 51,200; 48 at regress, 4,608).
 
 use crate::error::Result;
-use crate::mesh::Mesh;
+use crate::geometry::mesh::Mesh;
 use crate::rng::SplitMix64;
 
 /// Side of the terrain square, world units.

@@ -4,11 +4,13 @@
 //! keys, the flags' names without dashes); a key it leaves out takes the flag's default
 //! (`crate::defaults::clap_defaults`), so a file and a command line with the same settings are the same run.
 
-use crate::blocks::PartitionMode;
+pub mod config;
+
+use crate::geometry::blocks::PartitionMode;
+use crate::measure::metrics::{Metric, MetricReduction};
 use crate::methods::MethodOptions;
-use crate::metrics::{Metric, MetricReduction};
+use crate::scene::schedule::FadeMode;
 use crate::scene::{CameraMode, Profile, SweepStart};
-use crate::schedule::FadeMode;
 use clap::{Args, Parser, Subcommand};
 use serde::Deserialize;
 use std::path::PathBuf;
@@ -78,7 +80,7 @@ pub struct ClipsArgs {
     pub gif: bool,
     /// MP4s with ffmpeg: auto (when ffmpeg is on the PATH), on (an error without it), off.
     #[arg(long, value_enum, default_value = "auto")]
-    pub mp4: crate::clips::Mp4,
+    pub mp4: Mp4,
 }
 
 #[derive(Debug, Clone, Args)]
@@ -206,10 +208,10 @@ pub struct SceneArgs {
     pub camera: CameraMode,
     #[command(flatten)]
     #[serde(flatten)]
-    pub taa: crate::taa::TaaArgs,
+    pub taa: crate::effects::taa::TaaArgs,
     #[command(flatten)]
     #[serde(flatten)]
-    pub shadow: crate::shadow::ShadowArgs,
+    pub shadow: crate::effects::shadow::ShadowArgs,
 }
 
 impl Default for SceneArgs {
@@ -313,6 +315,16 @@ pub struct DescribeArgs {
     pub json: bool,
 }
 
+/// Whether to write MP4s with ffmpeg.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
+pub enum Mp4 {
+    /// When `ffmpeg` is on the PATH.
+    Auto,
+    /// Always; an error when `ffmpeg` is missing.
+    On,
+    Off,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -339,7 +351,7 @@ mod tests {
         assert_eq!(set.scene_args.pixel_error, Some(2.0));
         assert_eq!(
             set.method_options.dither.noise,
-            crate::noise::NoisePattern::Bayer4
+            crate::methods::noise::NoisePattern::Bayer4
         );
         assert_eq!(
             set.method_options.fsi.fsi_check,

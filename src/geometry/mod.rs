@@ -1,0 +1,10 @@
+//! Meshes and what is computed from them on the CPU: loading (OBJ, glTF), LOD chains, morph targets, the
+//! procedural models and terrain, Blow's blocks with seams, and meshoptimizer's cluster DAG.
+
+pub mod blocks;
+pub mod cluster_dag;
+pub mod lod;
+pub mod mesh;
+pub mod morph;
+pub mod procgen;
+pub mod terrain;
