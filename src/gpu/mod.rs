@@ -2,6 +2,7 @@
 //! pipelines, draw lists, read-back, timestamps and the metric kernel. It imports nothing above it except
 //! the scene's data (`crate::scene`), never the methods, the configuration or the runner.
 
+pub mod compute;
 pub mod context;
 pub mod draw_list;
 pub mod instances;

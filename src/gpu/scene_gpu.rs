@@ -30,12 +30,26 @@ struct CameraRaw {
 /// Byte offset of `light_view_proj` in the camera uniform (what [`SceneGpu::write_camera`] leaves alone).
 const LIGHT_OFFSET: u64 = 64 + 16 + 16;
 
-/// The camera bind groups' shadow maps: a 1x1 placeholder (shadows off, and the shadow passes themselves),
-/// then with `--shadows on` the method's, the reference's and the one of lodpop's counterfactual frame.
-pub const SHADOW_NONE: usize = 0;
-pub const SHADOW_METHOD: usize = 1;
-pub const SHADOW_REFERENCE: usize = 2;
-pub const SHADOW_BEFORE: usize = 3;
+/// One of the scene's shadow maps: the one a shadow pass writes, and the one draws are lit by. The layer above
+/// decides what each map stands for; the GPU layer only keeps them apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ShadowMap(usize);
+
+impl ShadowMap {
+    /// The 1x1 placeholder: draws with shadows off, and the shadow passes themselves (so the map being written
+    /// is never the one bound).
+    pub const NONE: ShadowMap = ShadowMap(0);
+
+    /// The `i`-th of the maps a scene with `--shadows on` has ([`SceneGpu::with_shadow_maps`]).
+    pub const fn lit(i: usize) -> ShadowMap {
+        ShadowMap(i + 1)
+    }
+
+    /// Index into [`SceneGpu::shadow_views`] and [`SceneGpu::shadow_maps`].
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
 
 /// Where one LOD of one model lives in the shared vertex and index buffers.
 #[derive(Debug, Clone, Copy)]
@@ -64,7 +78,7 @@ pub struct SceneGpu {
     pub seam_base: u32,
     pub camera_buffer: wgpu::Buffer,
     pub camera_layout: wgpu::BindGroupLayout,
-    /// The camera's bind group (group 0) with each shadow map ([`SHADOW_NONE`] ...); draws use the active one.
+    /// The camera's bind group (group 0) with each shadow map ([`ShadowMap`]); draws use the active one.
     pub camera_groups: Vec<wgpu::BindGroup>,
     active_group: std::cell::Cell<usize>,
     /// The shadow maps' depth views, indexed like `camera_groups` (`--shadows on`; only the placeholder
@@ -115,7 +129,14 @@ impl SceneGpu {
         buffer.write(&self.queue, first, list, &self.uploads);
     }
 
+    /// With one shadow map under `--shadows on`.
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<SceneGpu> {
+        SceneGpu::with_shadow_maps(ctx, scene, 1)
+    }
+
+    /// With `lit` shadow maps under `--shadows on` (`ShadowMap::lit(0)` ...), besides the placeholder; none
+    /// without shadows.
+    pub fn with_shadow_maps(ctx: &GpuContext, scene: &Scene, lit: usize) -> Result<SceneGpu> {
         let device = &ctx.device;
         let mut vertices: Vec<Vertex> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
@@ -208,10 +229,14 @@ impl SceneGpu {
             ],
         });
         let shadow_size = scene.shadows.map_or(1, |s| s.size);
-        let maps = if scene.shadows.is_some() { 4 } else { 1 };
+        let maps = if scene.shadows.is_some() { 1 + lit } else { 1 };
         let shadow_maps: Vec<wgpu::Texture> = (0..maps)
             .map(|i| {
-                let side = if i == SHADOW_NONE { 1 } else { shadow_size };
+                let side = if i == ShadowMap::NONE.index() {
+                    1
+                } else {
+                    shadow_size
+                };
                 texture_2d(
                     device,
                     &format!("shadow map {i}"),
@@ -291,7 +316,7 @@ impl SceneGpu {
             camera_buffer,
             camera_layout,
             camera_groups,
-            active_group: std::cell::Cell::new(SHADOW_NONE),
+            active_group: std::cell::Cell::new(ShadowMap::NONE.index()),
             shadow_views,
             shadow_maps,
             shadow_size,
@@ -344,15 +369,20 @@ impl SceneGpu {
         );
     }
 
-    /// The camera bind group draws use from now on: the one with shadow map `index` ([`SHADOW_METHOD`] ...).
-    pub fn use_shadow_map(&self, index: usize) {
+    /// The camera bind group draws use from now on: the one with shadow map `map` (the placeholder when the
+    /// scene has no such map: shadows off).
+    pub fn use_shadow_map(&self, map: ShadowMap) {
         self.active_group
-            .set(index.min(self.camera_groups.len().saturating_sub(1)));
+            .set(map.index().min(self.camera_groups.len().saturating_sub(1)));
     }
 
-    /// Which shadow map draws are lit by ([`SHADOW_NONE`] ...).
-    pub fn active_shadow_map(&self) -> usize {
-        self.active_group.get()
+    /// Runs `draw` lit by shadow map `map`, then restores the map that was in use.
+    pub fn lit_by<T>(&self, map: ShadowMap, draw: impl FnOnce() -> T) -> T {
+        let active = self.active_group.get();
+        self.use_shadow_map(map);
+        let out = draw();
+        self.active_group.set(active);
+        out
     }
 
     /// The camera bind group of the shadow map in use.

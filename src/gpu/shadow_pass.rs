@@ -5,7 +5,7 @@
 use crate::gpu::draw_list::{DrawList, DrawStats, PipelineIndex};
 use crate::gpu::instances::InstanceBuffer;
 use crate::gpu::pipelines::shadow_pipeline;
-use crate::gpu::scene_gpu::{SceneGpu, SHADOW_NONE};
+use crate::gpu::scene_gpu::{SceneGpu, ShadowMap};
 
 /// Pipeline indices of a shadow draw list: a caster drawn whole, and one LOD of a dithered caster.
 pub const CAST_WHOLE: PipelineIndex = 0;
@@ -50,16 +50,14 @@ impl ShadowPass {
         &self,
         gpu: &SceneGpu,
         encoder: &mut wgpu::CommandEncoder,
-        map: usize,
+        map: ShadowMap,
         list: &DrawList,
     ) -> DrawStats {
-        let buffer = &self.buffers[map];
+        let buffer = &self.buffers[map.index()];
         gpu.upload(buffer, list);
-        let mut pass = gpu.begin_depth_pass(encoder, &gpu.shadow_views[map], "shadow pass");
-        let active = gpu.active_shadow_map();
-        gpu.use_shadow_map(SHADOW_NONE);
-        let stats = gpu.draw(&mut pass, buffer, 0, list, &[&self.whole, &self.dithered]);
-        gpu.use_shadow_map(active);
-        stats
+        let mut pass = gpu.begin_depth_pass(encoder, &gpu.shadow_views[map.index()], "shadow pass");
+        gpu.lit_by(ShadowMap::NONE, || {
+            gpu.draw(&mut pass, buffer, 0, list, &[&self.whole, &self.dithered])
+        })
     }
 }

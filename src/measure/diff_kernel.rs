@@ -3,6 +3,7 @@
 //! (bound once); `encode` picks the pair.
 
 use crate::error::Result;
+use crate::gpu::compute::{bind_group, results_buffers, uniform_buffer};
 use crate::gpu::context::GpuContext;
 use crate::gpu::targets::RenderTarget;
 
@@ -42,53 +43,19 @@ impl DiffKernel {
             compilation_options: Default::default(),
             cache: None,
         });
-        let size = frames as u64 * 8;
-        let sums = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: 16,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let [sums, readback] = results_buffers(device, [label, label], frames as u64 * 8);
+        let params = uniform_buffer(device, label, 16);
         let layout = pipeline.get_bind_group_layout(0);
         let bind_groups = pairs
             .iter()
             .map(|(a, b)| {
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some(label),
-                    layout: &layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: wgpu::BindingResource::TextureView(&a.color_bytes_view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::TextureView(&b.color_bytes_view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: sums.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: params.as_entire_binding(),
-                        },
-                    ],
-                })
+                let resources = vec![
+                    wgpu::BindingResource::TextureView(&a.color_bytes_view),
+                    wgpu::BindingResource::TextureView(&b.color_bytes_view),
+                    sums.as_entire_binding(),
+                    params.as_entire_binding(),
+                ];
+                bind_group(device, label, &layout, resources)
             })
             .collect();
         ctx.check_errors()?;

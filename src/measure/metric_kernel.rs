@@ -2,9 +2,14 @@
 //! scalars. Results of every frame of a block go to their own slot of one buffer, read once at the end.
 
 use crate::error::Result;
+use crate::gpu::compute::{
+    bind_group, buffer, results_buffers, storage_entry, texture_entry, uniform_buffer,
+    uniform_entry,
+};
 use crate::gpu::context::GpuContext;
 use crate::gpu::targets::RenderTarget;
 use crate::measure::metrics::{FrameMetrics, MetricReduction};
+use wgpu::BufferUsages as U;
 
 pub const METRICS_WGSL: &str = include_str!("../../shaders/metrics.wgsl");
 
@@ -22,6 +27,61 @@ pub struct MetricKernel {
     height: u32,
     frames: u32,
     background: u32,
+}
+
+/// One layout for both entry points, so one bind group serves the two dispatches of a frame.
+fn metric_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("metric layout"),
+        entries: &[
+            texture_entry(0),
+            texture_entry(1),
+            storage_entry(2),
+            storage_entry(3),
+            uniform_entry(4),
+            storage_entry(5),
+            storage_entry(6),
+        ],
+    })
+}
+
+/// The pipelines of `main` (the per-pixel figures) and `crack_main` (the crack test of the uncovered pixels),
+/// with the shader's DE2000 and WORKGROUP_REDUCE constants.
+fn metric_pipelines(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::BindGroupLayout,
+    (de2000, reduction): (bool, MetricReduction),
+) -> [wgpu::ComputePipeline; 2] {
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("metric pipeline layout"),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    let constants = [
+        ("DE2000", de2000 as u32 as f64),
+        (
+            "WORKGROUP_REDUCE",
+            (reduction == MetricReduction::Workgroup) as u32 as f64,
+        ),
+    ];
+    let compute = |label, entry_point| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pipeline_layout),
+            module,
+            entry_point: Some(entry_point),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &constants,
+                ..Default::default()
+            },
+            cache: None,
+        })
+    };
+    [
+        compute("metric kernel", "main"),
+        compute("crack kernel", "crack_main"),
+    ]
 }
 
 /// Workgroups of `crack_main` (CRACK_GROUPS in the shader).
@@ -48,148 +108,29 @@ impl MetricKernel {
             label: Some("metrics.wgsl"),
             source: wgpu::ShaderSource::Wgsl(METRICS_WGSL.into()),
         });
-        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let texture = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        // One layout for both entry points, so one bind group serves the two dispatches of a frame.
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("metric layout"),
-            entries: &[
-                texture(0),
-                texture(1),
-                storage(2, false),
-                storage(3, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                storage(5, false),
-                storage(6, false),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("metric pipeline layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let constants = [
-            ("DE2000", de2000 as u32 as f64),
-            (
-                "WORKGROUP_REDUCE",
-                (reduction == MetricReduction::Workgroup) as u32 as f64,
-            ),
+        let layout = metric_layout(device);
+        let [pipeline, crack_pipeline] =
+            metric_pipelines(device, &module, &layout, (de2000, reduction));
+        let pixels = width as u64 * height as u64;
+        let uncovered_list = buffer(device, "uncovered pixels", pixels.max(1) * 4, U::STORAGE);
+        let uncovered_count = buffer(device, "uncovered pixel count", 4, U::STORAGE | U::COPY_DST);
+        let prev_error = buffer(device, "previous error image", pixels * 4, U::STORAGE);
+        let [sums, readback] = results_buffers(
+            device,
+            ["metric sums", "metric read-back"],
+            frames as u64 * 4 * SLOT_WORDS as u64,
+        );
+        let params = uniform_buffer(device, "metric params", 32);
+        let resources = vec![
+            wgpu::BindingResource::TextureView(&method.color_bytes_view),
+            wgpu::BindingResource::TextureView(&reference.color_bytes_view),
+            prev_error.as_entire_binding(),
+            sums.as_entire_binding(),
+            params.as_entire_binding(),
+            uncovered_list.as_entire_binding(),
+            uncovered_count.as_entire_binding(),
         ];
-        let compute = |label, entry_point| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry_point),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
-                },
-                cache: None,
-            })
-        };
-        let pipeline = compute("metric kernel", "main");
-        let crack_pipeline = compute("crack kernel", "crack_main");
-        let uncovered_list = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("uncovered pixels"),
-            size: (width as u64 * height as u64).max(1) * 4,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
-        let uncovered_count = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("uncovered pixel count"),
-            size: 4,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let prev_error = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("previous error image"),
-            size: width as u64 * height as u64 * 4,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
-        let sums_size = frames as u64 * 4 * SLOT_WORDS as u64;
-        let sums = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("metric sums"),
-            size: sums_size,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("metric read-back"),
-            size: sums_size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("metric params"),
-            size: 32,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("metric bind group"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&method.color_bytes_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&reference.color_bytes_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: prev_error.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: sums.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: uncovered_list.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: uncovered_count.as_entire_binding(),
-                },
-            ],
-        });
+        let bind_group = bind_group(device, "metric bind group", &layout, resources);
         ctx.check_errors()?;
         Ok(MetricKernel {
             pipeline,

@@ -4,7 +4,7 @@
 use crate::common::{col, read_csv, run_into, scene_config};
 use lodbench::effects::shadow::{light_matrix, Caster};
 use lodbench::gpu::readback::read_texture;
-use lodbench::gpu::scene_gpu::SHADOW_METHOD;
+use lodbench::gpu::scene_gpu::ShadowMap;
 use lodbench::gpu::shadow_pass::ShadowPass;
 use lodbench::gpu::{DrawList, GpuContext, SceneGpu};
 use lodbench::measure::FrameDriver;
@@ -13,7 +13,7 @@ use lodbench::methods::{alpha::Alpha, discrete::Discrete};
 use lodbench::scene::schedule::InstanceState;
 use lodbench::scene::{SceneDef, SceneKind};
 
-/// Shadow map `SHADOW_METHOD` as `method` casts with the bunny at `state`, as read-back depth bytes.
+/// Shadow map `ShadowMap::lit(0)` as `method` casts with the bunny at `state`, as read-back depth bytes.
 fn shadow_map(
     ctx: &GpuContext,
     gpu: &SceneGpu,
@@ -28,13 +28,13 @@ fn shadow_map(
         &mut list,
     );
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    pass.encode(gpu, &mut encoder, SHADOW_METHOD, &list);
+    pass.encode(gpu, &mut encoder, ShadowMap::lit(0), &list);
     ctx.queue.submit([encoder.finish()]);
     ctx.wait_idle().unwrap();
     ctx.check_errors().unwrap();
     read_texture(
         ctx,
-        &gpu.shadow_maps[SHADOW_METHOD],
+        &gpu.shadow_maps[ShadowMap::lit(0).index()],
         wgpu::TextureAspect::DepthOnly,
         4,
     )

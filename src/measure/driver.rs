@@ -1,0 +1,91 @@
+//! A walk along a scene's path: the shared LOD schedule and the instance matrices of each frame, the same
+//! for every method.
+
+use crate::measure::records::TransitionPair;
+use crate::methods::FrameInput;
+use crate::scene::schedule::{InstanceState, LodSchedule};
+use crate::scene::Scene;
+use glam::Mat4;
+
+/// Walks a scene's frames in order: the shared LOD schedule and the instance matrices of each frame.
+pub struct FrameDriver<'s> {
+    scene: &'s Scene,
+    schedule: LodSchedule,
+    pub states: Vec<InstanceState>,
+    pub matrices: Vec<Mat4>,
+    pub distances: Vec<f32>,
+}
+
+/// Method-independent facts of one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameFacts {
+    pub lod_mean: f64,
+    pub t_instances: u32,
+    /// Mean k over the instances in transition (None when none is).
+    pub k_mean: Option<f64>,
+    /// The LODs the t-instances go between.
+    pub pair: TransitionPair,
+}
+
+impl<'s> FrameDriver<'s> {
+    pub fn new(scene: &'s Scene) -> Self {
+        let n = scene.instances.len();
+        FrameDriver {
+            scene,
+            schedule: LodSchedule::new(scene.schedule, n),
+            states: Vec::with_capacity(n),
+            matrices: Vec::with_capacity(n),
+            distances: Vec::with_capacity(n),
+        }
+    }
+
+    pub fn reset(&mut self) {
+        self.schedule.reset();
+    }
+
+    /// Advances to `frame` (frames must come in order after a reset).
+    pub fn advance(&mut self, frame: u32) -> FrameFacts {
+        self.states.clear();
+        self.matrices.clear();
+        self.distances.clear();
+        let mut lod_sum = 0.0f64;
+        let mut t = 0u32;
+        let mut k_sum = 0.0f64;
+        let mut pair = TransitionPair::None;
+        let eye = self.scene.camera(frame).eye;
+        for (i, inst) in self.scene.instances.iter().enumerate() {
+            let d = self.scene.instance_position(i, frame).distance(eye);
+            let switches = &self.scene.models[inst.model as usize].switches;
+            let s = self.schedule.update(i, d, switches);
+            if self.scene.ground != Some(i) {
+                lod_sum += s.lod_value() as f64;
+            }
+            if s.in_transition() {
+                t += 1;
+                k_sum += s.k as f64;
+                pair = pair.with(s.lod_from, s.lod_to);
+            }
+            self.states.push(s);
+            self.distances.push(d);
+            self.matrices.push(self.scene.instance_matrix(i, frame));
+        }
+        FrameFacts {
+            lod_mean: lod_sum
+                / (self.scene.instances.len() - self.scene.ground.is_some() as usize).max(1) as f64,
+            t_instances: t,
+            k_mean: (t > 0).then(|| k_sum / t as f64),
+            pair,
+        }
+    }
+
+    pub fn input(&self, frame: u32) -> FrameInput<'_> {
+        FrameInput {
+            frame,
+            scene: self.scene,
+            states: &self.states,
+            matrices: &self.matrices,
+            distances: &self.distances,
+            timed: false,
+        }
+    }
+}

@@ -1,0 +1,238 @@
+//! The quality pass's side of the engine effects: which shadow map stands for what, the shadow's own share of
+//! the error, every frame's light, and the TAA streams of the method and the reference.
+
+use super::diff_kernel::DiffKernel;
+use crate::error::Result;
+use crate::gpu::scene_gpu::ShadowMap;
+use crate::gpu::shadow_pass::ShadowPass;
+use crate::gpu::taa_resolve::{TaaResolve, TaaStream};
+use crate::gpu::{DrawList, GpuContext, RenderTarget, SceneGpu};
+use crate::methods::{FrameInput, Method};
+use crate::scene::schedule::InstanceState;
+use crate::scene::Scene;
+use glam::Mat4;
+
+/// What a shadow map of the block stands for (`--shadows on`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShadowRole {
+    /// What the method casts this frame (the timing pass uses only this one).
+    Method,
+    /// What the reference casts: its LOD0.
+    Reference,
+    /// What the method cast with the previous frame's states: lodpop's counterfactual.
+    Before,
+}
+
+impl ShadowRole {
+    /// How many shadow maps the block's scene needs.
+    pub const COUNT: usize = 3;
+
+    pub fn map(self) -> ShadowMap {
+        ShadowMap::lit(match self {
+            ShadowRole::Method => 0,
+            ShadowRole::Reference => 1,
+            ShadowRole::Before => 2,
+        })
+    }
+}
+
+/// Whose casters a shadow map receives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Casters {
+    /// The reference's own casters: `--shadow-lod` does not apply to it.
+    Reference,
+    /// A method's casters under `--shadow-lod`.
+    Method,
+}
+
+/// One frame's light: world to the shadow map's clip space and its depth bias.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameLight {
+    pub matrix: Mat4,
+    pub bias: f32,
+}
+
+/// `--shadows on`: every frame's light, fitted to the casters' bounding spheres (every instance but the ground)
+/// with room behind them for the receivers; the same for every method, so computed once per block. Empty
+/// without shadows.
+pub fn frame_lights(scene: &Scene) -> Vec<FrameLight> {
+    if scene.shadows.is_none() {
+        return Vec::new();
+    }
+    (0..scene.frames)
+        .map(|f| {
+            let spheres: Vec<(glam::Vec3, f32)> = scene
+                .instances
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| scene.ground != Some(*i))
+                .map(|(i, inst)| {
+                    (
+                        scene.instance_position(i, f),
+                        scene.models[inst.model as usize].radius,
+                    )
+                })
+                .collect();
+            let r = spheres.iter().map(|s| s.1).fold(0.0f32, f32::max);
+            let (matrix, depth) = crate::effects::shadow::light_matrix(
+                glam::Vec3::from(crate::gpu::LIGHT_DIR),
+                &spheres,
+                3.0 * r,
+            );
+            FrameLight {
+                matrix,
+                bias: crate::effects::shadow::BIAS_OF_RADIUS * r / depth.max(1e-6),
+            }
+        })
+        .collect()
+}
+
+/// `--shadows on`: the shadow pass and the frames' lights.
+pub struct Shadows {
+    pass: ShadowPass,
+    lights: Vec<FrameLight>,
+    settings: crate::effects::shadow::Shadows,
+}
+
+impl Shadows {
+    pub fn new(gpu: &SceneGpu, scene: &Scene) -> Option<Shadows> {
+        Some(Shadows {
+            settings: scene.shadows?,
+            pass: ShadowPass::new(gpu, scene.instances.len() as u32),
+            lights: frame_lights(scene),
+        })
+    }
+
+    /// Frame `f`'s light into the camera uniform.
+    pub fn write_light(&self, gpu: &SceneGpu, f: u32) {
+        if let Some(l) = self.lights.get(f as usize) {
+            gpu.write_light(&l.matrix, l.bias);
+        }
+    }
+
+    /// A command buffer, to be submitted before the frame's, that draws into the shadow map of `role` what
+    /// `method` casts (asked after its `encode` of the frame; `states` this frame's, or the earlier frame's for
+    /// [`ShadowRole::Before`]).
+    pub fn commands(
+        &self,
+        gpu: &SceneGpu,
+        method: &dyn Method,
+        input: &FrameInput<'_>,
+        states: &[InstanceState],
+        (role, casters): (ShadowRole, Casters),
+    ) -> wgpu::CommandBuffer {
+        let mut list = DrawList::default();
+        let input = FrameInput { states, ..*input };
+        let before = role == ShadowRole::Before;
+        crate::methods::common::shadow_list(
+            &input,
+            |i| {
+                let own = method.shadow_caster(states, i, before);
+                match casters {
+                    Casters::Reference => own,
+                    Casters::Method => states[i].caster_under(own, self.settings.lod),
+                }
+            },
+            &mut list,
+        );
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.pass.encode(gpu, &mut encoder, role.map(), &list);
+        encoder.finish()
+    }
+}
+
+/// `--shadows on`: the shadow's own share of the error: the reference's LOD0 objects lit by the method's shadow
+/// map (`now`) and by its counterfactual's (`before`), with their kernels against the reference (shadow_rmse)
+/// and against each other (shadow_lodpop).
+pub struct ShadowShare {
+    pub now: RenderTarget,
+    pub before: RenderTarget,
+    pub rmse: DiffKernel,
+    pub lodpop: DiffKernel,
+}
+
+impl ShadowShare {
+    pub fn new(ctx: &GpuContext, scene: &Scene, reference: &RenderTarget) -> Result<ShadowShare> {
+        let (w, h) = (scene.width, scene.height);
+        let now = RenderTarget::new(&ctx.device, "shadow share now", w, h);
+        let before = RenderTarget::new(&ctx.device, "shadow share before", w, h);
+        let rmse = DiffKernel::new(ctx, "shadow rmse", &[(&now, reference)], scene.frames)?;
+        let lodpop = DiffKernel::new(ctx, "shadow lodpop", &[(&now, &before)], scene.frames)?;
+        Ok(ShadowShare {
+            now,
+            before,
+            rmse,
+            lodpop,
+        })
+    }
+}
+
+/// `--taa on`: the resolve, and the image streams of the method and of the reference, each with its history.
+pub struct TaaStreams {
+    pub resolve: TaaResolve,
+    pub method: TaaStream,
+    pub reference: TaaStream,
+}
+
+impl TaaStreams {
+    pub fn new(ctx: &GpuContext, scene: &Scene) -> Option<TaaStreams> {
+        let resolve = TaaResolve::new(ctx, scene.taa?);
+        let (w, h) = (scene.width, scene.height);
+        Some(TaaStreams {
+            method: resolve.stream(ctx, "method", w, h),
+            reference: resolve.stream(ctx, "reference", w, h),
+            resolve,
+        })
+    }
+
+    pub fn reset(&mut self) {
+        self.method.reset();
+        self.reference.reset();
+    }
+
+    pub fn begin_frame(&self, ctx: &GpuContext) {
+        self.resolve.begin_frame(ctx, &self.method);
+        self.resolve.begin_frame(ctx, &self.reference);
+    }
+
+    /// Both frames resolved in place, each against its own history, which they update.
+    pub fn resolve_frames(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        method: &RenderTarget,
+        reference: &RenderTarget,
+    ) {
+        self.resolve
+            .encode(ctx, encoder, &self.method, method, true);
+        self.resolve
+            .encode(ctx, encoder, &self.reference, reference, true);
+    }
+
+    /// A counterfactual of the method's frame resolved against the method's history, leaving it as it is.
+    pub fn resolve_method_counterfactual(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) {
+        self.resolve
+            .encode(ctx, encoder, &self.method, target, false);
+    }
+
+    /// A counterfactual of the reference's frame resolved against the reference's history, leaving it as it is.
+    pub fn resolve_reference_counterfactual(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+    ) {
+        self.resolve
+            .encode(ctx, encoder, &self.reference, target, false);
+    }
+
+    pub fn advance(&mut self) {
+        self.method.advance();
+        self.reference.advance();
+    }
+}

@@ -1,0 +1,572 @@
+//! The quality pass of one method on a block, frame by frame in stages:
+//!
+//! 1. **render**: the reference and the method into two targets, each lit by its own shadow map;
+//! 2. **shadow maps** (`--shadows on`): what the reference, the method and the method's counterfactual cast,
+//!    asked once the method has decided its frame, submitted before the frame's commands;
+//! 3. **effects**: `--taa on` resolves both frames in place; `--shadows on` renders the shadow's own share;
+//! 4. **metrics**: the metric kernel reduces the difference of the two targets to scalars on the GPU;
+//! 5. **read-back requests**: the frames (for FLIP and dumps) and the method's intermediate images;
+//! 6. **counterfactuals**: lodpop's and the lag's frames at this pose, in a submission of their own;
+//! 7. **collect**: FLIP and the dump callback on the read-back images, or a bound on the frames in flight.
+//!
+//! The scalars of all frames are read back once at the end. FSI's combination pass is timed here.
+
+use super::block::{BlockRunner, FrameImages};
+use super::check_interrupt;
+use super::diff_kernel::DiffKernel;
+use super::driver::FrameDriver;
+use super::effects::{Casters, ShadowRole};
+use super::metric_kernel::MetricKernel;
+use crate::error::{Error, Result};
+use crate::gpu::timing::GpuTimer;
+use crate::gpu::{GpuContext, RenderTarget, SceneGpu, TextureReadback};
+use crate::measure::metrics::{FrameMetrics, Metric, MetricReduction};
+use crate::methods::{FrameInput, Method};
+use crate::scene::schedule::InstanceState;
+use crate::scene::Scene;
+use indicatif::ProgressBar;
+use std::collections::VecDeque;
+use std::time::Instant;
+
+/// What the quality pass computes besides rmse, pop and lodpop, and how.
+#[derive(Debug, Clone, Default)]
+pub struct QualityOptions {
+    /// `--metrics`: `Metric::Flip` and `Metric::De2000` switch those metrics on.
+    pub metrics: Vec<Metric>,
+    /// `--metric-reduction`.
+    pub reduction: MetricReduction,
+}
+
+impl QualityOptions {
+    /// With de2000 (the GPU-oracle tests).
+    pub fn with_de2000() -> QualityOptions {
+        QualityOptions {
+            metrics: vec![Metric::De2000],
+            ..Default::default()
+        }
+    }
+}
+
+/// The quality pass's render targets.
+pub struct QualityTargets {
+    pub method: RenderTarget,
+    pub reference: RenderTarget,
+    /// lodpop's counterfactual frames at the current pose: without the method's lag (`now`) and with the
+    /// previous schedule (`before`).
+    pub now: RenderTarget,
+    pub before: RenderTarget,
+}
+
+impl QualityTargets {
+    pub fn new(ctx: &GpuContext, w: u32, h: u32) -> QualityTargets {
+        QualityTargets {
+            method: RenderTarget::new(&ctx.device, "method target", w, h),
+            reference: RenderTarget::new(&ctx.device, "reference target", w, h),
+            now: RenderTarget::new(&ctx.device, "lodpop now target", w, h),
+            before: RenderTarget::new(&ctx.device, "lodpop before target", w, h),
+        }
+    }
+}
+
+/// The quality pass's GPU reductions, one slot per frame each.
+pub struct QualityKernels {
+    /// rmse, pop, de2000, uncovered and crack pixels of (method, reference).
+    pub metric: MetricKernel,
+    /// Times the metric kernel alone (its own cost, reported in run.json).
+    pub metric_timer: Option<GpuTimer>,
+    /// lodpop: pair 0 = (method, before), pair 1 = (now, before).
+    pub lodpop: DiffKernel,
+    /// lag_rmse: (method, now).
+    pub lag: DiffKernel,
+}
+
+impl QualityKernels {
+    pub fn new(
+        ctx: &GpuContext,
+        gpu: &SceneGpu,
+        scene: &Scene,
+        t: &QualityTargets,
+        quality: &QualityOptions,
+    ) -> Result<QualityKernels> {
+        let frames = scene.frames;
+        let pairs = [(&t.method, &t.before), (&t.now, &t.before)];
+        Ok(QualityKernels {
+            lodpop: DiffKernel::new(ctx, "lodpop", &pairs, frames)?,
+            lag: DiffKernel::new(ctx, "lag", &[(&t.method, &t.now)], frames)?,
+            metric: MetricKernel::new(
+                ctx,
+                (&t.method, &t.reference),
+                frames,
+                (quality.metrics.contains(&Metric::De2000), quality.reduction),
+                gpu.background_bytes(ctx)?,
+            )?,
+            metric_timer: GpuTimer::new(ctx, frames),
+        })
+    }
+}
+
+/// The shadow's own share of the error per frame (`--shadows on`).
+pub struct ShadowFigures {
+    pub rmse: Vec<f64>,
+    pub lodpop: Vec<f64>,
+}
+
+/// What the quality pass measured, per frame.
+pub struct QualityPass {
+    pub metrics: Vec<FrameMetrics>,
+    /// `--metrics flip`: mean FLIP per frame.
+    pub flip: Vec<Option<f64>>,
+    pub lodpop: Vec<f64>,
+    /// Methods with a lag (FSI): lag_rmse per frame.
+    pub lag: Option<Vec<f64>>,
+    pub shadow: Option<ShadowFigures>,
+    /// The method's own stage per frame (FSI's combination pass), when it has one: timed in the quality pass,
+    /// so that its timestamps are never inside a timing-pass frame.
+    pub stage_ms: Option<Vec<Option<f64>>>,
+    pub ms_per_frame: f64,
+    pub metric_gpu_ms_median: Option<f64>,
+}
+
+/// Keep at most this many quality-pass frames queued on the GPU.
+const QUALITY_IN_FLIGHT: usize = 2;
+
+/// The schedule states of the last frames, newest first: lodpop's history.
+struct StateHistory {
+    /// How many earlier frames the method's counterfactual reads (`Method::lodpop_history`, at least 1).
+    depth: usize,
+    frames: VecDeque<Vec<InstanceState>>,
+}
+
+impl StateHistory {
+    fn new(depth: usize) -> StateHistory {
+        StateHistory {
+            depth,
+            frames: VecDeque::with_capacity(depth + 1),
+        }
+    }
+
+    /// The previous frame's states (before [`StateHistory::push`] of this frame's).
+    fn previous(&self) -> Option<&[InstanceState]> {
+        self.frames.front().map(Vec::as_slice)
+    }
+
+    fn push(&mut self, states: &[InstanceState]) {
+        self.frames.push_front(states.to_vec());
+        self.frames.truncate(self.depth + 1);
+    }
+
+    /// Whether the frame after `push` can differ from its counterfactual: the states changed within the
+    /// history, a transition is under way with a history deeper than one frame, or the method says its
+    /// selection changed (asked last).
+    fn changed(&self, selection_changed: impl FnOnce() -> bool) -> bool {
+        let h = &self.frames;
+        h.len() > 1
+            && (h.iter().skip(1).any(|s| *s != h[0])
+                || (self.depth > 1 && h.iter().flatten().any(|s| s.in_transition()))
+                || selection_changed())
+    }
+
+    /// The earlier frames' states, newest first.
+    fn earlier(&self) -> Vec<&[InstanceState]> {
+        self.frames.iter().skip(1).map(Vec::as_slice).collect()
+    }
+}
+
+/// Which counterfactual frames were drawn this frame.
+#[derive(Debug, Clone, Copy)]
+struct Counterfactuals {
+    /// The frame without the method's lag (`now`): the method has one.
+    unlagged: bool,
+    /// The frame with the previous schedule (`before`): it can differ from the frame.
+    changed: bool,
+}
+
+/// The read-backs one frame asked for.
+struct FrameReads {
+    /// The method's and the reference's frames were copied for read-back.
+    frames: bool,
+    /// The frame goes to the dump callback.
+    dump: bool,
+    /// The method's intermediate images and the counterfactual frames (dumped frames only).
+    extras: Vec<(&'static str, TextureReadback)>,
+}
+
+/// What the pass carries from frame to frame.
+struct Walk {
+    history: StateHistory,
+    in_flight: VecDeque<wgpu::SubmissionIndex>,
+    flip: Vec<Option<f64>>,
+    has_lag: bool,
+}
+
+impl BlockRunner<'_> {
+    /// The quality pass of `method` walking `driver`; `dump_frames`: per frame, whether it goes to `on_frames`.
+    pub(super) fn quality_pass(
+        &mut self,
+        method: &mut dyn Method,
+        driver: &mut FrameDriver<'_>,
+        dump_frames: &[bool],
+        progress: &ProgressBar,
+        on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
+    ) -> Result<QualityPass> {
+        let frames = self.scene.frames;
+        driver.reset();
+        let mut walk = Walk {
+            history: StateHistory::new(method.lodpop_history().max(1)),
+            in_flight: VecDeque::new(),
+            flip: vec![None; frames as usize],
+            has_lag: false,
+        };
+        let pass_start = Instant::now();
+        if let Some(taa) = &mut self.effects.taa {
+            taa.reset();
+        }
+        for f in 0..frames {
+            check_interrupt()?;
+            driver.advance(f);
+            self.quality_frame(
+                method,
+                driver,
+                f,
+                dump_frames[f as usize],
+                &mut walk,
+                on_frames,
+            )?;
+            progress.inc(1);
+        }
+        self.ctx.wait_idle()?;
+        let ms_per_frame = pass_start.elapsed().as_secs_f64() * 1e3 / frames as f64;
+        self.read_figures(method, walk, ms_per_frame)
+    }
+
+    /// One frame of the quality pass, through every stage.
+    fn quality_frame(
+        &mut self,
+        method: &mut dyn Method,
+        driver: &FrameDriver<'_>,
+        f: u32,
+        dump: bool,
+        walk: &mut Walk,
+        on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
+    ) -> Result<()> {
+        let ctx = self.ctx;
+        self.write_frame(f);
+        if let Some(taa) = &self.effects.taa {
+            taa.begin_frame(ctx);
+        }
+        let input = driver.input(f);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        if f == 0 {
+            self.clear_kernels(&mut encoder);
+        }
+        self.render_frames(method, &input, &mut encoder);
+        let shadows = self.shadow_maps(method, &input, walk.history.previous());
+        self.apply_effects(&input, &mut encoder, f);
+        self.encode_metrics(&mut encoder, f);
+        let mut reads = self.request_reads(method, &mut encoder, dump);
+        let mut index = ctx
+            .queue
+            .submit(shadows.into_iter().chain([encoder.finish()]));
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        walk.history.push(&driver.states);
+        let drawn = self.counterfactuals(method, &input, &walk.history, &mut encoder, f);
+        walk.has_lag |= drawn.unlagged;
+        if reads.dump {
+            self.request_counterfactual_reads(drawn, &mut encoder, &mut reads);
+        }
+        if drawn.unlagged || drawn.changed {
+            index = ctx.queue.submit([encoder.finish()]);
+        }
+        if let Some(taa) = &mut self.effects.taa {
+            taa.advance();
+        }
+        self.collect_frame(f, reads, index, walk, on_frames)
+    }
+
+    /// lodpop's, the lag's and the shadow share's accumulators, before the first frame.
+    fn clear_kernels(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.kernels.lodpop.clear(encoder);
+        self.kernels.lag.clear(encoder);
+        if let Some(share) = &self.effects.shadow_share {
+            share.rmse.clear(encoder);
+            share.lodpop.clear(encoder);
+        }
+    }
+
+    /// Stage 1: the reference and the method, each lit by its own shadow map.
+    fn render_frames(
+        &mut self,
+        method: &mut dyn Method,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+    ) {
+        let (gpu, t, reference) = (&self.gpu, &self.targets, &mut self.reference);
+        gpu.lit_by(ShadowRole::Reference.map(), || {
+            reference.encode(gpu, input, encoder, &t.reference)
+        });
+        gpu.lit_by(ShadowRole::Method.map(), || {
+            method.encode(gpu, input, encoder, &t.method)
+        });
+    }
+
+    /// Stage 2 (`--shadows on`): the frame's shadow maps: the reference's LOD0, the method's casters, and, for
+    /// lodpop's counterfactual, what the method cast with the `previous` frame's states.
+    fn shadow_maps(
+        &self,
+        method: &dyn Method,
+        input: &FrameInput<'_>,
+        previous: Option<&[InstanceState]>,
+    ) -> Vec<wgpu::CommandBuffer> {
+        let Some(shadows) = &self.effects.shadows else {
+            return Vec::new();
+        };
+        let gpu = &self.gpu;
+        let mut out = vec![
+            shadows.commands(
+                gpu,
+                self.reference.as_ref(),
+                input,
+                input.states,
+                (ShadowRole::Reference, Casters::Reference),
+            ),
+            shadows.commands(
+                gpu,
+                method,
+                input,
+                input.states,
+                (ShadowRole::Method, Casters::Method),
+            ),
+        ];
+        if let Some(previous) = previous {
+            out.push(shadows.commands(
+                gpu,
+                method,
+                input,
+                previous,
+                (ShadowRole::Before, Casters::Method),
+            ));
+        }
+        out
+    }
+
+    /// Stage 3: TAA resolves both frames in place (each against its own history) before anything reads them;
+    /// the shadow's own share: LOD0 objects lit by the method's shadow map now and by its counterfactual's
+    /// (resolved against the reference's history under TAA, which they leave as it is).
+    fn apply_effects(
+        &mut self,
+        input: &FrameInput<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        f: u32,
+    ) {
+        let (ctx, gpu, t, reference) = (self.ctx, &self.gpu, &self.targets, &mut self.reference);
+        if let Some(taa) = &self.effects.taa {
+            taa.resolve_frames(ctx, encoder, &t.method, &t.reference);
+        }
+        let Some(share) = &self.effects.shadow_share else {
+            return;
+        };
+        for (role, target) in [
+            (ShadowRole::Method, &share.now),
+            (ShadowRole::Before, &share.before),
+        ] {
+            gpu.lit_by(role.map(), || reference.encode(gpu, input, encoder, target));
+            if let Some(taa) = &self.effects.taa {
+                taa.resolve_reference_counterfactual(ctx, encoder, target);
+            }
+        }
+        share.rmse.encode(&ctx.queue, encoder, f, 0);
+        if f > 0 {
+            share.lodpop.encode(&ctx.queue, encoder, f, 0);
+        }
+    }
+
+    /// Stage 4: the metric kernel on (method, reference), timed on its own.
+    fn encode_metrics(&self, encoder: &mut wgpu::CommandEncoder, f: u32) {
+        let k = &self.kernels;
+        if let Some(t) = &k.metric_timer {
+            t.begin(encoder, f);
+        }
+        k.metric.encode(&self.ctx.queue, encoder, f);
+        if let Some(t) = &k.metric_timer {
+            t.end(encoder, f);
+        }
+    }
+
+    /// Stage 5: copies of the frames for FLIP or a dump, and of the method's intermediate images (FSI's LOD
+    /// buffers) for a dump.
+    fn request_reads(
+        &self,
+        method: &dyn Method,
+        encoder: &mut wgpu::CommandEncoder,
+        dump: bool,
+    ) -> FrameReads {
+        let frames = match &self.readback {
+            Some([m, r]) if dump || self.flip => {
+                m.encode_copy(encoder, &self.targets.method);
+                r.encode_copy(encoder, &self.targets.reference);
+                true
+            }
+            _ => false,
+        };
+        let extras = if dump {
+            method
+                .debug_targets()
+                .into_iter()
+                .map(|(name, t)| (name, self.copy_of(encoder, name, t)))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        FrameReads {
+            frames,
+            dump,
+            extras,
+        }
+    }
+
+    fn copy_of(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        name: &str,
+        t: &RenderTarget,
+    ) -> TextureReadback {
+        let rb = TextureReadback::color(&self.ctx.device, name, t.width, t.height);
+        rb.encode_copy(encoder, t);
+        rb
+    }
+
+    /// Stage 6: lodpop's and the lag's counterfactual frames at this pose, and their kernels (the method
+    /// writes its instance data again through the queue, so this goes in a submission of its own).
+    fn counterfactuals(
+        &self,
+        method: &mut dyn Method,
+        input: &FrameInput<'_>,
+        history: &StateHistory,
+        encoder: &mut wgpu::CommandEncoder,
+        f: u32,
+    ) -> Counterfactuals {
+        let (ctx, gpu, t, k) = (self.ctx, &self.gpu, &self.targets, &self.kernels);
+        let taa = self.effects.taa.as_ref();
+        let unlagged = method.encode_unlagged(gpu, input, encoder, &t.now);
+        if unlagged {
+            if let Some(taa) = taa {
+                taa.resolve_method_counterfactual(ctx, encoder, &t.now);
+            }
+            k.lag.encode(&ctx.queue, encoder, f, 0);
+        }
+        let changed = history.changed(|| method.selection_changed());
+        if changed {
+            let earlier = history.earlier();
+            gpu.lit_by(ShadowRole::Before.map(), || {
+                method.encode_before(gpu, input, &earlier, encoder, &t.before)
+            });
+            if let Some(taa) = taa {
+                taa.resolve_method_counterfactual(ctx, encoder, &t.before);
+            }
+            k.lodpop.encode(&ctx.queue, encoder, f, unlagged as usize);
+        }
+        Counterfactuals { unlagged, changed }
+    }
+
+    /// With a dump: the counterfactual frames drawn this frame, for read-back.
+    fn request_counterfactual_reads(
+        &self,
+        drawn: Counterfactuals,
+        encoder: &mut wgpu::CommandEncoder,
+        reads: &mut FrameReads,
+    ) {
+        for (name, show, target) in [
+            ("lodpop-now", drawn.unlagged, &self.targets.now),
+            ("lodpop-before", drawn.changed, &self.targets.before),
+        ] {
+            if show {
+                let rb = self.copy_of(encoder, name, target);
+                reads.extras.push((name, rb));
+            }
+        }
+    }
+
+    /// Stage 7: FLIP and the dump callback on the frame's read-back images, or, when nothing is read back, a
+    /// bound on the frames queued on the GPU.
+    fn collect_frame(
+        &self,
+        f: u32,
+        reads: FrameReads,
+        index: wgpu::SubmissionIndex,
+        walk: &mut Walk,
+        on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
+    ) -> Result<()> {
+        let ctx = self.ctx;
+        if let (true, Some([m, r])) = (reads.frames, &self.readback) {
+            let method_rgba = m.read(ctx)?;
+            let reference_rgba = r.read(ctx)?;
+            if self.flip {
+                walk.flip[f as usize] = Some(crate::measure::metrics::flip_mean(
+                    &method_rgba,
+                    &reference_rgba,
+                    self.scene.width,
+                    self.scene.height,
+                ));
+            }
+            if reads.dump {
+                let extras = reads
+                    .extras
+                    .iter()
+                    .map(|(name, rb)| Ok((*name, rb.read(ctx)?)))
+                    .collect::<Result<Vec<_>>>()?;
+                on_frames(f, (&method_rgba, &reference_rgba, &extras))?;
+            }
+            return Ok(());
+        }
+        walk.in_flight.push_back(index);
+        if walk.in_flight.len() > QUALITY_IN_FLIGHT {
+            if let Some(oldest) = walk.in_flight.pop_front() {
+                ctx.device
+                    .poll(wgpu::PollType::Wait {
+                        submission_index: Some(oldest),
+                        timeout: None,
+                    })
+                    .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// After the last frame: every kernel's per-frame figures, read back once.
+    fn read_figures(
+        &self,
+        method: &dyn Method,
+        walk: Walk,
+        ms_per_frame: f64,
+    ) -> Result<QualityPass> {
+        let (ctx, k, frames) = (self.ctx, &self.kernels, self.scene.frames);
+        let shadow = match &self.effects.shadow_share {
+            Some(share) => Some(ShadowFigures {
+                rmse: share.rmse.read(ctx, frames)?,
+                lodpop: share.lodpop.read(ctx, frames)?,
+            }),
+            None => None,
+        };
+        let metric_gpu_ms_median = match &k.metric_timer {
+            Some(t) => {
+                let ms: Vec<f64> = t.read(ctx)?.into_iter().flatten().collect();
+                crate::measure::stats::percentile(&ms, 50.0)
+            }
+            None => None,
+        };
+        Ok(QualityPass {
+            metrics: k.metric.read(ctx, frames)?,
+            flip: walk.flip,
+            lodpop: k.lodpop.read(ctx, frames)?,
+            lag: if walk.has_lag {
+                Some(k.lag.read(ctx, frames)?)
+            } else {
+                None
+            },
+            shadow,
+            stage_ms: method.stage_gpu_ms(ctx)?,
+            ms_per_frame,
+            metric_gpu_ms_median,
+        })
+    }
+}

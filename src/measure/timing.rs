@@ -1,0 +1,320 @@
+//! The warm-up and the timing rounds of a block's methods.
+//!
+//! - Warm-up ([`WarmUpPlan`]): `warmup` untimed frames, then the first frames of each distinct transition, so
+//!   every pipeline a method uses has run once before timing.
+//! - Timing rounds ([`BlockRunner::time_methods`]): the path is cut into `rounds` consecutive segments; round r
+//!   times every method over segment r in a seeded shuffled order, each method continuing its own walk, so drift
+//!   of the machine's speed falls on all methods alike and each round pairs the methods on the same frames.
+//!   Nothing but the method's own work is in a timed frame (no metric, no read-back, no stage timestamps). Each
+//!   frame is submitted and waited for, so `cpu_ms` is a true encode-to-completion time and frames never
+//!   overlap; GPU timestamps are resolved into one buffer per method and read once after the rounds.
+
+use super::block::BlockRunner;
+use super::driver::{FrameDriver, FrameFacts};
+use super::effects::{Casters, ShadowRole};
+use super::{check_interrupt, is_reference};
+use crate::error::Result;
+use crate::gpu::timing::GpuTimer;
+use crate::gpu::DrawStats;
+use crate::measure::records::{BlockRounds, Round, TransitionPair};
+use crate::methods::{FrameInput, Method, MethodEntry};
+use crate::rng::SplitMix64;
+use crate::scene::Scene;
+use indicatif::ProgressBar;
+use std::time::Instant;
+
+/// Instance bytes a method moved over its timed frames.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Uploads {
+    /// Bytes of the instance lists it built.
+    pub listed: u64,
+    /// Bytes it wrote to the GPU.
+    pub written: u64,
+}
+
+/// One method of a block from its creation through the timing rounds: the method (kept for its quality pass),
+/// its own walk along the path, and what its timed frames measured.
+pub struct TimedMethod<'s> {
+    pub label: String,
+    pub(super) entry: MethodEntry,
+    pub(super) method: Box<dyn Method>,
+    pub(super) driver: FrameDriver<'s>,
+    timer: Option<GpuTimer>,
+    pub(super) facts: Vec<FrameFacts>,
+    pub(super) cpu_ms: Vec<f64>,
+    pub(super) stats: Vec<DrawStats>,
+    /// The round each frame was timed in.
+    pub(super) round: Vec<u32>,
+    /// GPU time per frame, read after the last round (None without timestamp queries).
+    pub(super) gpu_ms: Vec<Option<f64>>,
+    /// Wall time of the method's timed segments, ms.
+    wall_ms: f64,
+    pub(super) uploads: Uploads,
+    /// `--warmup` (the frames of the path rendered untimed first; [`WarmUpPlan`] adds transition frames).
+    pub(super) warmup: u32,
+}
+
+impl TimedMethod<'_> {
+    /// Wall time per timed frame (render + wait), ms.
+    pub fn ms_per_frame(&self) -> f64 {
+        self.wall_ms / self.cpu_ms.len().max(1) as f64
+    }
+}
+
+/// The timing-round time per frame of the (first) reference among `timed`, listed or timed only: the denominator
+/// of `quality_to_renders_ratio`.
+pub fn reference_ms_per_frame(timed: &[TimedMethod<'_>]) -> Option<f64> {
+    timed
+        .iter()
+        .find(|t| is_reference(&t.label))
+        .map(TimedMethod::ms_per_frame)
+}
+
+/// The frames every method renders untimed before the rounds: the first `warmup` frames of the path (wrapping),
+/// then the first frame of each distinct transition of the path (`lod_from -> lod_to` pair) and the two frames
+/// after it, so that every pipeline and buffer a method uses in a transition is used once before timing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WarmUpPlan {
+    pub warmup: u32,
+    pub transition_frames: Vec<u32>,
+}
+
+impl WarmUpPlan {
+    /// Walks the path once on the CPU to find the transitions.
+    pub fn new(scene: &Scene, warmup: u32) -> WarmUpPlan {
+        let mut driver = FrameDriver::new(scene);
+        let mut seen: Vec<TransitionPair> = Vec::new();
+        let mut frames: Vec<u32> = Vec::new();
+        for f in 0..scene.frames {
+            let pair = driver.advance(f).pair;
+            if pair != TransitionPair::None && !seen.contains(&pair) {
+                seen.push(pair);
+                frames.extend((f..f + 3).filter(|&g| g < scene.frames));
+            }
+        }
+        frames.sort_unstable();
+        frames.dedup();
+        WarmUpPlan {
+            warmup,
+            transition_frames: frames,
+        }
+    }
+}
+
+/// The frames of round `r` of `rounds` over `frames` frames: consecutive segments of (nearly) equal length.
+pub fn round_frames(r: u32, rounds: u32, frames: u32) -> (u32, u32) {
+    let at = |i: u32| (i as u64 * frames as u64 / rounds.max(1) as u64) as u32;
+    (at(r), at(r + 1))
+}
+
+/// Round `r`'s order of `n` methods: a Fisher-Yates shuffle drawn from `rng`.
+pub fn shuffled_order(n: usize, rng: &mut SplitMix64) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..n).collect();
+    for i in (1..n).rev() {
+        let j = (rng.next_u64() % (i as u64 + 1)) as usize;
+        order.swap(i, j);
+    }
+    order
+}
+
+impl<'a> BlockRunner<'a> {
+    /// Creates the methods `labels` (a label `NAME#k` is another instance of NAME), warms each up
+    /// ([`WarmUpPlan`]), then times them in `rounds` interleaved rounds: round r times every method over the
+    /// frames [`round_frames`]`(r)`, in an order shuffled from `seed`, each method continuing its own walk along
+    /// the path. When no label is the reference, the reference is timed too (its time per frame is the
+    /// denominator of run.json's `quality_to_renders_ratio`) and returned last, labelled `reference`.
+    pub fn time_methods(
+        &self,
+        labels: &[String],
+        warmup: u32,
+        rounds: u32,
+        seed: u64,
+        progress: &ProgressBar,
+    ) -> Result<(Vec<TimedMethod<'a>>, BlockRounds)> {
+        let (scene, frames) = (self.scene, self.scene.frames);
+        let mut labels = labels.to_vec();
+        let timed_only: Vec<String> = if labels.iter().any(|l| is_reference(l)) {
+            Vec::new()
+        } else {
+            labels.push("reference".into());
+            vec!["reference".into()]
+        };
+        let mut methods = labels
+            .iter()
+            .map(|label| self.create_timed(label, warmup))
+            .collect::<Result<Vec<_>>>()?;
+        let plan = WarmUpPlan::new(scene, warmup);
+        for m in methods.iter_mut() {
+            self.warm_up(m, &plan, progress)?;
+            m.driver.reset();
+        }
+        let rounds = rounds.clamp(1, frames.max(1));
+        let mut rng = SplitMix64::new(seed);
+        let mut info = BlockRounds {
+            scene: scene.name().to_string(),
+            count: scene.count,
+            seed,
+            warmup_transition_frames: plan.transition_frames.clone(),
+            timed_only,
+            rounds: Vec::with_capacity(rounds as usize),
+        };
+        for r in 0..rounds {
+            let (lo, hi) = round_frames(r, rounds, frames);
+            let order = shuffled_order(methods.len(), &mut rng);
+            for &i in &order {
+                self.time_segment(&mut methods[i], r, lo..hi, progress)?;
+            }
+            info.rounds.push(Round {
+                round: r,
+                frames: [lo, hi],
+                order: order.iter().map(|&i| methods[i].label.clone()).collect(),
+            });
+        }
+        for m in methods.iter_mut() {
+            m.gpu_ms = match &m.timer {
+                Some(t) => t.read(self.ctx)?,
+                None => Vec::new(),
+            };
+        }
+        self.ctx.check_errors()?;
+        Ok((methods, info))
+    }
+
+    /// The method `label`, created, with an empty record of its timed frames.
+    fn create_timed(&self, label: &str, warmup: u32) -> Result<TimedMethod<'a>> {
+        let (scene, frames) = (self.scene, self.scene.frames as usize);
+        let entry = *self.setup.registry.get(label)?;
+        Ok(TimedMethod {
+            label: label.to_string(),
+            entry,
+            method: (entry.create)(&self.build())?,
+            driver: FrameDriver::new(scene),
+            timer: GpuTimer::new(self.ctx, scene.frames),
+            facts: Vec::with_capacity(frames),
+            cpu_ms: Vec::with_capacity(frames),
+            stats: Vec::with_capacity(frames),
+            round: Vec::with_capacity(frames),
+            gpu_ms: Vec::new(),
+            wall_ms: 0.0,
+            uploads: Uploads::default(),
+            warmup,
+        })
+    }
+
+    /// `plan`'s warm-up frames, untimed.
+    fn warm_up(
+        &self,
+        m: &mut TimedMethod<'_>,
+        plan: &WarmUpPlan,
+        progress: &ProgressBar,
+    ) -> Result<()> {
+        let scene = self.scene;
+        for w in 0..plan.warmup {
+            let f = w % scene.frames;
+            if f == 0 {
+                m.driver.reset();
+            }
+            m.driver.advance(f);
+            self.render_untimed(m, f)?;
+            progress.inc(1);
+        }
+        m.driver.reset();
+        let last = plan.transition_frames.last().copied();
+        for f in 0..last.map_or(0, |l| l + 1) {
+            m.driver.advance(f);
+            if plan.transition_frames.binary_search(&f).is_ok() {
+                self.render_untimed(m, f)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// `--shadows on`, outside the quality pass: what `m` casts this frame, into the method's shadow map.
+    fn own_shadow(
+        &self,
+        m: &TimedMethod<'_>,
+        input: &FrameInput<'_>,
+    ) -> Option<wgpu::CommandBuffer> {
+        let casters = if is_reference(&m.label) {
+            Casters::Reference
+        } else {
+            Casters::Method
+        };
+        let shadows = self.effects.shadows.as_ref()?;
+        Some(shadows.commands(
+            &self.gpu,
+            m.method.as_ref(),
+            input,
+            input.states,
+            (ShadowRole::Method, casters),
+        ))
+    }
+
+    fn render_untimed(&self, m: &mut TimedMethod<'_>, f: u32) -> Result<()> {
+        check_interrupt()?;
+        let ctx = self.ctx;
+        self.write_frame(f);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let input = m.driver.input(f);
+        m.method
+            .encode(&self.gpu, &input, &mut encoder, &self.timing_target);
+        let shadow = self.own_shadow(m, &input);
+        ctx.queue
+            .submit(shadow.into_iter().chain([encoder.finish()]));
+        ctx.wait_idle()
+    }
+
+    /// Times `m` over `frames` (the next frames of its walk) in round `round`: each frame submitted and waited
+    /// for, bracketed by the method's own timestamps, nothing else in its command buffer.
+    fn time_segment(
+        &self,
+        m: &mut TimedMethod<'_>,
+        round: u32,
+        frames: std::ops::Range<u32>,
+        progress: &ProgressBar,
+    ) -> Result<()> {
+        let ctx = self.ctx;
+        let uploads_before = self.gpu.uploads.get();
+        let start = Instant::now();
+        for f in frames {
+            check_interrupt()?;
+            m.facts.push(m.driver.advance(f));
+            let t0 = Instant::now();
+            self.write_frame(f);
+            // With --shadows on the shadow pass goes in a command buffer of its own, before the frame's (it
+            // draws what the method decided in `encode`); the method's timestamps open it.
+            let mut first = ctx.device.create_command_encoder(&Default::default());
+            if let Some(t) = &m.timer {
+                t.begin(&mut first, f);
+            }
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            let input = FrameInput {
+                timed: true,
+                ..m.driver.input(f)
+            };
+            let stats = m
+                .method
+                .encode(&self.gpu, &input, &mut encoder, &self.timing_target);
+            m.stats.push(stats);
+            if let Some(t) = &m.timer {
+                t.end(&mut encoder, f);
+            }
+            let shadow = self.own_shadow(m, &input);
+            ctx.queue.submit(
+                [first.finish()]
+                    .into_iter()
+                    .chain(shadow)
+                    .chain([encoder.finish()]),
+            );
+            ctx.wait_idle()?;
+            m.cpu_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+            m.round.push(round);
+            progress.inc(1);
+        }
+        m.wall_ms += start.elapsed().as_secs_f64() * 1e3;
+        let after = self.gpu.uploads.get();
+        m.uploads.listed += after.0 - uploads_before.0;
+        m.uploads.written += after.1 - uploads_before.1;
+        Ok(())
+    }
+}
