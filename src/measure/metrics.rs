@@ -2,9 +2,9 @@
 //! (they must agree to 1e-5) and what `--dump-frames` heat-maps are made from.
 //!
 //! Images are tightly packed RGBA8 with sRGB-encoded colour; alpha is ignored. Values are taken as encoded
-//! values in [0, 1] (byte / 255), as seed 003 section 6 compares the stored images.
+//! values in [0, 1] (byte / 255), as Sheliemietiev et al. 2023 section 6 compares the stored images.
 
-/// rmse of seed 003 section 6 steps 5-6: per pixel the mean over R, G, B of |a - b|, then the root mean square
+/// rmse of Sheliemietiev et al. 2023 section 6 steps 5-6: per pixel the mean over R, G, B of |a - b|, then the root mean square
 /// over pixels.
 pub fn rmse_srgb(method: &[u8], reference: &[u8]) -> f64 {
     assert_eq!(method.len(), reference.len(), "images of different sizes");
@@ -340,7 +340,7 @@ pub fn crack_pixels(
     (uncovered, cracks)
 }
 
-/// Per-pixel mean absolute difference over R, G, B in [0, 1]: the single-channel difference image of seed 003
+/// Per-pixel mean absolute difference over R, G, B in [0, 1]: the single-channel difference image of Sheliemietiev et al. 2023
 /// section 6 step 5.
 pub fn difference_image(method: &[u8], reference: &[u8]) -> Vec<f32> {
     method

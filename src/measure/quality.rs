@@ -570,3 +570,58 @@ impl BlockRunner<'_> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn states(lods: &[(u32, u32, f32)]) -> Vec<InstanceState> {
+        lods.iter()
+            .map(|&(lod_from, lod_to, k)| InstanceState {
+                lod_from,
+                lod_to,
+                k,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_counterfactual_is_drawn_only_when_the_frame_can_differ() {
+        let steady = states(&[(1, 1, 0.0), (2, 2, 0.0)]);
+        let switched = states(&[(1, 1, 0.0), (3, 3, 0.0)]);
+        let mut h = StateHistory::new(1);
+        h.push(&steady);
+        assert!(!h.changed(|| true), "the first frame has no earlier frame");
+        assert_eq!(h.previous(), Some(steady.as_slice()));
+        h.push(&steady);
+        assert!(!h.changed(|| false), "the same states twice");
+        assert!(h.changed(|| true), "the method's own selection changed");
+        h.push(&switched);
+        assert!(h.changed(|| false), "an instance switched");
+        assert_eq!(
+            h.earlier(),
+            vec![steady.as_slice()],
+            "depth 1 keeps one earlier frame"
+        );
+    }
+
+    #[test]
+    fn a_deeper_history_counts_a_transition_under_way() {
+        let blending = states(&[(1, 2, 0.5)]);
+        let mut shallow = StateHistory::new(1);
+        let mut deep = StateHistory::new(2);
+        for _ in 0..3 {
+            shallow.push(&blending);
+            deep.push(&blending);
+        }
+        assert!(
+            !shallow.changed(|| false),
+            "one frame back, the same blend state"
+        );
+        assert!(
+            deep.changed(|| false),
+            "two frames back, a transition under way"
+        );
+        assert_eq!(deep.earlier().len(), 2);
+    }
+}

@@ -100,7 +100,7 @@ pub struct SummaryRecord {
     pub crack_px_max: u64,
     pub extra_target_bytes: u64,
     /// Largest relative change of the triangle count between consecutive frames,
-    /// max |t_f - t_(f-1)| / t_(f-1) (seed 000 section 4 saw at most 2 % with FSI).
+    /// max |t_f - t_(f-1)| / t_(f-1) (Scherzer & Wimmer 2008 section 4 saw at most 2 % with FSI).
     pub tri_alternation_max: f64,
     /// Median GPU time of FSI's combination pass (empty for other methods).
     pub combine_gpu_ms_median: Option<f64>,

@@ -318,3 +318,47 @@ impl<'a> BlockRunner<'a> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rounds_partition_the_path() {
+        for (rounds, frames) in [(1, 10), (3, 10), (20, 300), (7, 7), (4, 3)] {
+            let segments: Vec<(u32, u32)> = (0..rounds)
+                .map(|r| round_frames(r, rounds, frames))
+                .collect();
+            assert_eq!(segments[0].0, 0);
+            assert_eq!(segments[rounds as usize - 1].1, frames);
+            for w in segments.windows(2) {
+                assert_eq!(w[0].1, w[1].0, "{rounds} rounds over {frames} frames");
+            }
+            let lengths: Vec<u32> = segments.iter().map(|(lo, hi)| hi - lo).collect();
+            let (min, max) = (lengths.iter().min(), lengths.iter().max());
+            assert!(max.zip(min).is_some_and(|(a, b)| a - b <= 1), "{lengths:?}");
+        }
+    }
+
+    #[test]
+    fn round_orders_are_seeded_permutations() {
+        let draw = |seed| {
+            let mut rng = SplitMix64::new(seed);
+            (0..20)
+                .map(|_| shuffled_order(5, &mut rng))
+                .collect::<Vec<_>>()
+        };
+        let orders = draw(3);
+        assert_eq!(orders, draw(3), "the same seed gives the same orders");
+        assert_ne!(orders, draw(4), "another seed gives other orders");
+        for o in &orders {
+            let mut sorted = o.clone();
+            sorted.sort_unstable();
+            assert_eq!(sorted, vec![0, 1, 2, 3, 4]);
+        }
+        assert!(
+            orders.iter().any(|o| o[0] != 0),
+            "the first method is not always first"
+        );
+    }
+}
