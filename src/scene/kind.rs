@@ -63,27 +63,28 @@ pub struct ProfileValues {
     pub sweep_start: SweepStart,
 }
 
-/// The paper's counts for bunny-grid (seed 003 section 6).
+/// The paper's counts for bunny-grid (Sheliemietiev et al. 2023, section 6).
 pub const PAPER_COUNTS: [u32; 5] = [50, 250, 500, 1000, 2000];
 
 /// A scene `--scene` accepts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SceneKind {
-    /// The popping experiment of seed 003 section 6: one bunny moved along the line of sight and back.
+    /// The popping experiment of Sheliemietiev et al. 2023, section 6: one bunny moved along the line of
+    /// sight and back.
     BunnySweep,
-    /// The performance experiment of seed 003 section 6, eq. 1: n bunnies on the +x axis.
+    /// The performance experiment of Sheliemietiev et al. 2023, section 6, eq. 1: n bunnies on the +x axis.
     BunnyGrid,
-    /// Seed 000's SIMPLE: a field of spheres whose LOD1 is a box.
+    /// Scherzer & Wimmer 2008's SIMPLE: a field of spheres whose LOD1 is a box.
     Simple,
-    /// Seed 000's WINDMILLS: a field of windmills with turning blades.
+    /// Scherzer & Wimmer 2008's WINDMILLS: a field of windmills with turning blades.
     Windmills,
-    /// Seed 000's TREES: a field of alpha-tested trees.
+    /// Scherzer & Wimmer 2008's TREES: a field of alpha-tested trees.
     Trees,
-    /// Seed 004 Fig. 1: the bunny clipped in half, one half reduced to a quarter, the halves joined by the
-    /// seam; a turntable around it.
+    /// Blow 2003, Unified Rendering LOD Part 3, Fig. 1: the bunny clipped in half, one half reduced to a
+    /// quarter, the halves joined by the seam; a turntable around it.
     BunnyHalves,
-    /// One large procedural heightfield (`src/terrain.rs`) in blocks, flown over low.
+    /// One large procedural heightfield (`geometry/terrain.rs`) in blocks, flown over low.
     Terrain,
 }
 
@@ -125,13 +126,15 @@ impl SceneKind {
             .ok_or_else(|| Error::unknown("scene", name, &Self::names()))
     }
 
-    /// The Stanford-bunny scenes of seed 003 (the others are seed 000's procedural camera flights).
+    /// The Stanford-bunny scenes of Sheliemietiev et al. 2023 (the others are Scherzer & Wimmer 2008's
+    /// procedural camera flights).
     pub fn is_bunny(self) -> bool {
         matches!(self, SceneKind::BunnySweep | SceneKind::BunnyGrid)
     }
 
-    /// The scenes of one large mesh divided into blocks (seed 004) and clusters: unified LOD, where each block
-    /// is a model of its own with one instance and the seams join them.
+    /// The scenes of one large mesh divided into blocks (Blow 2003, Unified Rendering LOD Part 3) and
+    /// clusters: unified LOD, where each block is a model of its own with one instance and the seams join
+    /// them.
     pub fn is_unified(self) -> bool {
         matches!(self, SceneKind::BunnyHalves | SceneKind::Terrain)
     }
@@ -166,14 +169,14 @@ impl SceneKind {
 
     /// What `profile` sets for this scene.
     ///
-    /// bunny-grid is a static scene: every frame is the same picture, so its timing needs fewer frames at small
-    /// profiles, and its instance counts make each frame far heavier on a software adapter. bunny-sweep needs
-    /// many frames: `pop` compares consecutive error images, so the bunny must move by well under a pixel per
-    /// frame for a LOD switch to stand out from the error pattern moving with the bunny (docs/measurement.md,
-    /// "Reading pop"). At 320x240, 2,400 frames is the fewest for which every discrete switch frame is a local
-    /// maximum of pop; 600 frames (quick) is only a look. The procedural scenes of seed 000 (simple, windmills,
-    /// trees) are camera flights over a field: their frames are heavy on a software adapter, so the small
-    /// profiles keep few frames and instances.
+    /// bunny-grid is a static scene: every frame is the same picture, so its timing needs fewer frames at
+    /// small profiles, and its instance counts make each frame far heavier on a software adapter. bunny-sweep
+    /// needs many frames: `pop` compares consecutive error images, so the bunny must move by well under a
+    /// pixel per frame for a LOD switch to stand out from the error pattern moving with the bunny
+    /// (docs/measurement.md, "Reading pop"). At 320x240, 2,400 frames is the fewest for which every discrete
+    /// switch frame is a local maximum of pop; 600 frames (quick) is only a look. The procedural scenes of
+    /// Scherzer & Wimmer 2008 (simple, windmills, trees) are camera flights over a field: their frames are
+    /// heavy on a software adapter, so the small profiles keep few frames and instances.
     pub fn profile(self, profile: Profile) -> ProfileValues {
         let frames = |grid: u32, flight: u32, sweep: u32| match self {
             SceneKind::BunnyGrid => grid,
@@ -212,9 +215,10 @@ impl SceneKind {
         }
     }
 
-    /// Instance counts under a profile, unless --count is given: bunny-grid's sweep of counts (seed 003), the
-    /// paper's 4,000 windmills and trees (seed 000 section 4; SIMPLE's count is not given there: 1,000), and
-    /// small fields for the small profiles. bunny-sweep is one bunny whatever --count says.
+    /// Instance counts under a profile, unless --count is given: bunny-grid's sweep of counts (Sheliemietiev
+    /// et al. 2023), the paper's 4,000 windmills and trees (Scherzer & Wimmer 2008, section 4; SIMPLE's count
+    /// is not given there: 1,000), and small fields for the small profiles. bunny-sweep is one bunny whatever
+    /// --count says.
     pub fn profile_counts(self, profile: Profile) -> Vec<u32> {
         use Profile::*;
         use SceneKind::*;

@@ -1,8 +1,9 @@
 //! The LOD schedule shared by every method: per instance per frame `(lod_from, lod_to, k)`.
 //!
-//! Selection is by distance against each model's switch distances (seed 003 section 8: transitions happen in
-//! a small band around the switch distance, 0.95-1.05). Methods never select LODs themselves; they only decide
-//! how to draw a state, so every method sees the same transitions on the same frames.
+//! Selection is by distance against each model's switch distances (Sheliemietiev et al. 2023, section 8:
+//! transitions happen in a small band around the switch distance, 0.95-1.05). Methods never select LODs
+//! themselves; they only decide how to draw a state, so every method sees the same transitions on the same
+//! frames.
 
 use crate::effects::shadow::{Caster, ShadowLod};
 use crate::error::{Error, Result};

@@ -1,16 +1,17 @@
-//! The unified-LOD scenes (seeds 001 and 004): one large mesh divided into a 3D grid of blocks
-//! ([`crate::geometry::blocks`]), each block a model of its own with its own LOD chain and one instance at the identity
-//! transform, so the shared schedule selects and fades each block on its own; the seams between neighbouring
-//! blocks, cross-referenced into every pair of their LODs; and the same mesh's cluster DAG for `clusterlod`.
+//! The unified-LOD scenes (Blow 2003, Unified Rendering LOD Parts 2 and 3): one large mesh divided into a 3D
+//! grid of blocks ([`crate::geometry::blocks`]), each block a model of its own with its own LOD chain and one
+//! instance at the identity transform, so the shared schedule selects and fades each block on its own; the
+//! seams between neighbouring blocks, cross-referenced into every pair of their LODs; and the same mesh's
+//! cluster DAG for `clusterlod`.
 //!
-//! - `bunny-halves` (seed 004 Fig. 1): the bunny (or `--mesh`) clipped in half by the plane through its centre
-//!   across x (a 2 x 1 x 1 grid), both halves with LOD0 and a LOD of a quarter of their triangles; the first
-//!   half always shows LOD0, the second always the quarter (their switch distances lie beyond and inside the
-//!   turntable), so the seam joins two different LODs on every frame. The camera circles the bunny once over
-//!   the frames, 10 degrees above its centre, where its bounding sphere fills 80 % of the view.
-//! - `terrain`: the heightfield of `src/terrain.rs` (or `--mesh`) in cubic blocks (`--blocks` along the longest
-//!   side), each with LODs of 100, 25, 6.25 and 1.5625 % of its triangles, selected by projected error
-//!   (`--pixel-error`). The camera flies along +z at a fixed height 3 % of the mesh's extent above its
+//! - `bunny-halves` (Blow 2003, Part 3, Fig. 1): the bunny (or `--mesh`) clipped in half by the plane through
+//!   its centre across x (a 2 x 1 x 1 grid), both halves with LOD0 and a LOD of a quarter of their triangles;
+//!   the first half always shows LOD0, the second always the quarter (their switch distances lie beyond and
+//!   inside the turntable), so the seam joins two different LODs on every frame. The camera circles the bunny
+//!   once over the frames, 10 degrees above its centre, where its bounding sphere fills 80 % of the view.
+//! - `terrain`: the heightfield of `geometry/terrain.rs` (or `--mesh`) in cubic blocks (`--blocks` along the
+//!   longest side), each with LODs of 100, 25, 6.25 and 1.5625 % of its triangles, selected by projected
+//!   error (`--pixel-error`). The camera flies along +z at a fixed height 3 % of the mesh's extent above its
 //!   highest point, looking 10 degrees down, from 5 % before its near edge to 80 % of the way across, so near
 //!   blocks are at full detail and far ones coarse.
 //!
@@ -19,128 +20,41 @@
 //! `clusterlod`'s cut uses too), i.e. [`crate::geometry::lod::switch_distance`] plus the radius, spread so that
 //! consecutive transition bands never overlap.
 
-use super::kind::SceneKind;
 use crate::error::{Error, Result};
-use crate::geometry::blocks::{BlockLod, Grid, Partition, PartitionMode};
+use crate::geometry::blocks::{BlockLod, Grid, Partition, PartitionMode, SeamPair};
 use crate::geometry::cluster_dag::ClusterDag;
 use crate::geometry::lod::{Lod, LodChain};
 use crate::geometry::mesh::Mesh;
+use crate::scene::bunny::{self, BUNNY_COLOR};
+use crate::scene::config::SceneConfig;
+use crate::scene::kind::{ProfileValues, SceneKind};
+use crate::scene::model::{CameraTrack, Instance, Layout, Model, ModelSet, Motion, SCENE_SEED};
+/// The unified scenes' data, defined with the rest of the data model.
+pub use crate::scene::model::{Preprocessing, Seam, SeamMesh, Unified};
 use crate::scene::schedule::ScheduleParams;
 use glam::{DVec3, Vec3};
-use serde::Serialize;
 use std::sync::Arc;
+use std::time::Instant;
 
 /// LOD targets of the terrain's blocks: each a quarter of the one before (what combining 2 x 2 blocks into
 /// one of the same triangle count gives in Blow's hierarchy).
 pub const TERRAIN_TARGETS: [f32; 4] = [1.0, 0.25, 0.0625, 0.015625];
-/// LOD targets of bunny-halves' halves (seed 004 Fig. 1c: "decreasing its triangle count by a factor of 4").
+/// LOD targets of bunny-halves' halves (Blow 2003, Part 3, Fig. 1c: "decreasing its triangle count by a
+/// factor of 4").
 pub const HALVES_TARGETS: [f32; 2] = [1.0, 0.25];
 /// Colour of the terrain (linear RGB).
 pub const TERRAIN_COLOR: [f32; 3] = [0.36, 0.45, 0.22];
-/// Colour of bunny-halves (the bunny's).
-pub const BUNNY_COLOR: [f32; 3] = [0.72, 0.45, 0.28];
-
-/// One seam mesh: the seam between two blocks at one pair of their LODs (empty where every quad is
-/// degenerate). Positions and normals are copies of the blocks' own, bit for bit, so the seam's edges are the
-/// blocks' edges exactly.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct SeamMesh {
-    pub positions: Vec<[f32; 3]>,
-    pub normals: Vec<[f32; 3]>,
-    pub indices: Vec<u32>,
-}
-
-/// The seams between blocks (models) `blocks.0` and `blocks.1`: `meshes[a * lods.1 + b]` joins the first at
-/// LOD a to the second at LOD b.
-#[derive(Debug, Clone)]
-pub struct Seam {
-    pub blocks: (u32, u32),
-    pub lods: (u32, u32),
-    pub meshes: Vec<SeamMesh>,
-}
-
-impl Seam {
-    pub fn mesh_index(&self, a: u32, b: u32) -> u32 {
-        a.min(self.lods.0 - 1) * self.lods.1 + b.min(self.lods.1 - 1)
-    }
-}
-
-/// What the preprocessing took and made (describe and run.json's scene descriptions).
-#[derive(Debug, Clone, Serialize)]
-pub struct Preprocessing {
-    pub partition: PartitionMode,
-    pub grid: [u32; 3],
-    pub block_size: f64,
-    pub blocks: usize,
-    pub input_triangles: usize,
-    /// Triangles of all blocks at full resolution (clipping adds some).
-    pub block_triangles: usize,
-    pub lod_targets: Vec<f32>,
-    pub seam_pairs: usize,
-    pub seam_edges: usize,
-    /// Seam triangles over every pair of LODs of every pair of blocks.
-    pub seam_triangles_all_lod_pairs: usize,
-    pub partition_ms: f64,
-    pub lod_chains_ms: f64,
-    pub seams_ms: f64,
-    /// Partition + LOD chains + seams: the blocks' whole preprocessing.
-    pub blocks_ms: f64,
-    /// Bytes of the blocks' LOD meshes and the seams as the GPU holds them (40-byte vertices, 4-byte indices).
-    pub blocks_bytes: u64,
-    pub seams_bytes: u64,
-    pub clusterlod_ms: f64,
-    pub clusterlod_bytes: u64,
-    pub clusters: usize,
-    pub cluster_groups: usize,
-    pub cluster_levels: u32,
-}
-
-/// A unified scene's mesh, seams and cluster DAG (shared by every block of the scene).
-#[derive(Debug)]
-pub struct Unified {
-    /// The whole mesh (clusterlod draws it).
-    pub mesh: Mesh,
-    pub dag: ClusterDag,
-    pub seams: Vec<Seam>,
-    /// `--pixel-error` as the blocks' switch distances and clusterlod's cut use it.
-    pub pixel_error: f32,
-    pub preprocessing: Preprocessing,
-}
 
 /// Bytes of a vertex on the GPU (`gpu::Vertex`: position, normal, aux).
 const VERTEX_BYTES: u64 = 40;
 
-/// Where the unified scenes' camera goes.
-#[derive(Debug, Clone, Copy)]
-pub enum UnifiedCamera {
-    /// A flight from `.0` to `.1` looking along the scene's `forward`.
-    Flight(Vec3, Vec3),
-    /// Once around `center` at `distance`, `elevation` radians above it.
-    Turntable {
-        center: Vec3,
-        distance: f32,
-        elevation: f32,
-    },
-}
-
-/// One block as the scene's model of it (`SceneDef` makes a `Model` and one instance of each).
-#[derive(Debug, Clone)]
-pub struct BlockModel {
-    pub name: String,
-    pub color: [f32; 3],
-    pub chain: LodChain,
-    pub switches: Vec<f32>,
-    pub switch_source: &'static str,
-    /// Bounding-sphere centre and radius of LOD0 (world units: blocks are at the identity transform).
-    pub center: Vec3,
-    pub radius: f32,
-}
-
-/// Everything `SceneDef` needs of a unified scene.
-pub struct UnifiedDef {
-    pub blocks: Vec<BlockModel>,
-    pub unified: Arc<Unified>,
-    pub camera: UnifiedCamera,
+/// What a unified scene's blocks are built from, once per scene: one instance per block (at the identity
+/// transform), the mesh, seams and DAG they share, and the camera.
+#[derive(Debug)]
+pub struct UnifiedParts {
+    pub instances: Vec<Instance>,
+    pub data: Arc<Unified>,
+    pub camera: CameraTrack,
     pub forward: Vec3,
     pub near: f32,
     pub far: f32,
@@ -162,21 +76,199 @@ pub struct UnifiedInput<'a> {
     pub fov_y: f32,
 }
 
-/// Builds `input.kind`'s blocks, seams and DAG.
-pub fn build(input: UnifiedInput<'_>) -> Result<UnifiedDef> {
-    let UnifiedInput {
+/// Unified scene `kind`: its mesh (`--mesh`, the built-in bunny, or the terrain), its blocks as models with
+/// one instance each, and its seams and cluster DAG.
+pub fn def(
+    kind: SceneKind,
+    cfg: &SceneConfig,
+    pv: &ProfileValues,
+    fov_y: f32,
+) -> Result<(ModelSet, UnifiedParts)> {
+    if cfg.switch_distances.is_some() {
+        return Err(Error::Config(format!(
+            "--switch-distances does not apply to {}: each of its blocks has switch distances of its own (set \
+             --pixel-error)",
+            kind.name()
+        )));
+    }
+    let started = Instant::now();
+    let (mesh, mesh_source) = load_mesh(kind, cfg)?;
+    let (models, parts) = build(UnifiedInput {
         kind,
         mesh,
-        mesh_source,
-        partition: partition_mode,
-        blocks,
-        pixel_error,
-        schedule,
-        width,
-        height,
+        mesh_source: &mesh_source,
+        partition: cfg.partition,
+        blocks: cfg
+            .blocks
+            .unwrap_or_else(|| SceneKind::terrain_blocks(cfg.profile)),
+        pixel_error: cfg.pixel_error(kind, pv.height),
+        schedule: &cfg.schedule,
+        width: pv.width,
+        height: pv.height,
         fov_y,
-    } = input;
-    let name = kind.name();
+    })?;
+    let set = ModelSet {
+        models,
+        mesh_source,
+        lod_generation_ms: started.elapsed().as_secs_f64() * 1e3,
+    };
+    Ok((set, parts))
+}
+
+/// The mesh of unified scene `kind` and its `mesh_source`: `--mesh`, else the built-in bunny (bunny-halves) or
+/// the procedural terrain.
+fn load_mesh(kind: SceneKind, cfg: &SceneConfig) -> Result<(Mesh, String)> {
+    let quads = SceneKind::terrain_quads(cfg.profile);
+    Ok(match (&cfg.mesh, kind) {
+        (Some(p), _) => (Mesh::load(p)?, p.display().to_string()),
+        (None, SceneKind::BunnyHalves) => {
+            (bunny::built_in_mesh()?, bunny::BUILT_IN_SOURCE.to_string())
+        }
+        (None, _) => (
+            crate::geometry::terrain::terrain_mesh(SCENE_SEED, quads)?,
+            format!("procedural (src/terrain.rs, seed SCENE_SEED = 2008, {quads} x {quads} cells)"),
+        ),
+    })
+}
+
+/// A unified scene's block instances for any count: one per block, the camera on its track.
+pub fn layout(u: &UnifiedParts) -> Layout {
+    let eye = match u.camera {
+        CameraTrack::Flight(from, _) => from,
+        CameraTrack::Turntable {
+            center,
+            distance,
+            elevation,
+        } => center + Vec3::new(0.0, elevation.sin(), elevation.cos()) * distance,
+    };
+    Layout {
+        instances: u.instances.clone(),
+        motion: Motion::Static,
+        near: u.near,
+        far: u.far,
+        eye,
+        forward: u.forward,
+        track: Some(u.camera),
+        unified: Some(u.data.clone()),
+    }
+}
+
+/// Builds `input.kind`'s blocks (as models), seams and DAG.
+pub fn build(input: UnifiedInput<'_>) -> Result<(Vec<Model>, UnifiedParts)> {
+    match input.kind {
+        SceneKind::BunnyHalves => halves(input),
+        _ => terrain(input),
+    }
+}
+
+/// bunny-halves: two cubes side by side, meeting in the plane x = the mesh's centre; the first half always at
+/// LOD0, the second always at its quarter; a turntable around the mesh's bounding sphere.
+fn halves(input: UnifiedInput<'_>) -> Result<(Vec<Model>, UnifiedParts)> {
+    let (lo, hi, extent) = checked_bounds(&input.mesh, input.mesh_source)?;
+    let cell = extent as f64 * 1.01;
+    let centre = ((lo.x + hi.x) * 0.5) as f64;
+    let grid = Grid {
+        origin: DVec3::new(
+            centre - cell,
+            lo.y as f64 - 0.005 * cell,
+            lo.z as f64 - 0.005 * cell,
+        ),
+        cell,
+        dims: [2, 1, 1],
+    };
+    let style = BlockStyle {
+        targets: &HALVES_TARGETS,
+        color: BUNNY_COLOR,
+        switch_source: "scene",
+    };
+    let mut made = prepare(&input, grid, style)?;
+    let (center, radius) = input.mesh.bounding_sphere();
+    let distance = radius / half_fov(input.width, input.height, input.fov_y).sin() / 0.8;
+    for (bi, m) in made.blocks.models.iter_mut().enumerate() {
+        // The first half never leaves LOD0, the second never shows it.
+        m.switches = vec![if bi == 0 {
+            distance * 1e3
+        } else {
+            distance * 0.05
+        }];
+    }
+    let view = View {
+        track: CameraTrack::Turntable {
+            center,
+            distance,
+            elevation: 10f32.to_radians(),
+        },
+        forward: -Vec3::Z,
+        near: radius * 0.02,
+        far: distance + 4.0 * radius,
+    };
+    finish(input, made, view)
+}
+
+/// terrain: cubic blocks, `input.blocks` along the longest side, with LODs selected by projected error; a
+/// flight along +z over the mesh.
+fn terrain(input: UnifiedInput<'_>) -> Result<(Vec<Model>, UnifiedParts)> {
+    let (lo, hi, extent) = checked_bounds(&input.mesh, input.mesh_source)?;
+    let grid = Grid::covering(
+        &input.mesh.positions,
+        extent as f64 / input.blocks as f64 * (1.0 + 1e-6),
+    )?;
+    let style = BlockStyle {
+        targets: &TERRAIN_TARGETS,
+        color: TERRAIN_COLOR,
+        switch_source: "pixel-error",
+    };
+    let mut made = prepare(&input, grid, style)?;
+    let pitch = 10f32.to_radians();
+    let y = hi.y + 0.03 * extent;
+    let x = (lo.x + hi.x) * 0.5;
+    let (z0, z1) = (lo.z - 0.05 * extent, lo.z + 0.8 * (hi.z - lo.z));
+    let view = View {
+        track: CameraTrack::Flight(Vec3::new(x, y, z0), Vec3::new(x, y, z1)),
+        forward: Vec3::new(0.0, -pitch.sin(), pitch.cos()),
+        near: extent * 5e-4,
+        far: extent * 2.0,
+    };
+    for m in &mut made.blocks.models {
+        m.switches = terrain_switches(m, &input);
+    }
+    finish(input, made, view)
+}
+
+/// A terrain block's switch distances: where each LOD's error projects to `--pixel-error` pixels at the
+/// distance from the camera to the block's bounding sphere, spread so that consecutive transition bands never
+/// overlap.
+fn terrain_switches(m: &Model, input: &UnifiedInput<'_>) -> Vec<f32> {
+    let schedule = input.schedule;
+    let band_ratio = (1.0 + schedule.band) * (1.0 + schedule.hysteresis)
+        / ((1.0 - schedule.band) * (1.0 - schedule.hysteresis))
+        * 1.01;
+    let mut out: Vec<f32> = Vec::new();
+    for lod in &m.chain.lods[1..] {
+        let d = crate::geometry::lod::switch_distance(
+            lod.error_abs,
+            1.0,
+            input.pixel_error,
+            input.height,
+            input.fov_y,
+        ) + m.radius;
+        let d = match out.last() {
+            Some(&prev) if d < prev * band_ratio => prev * band_ratio,
+            _ => d,
+        };
+        out.push(d);
+    }
+    out
+}
+
+/// The narrower of the two half fields of view (radians).
+fn half_fov(width: u32, height: u32, fov_y: f32) -> f32 {
+    let aspect = width as f32 / height as f32;
+    (fov_y * 0.5).min(((fov_y * 0.5).tan() * aspect).atan())
+}
+
+/// The mesh's bounds and longest side, after checking it has an area and an extent.
+fn checked_bounds(mesh: &Mesh, mesh_source: &str) -> Result<(Vec3, Vec3, f32)> {
     mesh.check_area(mesh_source)?;
     let (lo, hi) = mesh.bounds();
     let extent = (hi - lo).max_element();
@@ -186,39 +278,71 @@ pub fn build(input: UnifiedInput<'_>) -> Result<UnifiedDef> {
             problem: "has zero extent".into(),
         });
     }
-    let halves = kind == SceneKind::BunnyHalves;
-    let grid = if halves {
-        // Two cubes side by side, meeting in the plane x = the mesh's centre.
-        let cell = extent as f64 * 1.01;
-        let centre = ((lo.x + hi.x) * 0.5) as f64;
-        Grid {
-            origin: DVec3::new(
-                centre - cell,
-                lo.y as f64 - 0.005 * cell,
-                lo.z as f64 - 0.005 * cell,
-            ),
-            cell,
-            dims: [2, 1, 1],
-        }
-    } else {
-        Grid::covering(
-            &mesh.positions,
-            extent as f64 / blocks as f64 * (1.0 + 1e-6),
-        )?
-    };
-    let started = std::time::Instant::now();
-    let partition = match partition_mode {
+    Ok((lo, hi, extent))
+}
+
+/// What differs between the two scenes' blocks.
+struct BlockStyle {
+    targets: &'static [f32],
+    color: [f32; 3],
+    switch_source: &'static str,
+}
+
+/// Where the camera of a unified scene goes, and its clip planes.
+struct View {
+    track: CameraTrack,
+    forward: Vec3,
+    near: f32,
+    far: f32,
+}
+
+/// A scene's blocks as the partition and the simplifier made them: models (switch distances still to set),
+/// LODs and vertex normals per block.
+struct Blocks {
+    partition: Partition,
+    chains: Vec<Vec<BlockLod>>,
+    normals: Vec<Vec<[f32; 3]>>,
+    models: Vec<Model>,
+    targets: &'static [f32],
+    bytes: u64,
+    partition_ms: f64,
+    lod_chains_ms: f64,
+}
+
+/// Every pair of neighbouring blocks' seams at every pair of their LODs.
+struct Seams {
+    seams: Vec<Seam>,
+    pairs: usize,
+    triangles: usize,
+    bytes: u64,
+    ms: f64,
+}
+
+/// The steps both scenes share before their camera: blocks, seams and the cluster DAG.
+struct Prepared {
+    blocks: Blocks,
+    seams: Seams,
+    dag: ClusterDag,
+}
+
+fn prepare(input: &UnifiedInput<'_>, grid: Grid, style: BlockStyle) -> Result<Prepared> {
+    let blocks = blocks(input, grid, style)?;
+    let seams = seams(&blocks);
+    let dag = ClusterDag::build(input.mesh_source, &input.mesh)?;
+    Ok(Prepared { blocks, seams, dag })
+}
+
+/// Partitions the mesh into `grid`'s blocks and builds each block's LOD chain and model.
+fn blocks(input: &UnifiedInput<'_>, grid: Grid, style: BlockStyle) -> Result<Blocks> {
+    let mesh = &input.mesh;
+    let started = Instant::now();
+    let partition = match input.partition {
         PartitionMode::Clip => Partition::clip(&mesh.positions, &mesh.indices, grid),
         PartitionMode::Bin => Partition::bin(&mesh.positions, &mesh.indices, grid),
     };
     let partition_ms = started.elapsed().as_secs_f64() * 1e3;
-    let targets: &[f32] = if halves {
-        &HALVES_TARGETS
-    } else {
-        &TERRAIN_TARGETS
-    };
-    let started = std::time::Instant::now();
-    let mut chains = partition.lod_chains(targets)?;
+    let started = Instant::now();
+    let mut chains = partition.lod_chains(style.targets)?;
     // A LOD the simplifier emptied (a sliver of a block) repeats the one before.
     for chain in &mut chains {
         for l in 1..chain.len() {
@@ -228,59 +352,95 @@ pub fn build(input: UnifiedInput<'_>) -> Result<UnifiedDef> {
         }
     }
     let normals = partition.vertex_normals(&mesh.positions, &mesh.normals, &mesh.indices);
-    let color = if halves { BUNNY_COLOR } else { TERRAIN_COLOR };
     let mut models = Vec::with_capacity(partition.blocks.len());
-    let mut blocks_bytes = 0u64;
-    for (bi, (b, chain)) in partition.blocks.iter().zip(&chains).enumerate() {
-        let block_name = format!("{name} block {},{},{}", b.coord[0], b.coord[1], b.coord[2]);
-        let full = Mesh::new(
-            &block_name,
-            b.positions.clone(),
-            Some(normals[bi].clone()),
-            b.indices.clone(),
-        )?;
-        let lods = chain
-            .iter()
-            .zip(targets)
-            .map(|(l, &f)| {
-                Ok(Lod {
-                    mesh: crate::geometry::lod::compact(&block_name, &full, &l.indices)?,
-                    target_fraction: f,
-                    error_abs: l.error_abs,
-                })
-            })
-            .collect::<Result<Vec<_>>>()?;
-        blocks_bytes += lods
-            .iter()
-            .map(|l| l.mesh.vertex_count() as u64 * VERTEX_BYTES + l.mesh.indices.len() as u64 * 4)
-            .sum::<u64>();
-        let (center, radius) = lods[0].mesh.bounding_sphere();
-        models.push(BlockModel {
-            name: block_name,
-            color,
-            chain: LodChain { lods },
-            switches: Vec::new(),
-            switch_source: if halves { "scene" } else { "pixel-error" },
-            center,
-            radius,
-        });
+    let mut bytes = 0u64;
+    for (bi, chain) in chains.iter().enumerate() {
+        let (model, model_bytes) =
+            block_model(input.kind, &partition, bi, chain, &normals[bi], &style)?;
+        bytes += model_bytes;
+        models.push(model);
     }
-    let lod_chains_ms = started.elapsed().as_secs_f64() * 1e3;
+    Ok(Blocks {
+        partition,
+        chains,
+        normals,
+        models,
+        targets: style.targets,
+        bytes,
+        partition_ms,
+        lod_chains_ms: started.elapsed().as_secs_f64() * 1e3,
+    })
+}
 
-    let started = std::time::Instant::now();
-    let pairs = partition.seam_pairs();
+/// Block `bi`'s model (no switch distances yet) from its LODs' indices, and the bytes of its LOD meshes.
+fn block_model(
+    kind: SceneKind,
+    partition: &Partition,
+    bi: usize,
+    chain: &[BlockLod],
+    normals: &[[f32; 3]],
+    style: &BlockStyle,
+) -> Result<(Model, u64)> {
+    let b = &partition.blocks[bi];
+    let block_name = format!(
+        "{} block {},{},{}",
+        kind.name(),
+        b.coord[0],
+        b.coord[1],
+        b.coord[2]
+    );
+    let full = Mesh::new(
+        &block_name,
+        b.positions.clone(),
+        Some(normals.to_vec()),
+        b.indices.clone(),
+    )?;
+    let lods = chain
+        .iter()
+        .zip(style.targets)
+        .map(|(l, &f)| {
+            Ok(Lod {
+                mesh: crate::geometry::lod::compact(&block_name, &full, &l.indices)?,
+                target_fraction: f,
+                error_abs: l.error_abs,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let bytes = lods
+        .iter()
+        .map(|l| l.mesh.vertex_count() as u64 * VERTEX_BYTES + l.mesh.indices.len() as u64 * 4)
+        .sum::<u64>();
+    let (center, radius) = lods[0].mesh.bounding_sphere();
+    let model = Model {
+        name: block_name,
+        color: style.color,
+        lod_colors: Vec::new(),
+        spin_per_frame: 0.0,
+        chain: LodChain { lods },
+        switches: Vec::new(),
+        switch_source: style.switch_source,
+        center,
+        radius,
+        scale: 1.0,
+    };
+    Ok((model, bytes))
+}
+
+/// The seams of every pair of neighbouring blocks, at every pair of their LODs.
+fn seams(blocks: &Blocks) -> Seams {
+    let started = Instant::now();
+    let pairs = blocks.partition.seam_pairs();
     let mut seams = Vec::with_capacity(pairs.len());
-    let mut seam_triangles = 0;
-    let mut seams_bytes = 0u64;
+    let (mut triangles, mut bytes) = (0, 0u64);
     for pair in &pairs {
         let (a, b) = pair.blocks;
-        let (la, lb) = (chains[a].len(), chains[b].len());
+        let (la, lb) = (blocks.chains[a].len(), blocks.chains[b].len());
         let mut meshes = Vec::with_capacity(la * lb);
-        for lod_a in &chains[a] {
-            for lod_b in &chains[b] {
-                let m = seam_mesh(&partition, &normals, pair, lod_a, lod_b);
-                seam_triangles += m.indices.len() / 3;
-                seams_bytes += m.positions.len() as u64 * VERTEX_BYTES + m.indices.len() as u64 * 4;
+        for lod_a in &blocks.chains[a] {
+            for lod_b in &blocks.chains[b] {
+                let m = seam_mesh(&blocks.partition, &blocks.normals, pair, lod_a, lod_b);
+                triangles += m.indices.len() / 3;
+                bytes += m.positions.len() as u64 * VERTEX_BYTES + m.indices.len() as u64 * 4;
                 meshes.push(m);
             }
         }
@@ -290,109 +450,74 @@ pub fn build(input: UnifiedInput<'_>) -> Result<UnifiedDef> {
             meshes,
         });
     }
-    let seams_ms = started.elapsed().as_secs_f64() * 1e3;
-
-    let dag = ClusterDag::build(mesh_source, &mesh)?;
-
-    // The camera, then the switch distances (bunny-halves' depend on the turntable's distance).
-    let aspect = width as f32 / height as f32;
-    let half_fov = (fov_y * 0.5).min(((fov_y * 0.5).tan() * aspect).atan());
-    let (camera, forward, near, far) = if halves {
-        let (center, radius) = mesh.bounding_sphere();
-        let distance = radius / half_fov.sin() / 0.8;
-        (
-            UnifiedCamera::Turntable {
-                center,
-                distance,
-                elevation: 10f32.to_radians(),
-            },
-            -Vec3::Z,
-            radius * 0.02,
-            distance + 4.0 * radius,
-        )
-    } else {
-        let pitch = 10f32.to_radians();
-        let y = hi.y + 0.03 * extent;
-        let x = (lo.x + hi.x) * 0.5;
-        let (z0, z1) = (lo.z - 0.05 * extent, lo.z + 0.8 * (hi.z - lo.z));
-        (
-            UnifiedCamera::Flight(Vec3::new(x, y, z0), Vec3::new(x, y, z1)),
-            Vec3::new(0.0, -pitch.sin(), pitch.cos()),
-            extent * 5e-4,
-            extent * 2.0,
-        )
-    };
-    let band_ratio = (1.0 + schedule.band) * (1.0 + schedule.hysteresis)
-        / ((1.0 - schedule.band) * (1.0 - schedule.hysteresis))
-        * 1.01;
-    for (bi, m) in models.iter_mut().enumerate() {
-        m.switches = match camera {
-            UnifiedCamera::Turntable { distance, .. } => {
-                // The first half never leaves LOD0, the second never shows it.
-                vec![if bi == 0 {
-                    distance * 1e3
-                } else {
-                    distance * 0.05
-                }]
-            }
-            UnifiedCamera::Flight(..) => {
-                let mut out: Vec<f32> = Vec::new();
-                for lod in &m.chain.lods[1..] {
-                    let d = crate::geometry::lod::switch_distance(
-                        lod.error_abs,
-                        1.0,
-                        pixel_error,
-                        height,
-                        fov_y,
-                    ) + m.radius;
-                    let d = match out.last() {
-                        Some(&prev) if d < prev * band_ratio => prev * band_ratio,
-                        _ => d,
-                    };
-                    out.push(d);
-                }
-                out
-            }
-        };
-        schedule.check_switches(&m.name, &m.switches)?;
+    Seams {
+        seams,
+        pairs: pairs.len(),
+        triangles,
+        bytes,
+        ms: started.elapsed().as_secs_f64() * 1e3,
     }
+}
+
+/// The scene from its prepared blocks (switch distances set) and camera: the switch distances checked, one
+/// instance per block, and the preprocessing's record.
+fn finish(
+    input: UnifiedInput<'_>,
+    made: Prepared,
+    view: View,
+) -> Result<(Vec<Model>, UnifiedParts)> {
+    let Prepared { blocks, seams, dag } = made;
+    for m in &blocks.models {
+        input.schedule.check_switches(&m.name, &m.switches)?;
+    }
+    let mesh = input.mesh;
+    let p = &blocks.partition;
     let preprocessing = Preprocessing {
-        partition: partition.mode,
-        grid: partition.grid.dims,
-        block_size: partition.grid.cell,
-        blocks: partition.blocks.len(),
+        partition: p.mode,
+        grid: p.grid.dims,
+        block_size: p.grid.cell,
+        blocks: p.blocks.len(),
         input_triangles: mesh.triangle_count(),
-        block_triangles: partition.triangle_count(),
-        lod_targets: targets.to_vec(),
-        seam_pairs: pairs.len(),
-        seam_edges: partition.seams.len(),
-        seam_triangles_all_lod_pairs: seam_triangles,
-        partition_ms,
-        lod_chains_ms,
-        seams_ms,
-        blocks_ms: partition_ms + lod_chains_ms + seams_ms,
-        blocks_bytes,
-        seams_bytes,
+        block_triangles: p.triangle_count(),
+        lod_targets: blocks.targets.to_vec(),
+        seam_pairs: seams.pairs,
+        seam_edges: p.seams.len(),
+        seam_triangles_all_lod_pairs: seams.triangles,
+        partition_ms: blocks.partition_ms,
+        lod_chains_ms: blocks.lod_chains_ms,
+        seams_ms: seams.ms,
+        blocks_ms: blocks.partition_ms + blocks.lod_chains_ms + seams.ms,
+        blocks_bytes: blocks.bytes,
+        seams_bytes: seams.bytes,
         clusterlod_ms: dag.build_ms,
         clusterlod_bytes: dag.bytes() + mesh.vertex_count() as u64 * VERTEX_BYTES,
         clusters: dag.clusters.len(),
         cluster_groups: dag.groups.len(),
         cluster_levels: dag.levels(),
     };
-    Ok(UnifiedDef {
-        blocks: models,
-        unified: Arc::new(Unified {
-            mesh,
-            dag,
-            seams,
-            pixel_error,
-            preprocessing,
-        }),
-        camera,
-        forward,
-        near,
-        far,
-    })
+    let instances = (blocks.models.iter().enumerate())
+        .map(|(i, m)| Instance {
+            model: i as u32,
+            position: m.center,
+            yaw: 0.0,
+        })
+        .collect();
+    let data = Unified {
+        mesh,
+        dag,
+        seams: seams.seams,
+        pixel_error: input.pixel_error,
+        preprocessing,
+    };
+    let parts = UnifiedParts {
+        instances,
+        data: Arc::new(data),
+        camera: view.track,
+        forward: view.forward,
+        near: view.near,
+        far: view.far,
+    };
+    Ok((blocks.models, parts))
 }
 
 /// The seam of `pair` between its blocks at LODs `a` and `b` as a mesh of its own (three vertices a
@@ -400,7 +525,7 @@ pub fn build(input: UnifiedInput<'_>) -> Result<UnifiedDef> {
 fn seam_mesh(
     partition: &Partition,
     normals: &[Vec<[f32; 3]>],
-    pair: &crate::geometry::blocks::SeamPair,
+    pair: &SeamPair,
     a: &BlockLod,
     b: &BlockLod,
 ) -> SeamMesh {

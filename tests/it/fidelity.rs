@@ -32,7 +32,7 @@ fn dense_mesh_sweep_starts_outside_the_model() {
     ];
     let cfg = scene_config("bunny-sweep", &flags);
     let def = SceneDef::new(SceneKind::BunnySweep, &cfg).unwrap();
-    let path = def.path.unwrap();
+    let path = def.path().unwrap();
     let m = &def.models[0];
     assert!(path.near >= path.fit && path.fit > m.radius, "{path:?}");
     assert!(path.unreached >= 1, "{path:?} {:?}", m.switches);

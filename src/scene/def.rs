@@ -1,0 +1,155 @@
+//! [`SceneDef`]: what a scene name and the flags make, once per scene, and the scene of each instance count
+//! built from it by the family's builder (`procedural.rs`, `bunny.rs`, `unified.rs`).
+
+use crate::error::Result;
+use crate::scene::bunny::{self, BunnyParts, BunnyPath};
+use crate::scene::config::SceneConfig;
+use crate::scene::kind::{CameraMode, SceneKind};
+use crate::scene::model::{Layout, Model, Scene};
+use crate::scene::procedural;
+use crate::scene::schedule::ScheduleParams;
+use crate::scene::unified::{self, UnifiedParts};
+use std::sync::Arc;
+
+/// Scene-level facts that do not depend on the instance count: built once per scene name.
+#[derive(Debug, Clone)]
+pub struct SceneDef {
+    pub kind: SceneKind,
+    pub models: Arc<[Model]>,
+    pub frames: u32,
+    pub width: u32,
+    pub height: u32,
+    pub fov_y: f32,
+    pub schedule: ScheduleParams,
+    /// Instance counts to build (one block each).
+    pub counts: Vec<u32>,
+    pub camera_mode: CameraMode,
+    pub mesh_source: String,
+    /// Milliseconds spent building the models' LOD chains (once per scene, never per instance).
+    pub lod_generation_ms: f64,
+    /// What the scene's family adds to its models.
+    pub family: Family,
+    pub taa: Option<crate::effects::taa::Taa>,
+    pub shadows: Option<crate::effects::shadow::Shadows>,
+}
+
+/// The scene families and what each has beyond its models.
+#[derive(Debug, Clone)]
+pub enum Family {
+    /// simple, windmills, trees (`procedural.rs`).
+    Procedural,
+    /// bunny-sweep, bunny-grid: the path and the ground (`bunny.rs`).
+    Bunny(BunnyParts),
+    /// bunny-halves, terrain: the blocks, camera and frustum (`unified.rs`).
+    Unified(Arc<UnifiedParts>),
+}
+
+impl SceneDef {
+    pub fn new(kind: SceneKind, cfg: &SceneConfig) -> Result<SceneDef> {
+        let pv = cfg.resolved(kind);
+        let fov_y = cfg.fov_deg.to_radians();
+        let (set, family) = if kind.is_unified() {
+            let (set, parts) = unified::def(kind, cfg, &pv, fov_y)?;
+            (set, Family::Unified(Arc::new(parts)))
+        } else if kind.is_bunny() {
+            let (set, parts) = bunny::def(kind, cfg, &pv, fov_y)?;
+            (set, Family::Bunny(parts))
+        } else {
+            (
+                procedural::def(kind, cfg, pv.height, fov_y)?,
+                Family::Procedural,
+            )
+        };
+        Ok(SceneDef {
+            kind,
+            models: Arc::from(set.models),
+            frames: pv.frames,
+            width: pv.width,
+            height: pv.height,
+            fov_y,
+            schedule: cfg.schedule,
+            counts: cfg.counts(kind),
+            camera_mode: cfg.camera,
+            mesh_source: set.mesh_source,
+            lod_generation_ms: set.lod_generation_ms,
+            family,
+            taa: cfg.taa,
+            shadows: cfg.shadows,
+        })
+    }
+
+    /// The scene's name (the CSVs' `scene` column).
+    pub fn name(&self) -> &'static str {
+        self.kind.name()
+    }
+
+    /// The bunny scenes' path (sweep or grid); None for the others.
+    pub fn path(&self) -> Option<BunnyPath> {
+        match &self.family {
+            Family::Bunny(b) => Some(b.path),
+            _ => None,
+        }
+    }
+
+    /// The unified scenes' blocks, camera and frustum; None for the others.
+    pub fn unified(&self) -> Option<&UnifiedParts> {
+        match &self.family {
+            Family::Unified(u) => Some(u),
+            _ => None,
+        }
+    }
+
+    /// What a user should know before trusting the scene: switches the bunny path never reaches. One line each
+    /// scene (empty when there is nothing to say).
+    pub fn notes(&self) -> Vec<String> {
+        match (&self.family, self.models.first()) {
+            (Family::Bunny(b), Some(m)) => b.path.notes(self.kind, m),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The scene of `count` instances (the bunny scenes' ground with `--shadows on` comes last).
+    pub fn instantiate(&self, count: u32) -> Scene {
+        let layout = match &self.family {
+            Family::Procedural => procedural::layout(&self.models[0], count),
+            Family::Bunny(b) => bunny::layout(self.kind, &self.models[0], &b.path, count),
+            Family::Unified(u) => unified::layout(u),
+        };
+        let mut scene = self.scene(count, layout);
+        if let Family::Bunny(BunnyParts {
+            ground: Some(ground),
+            ..
+        }) = self.family
+        {
+            scene.ground = Some(scene.instances.len());
+            scene.instances.push(ground);
+        }
+        scene
+    }
+
+    /// The scene of `count` instances placed as `layout` says.
+    fn scene(&self, count: u32, layout: Layout) -> Scene {
+        Scene {
+            kind: self.kind,
+            count,
+            models: self.models.clone(),
+            instances: layout.instances,
+            motion: layout.motion,
+            frames: self.frames,
+            width: self.width,
+            height: self.height,
+            fov_y: self.fov_y,
+            near: layout.near,
+            far: layout.far,
+            eye: layout.eye,
+            forward: layout.forward,
+            camera_mode: self.camera_mode,
+            track: layout.track,
+            schedule: self.schedule,
+            unified: layout.unified,
+            taa: self.taa,
+            shadows: self.shadows,
+            ground: None,
+        }
+    }
+}

@@ -1,0 +1,114 @@
+//! What `lodbench describe` prints (and run.json's scene descriptions): a scene's settings, models, LODs and
+//! path, from its [`SceneDef`].
+
+use crate::geometry::lod::LodInfo;
+use crate::scene::bunny::BunnyPath;
+use crate::scene::config::SceneConfig;
+use crate::scene::def::SceneDef;
+use crate::scene::kind::CameraMode;
+use crate::scene::model::{Model, Motion, Preprocessing};
+use crate::scene::schedule::ScheduleParams;
+use serde::Serialize;
+
+/// What `lodbench describe` prints.
+#[derive(Debug, Clone, Serialize)]
+pub struct SceneDescription {
+    pub scene: String,
+    pub profile: String,
+    pub width: u32,
+    pub height: u32,
+    pub fov_y_deg: f32,
+    pub frames: u32,
+    pub instance_counts: Vec<u32>,
+    pub mesh: String,
+    pub pixel_error: f32,
+    pub schedule: ScheduleParams,
+    pub models: Vec<ModelDescription>,
+    pub motion: Motion,
+    pub camera: CameraMode,
+    /// Milliseconds to build the models' LOD chains (once per scene).
+    pub lod_generation_ms: f64,
+    /// Milliseconds to place the instances of the first count (once per block).
+    pub instance_build_ms: f64,
+    /// The bunny scenes' path (None for the procedural scenes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub path: Option<BunnyPath>,
+    /// [`SceneDef::notes`]: what the run warns about this scene.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+    /// The unified scenes' preprocessing: blocks, seams, cluster DAG, with times and sizes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unified: Option<Preprocessing>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct ModelDescription {
+    pub name: String,
+    pub radius: f32,
+    pub switch_source: &'static str,
+    pub lods: Vec<LodDescription>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct LodDescription {
+    #[serde(flatten)]
+    pub info: LodInfo,
+    /// Distance beyond which this LOD is selected (None for LOD0).
+    pub switch_distance: Option<f32>,
+    /// "not reached by the sweep" for a bunny-scene switch nearer than the path's start ([`BunnyPath`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<&'static str>,
+}
+
+/// [`LodDescription::note`] of a switch the bunny path never reaches.
+pub const NOT_REACHED: &str = "not reached by the sweep";
+
+impl SceneDef {
+    pub fn describe(&self, cfg: &SceneConfig) -> SceneDescription {
+        let started = std::time::Instant::now();
+        let first = self.instantiate(self.counts[0]);
+        let instance_build_ms = started.elapsed().as_secs_f64() * 1e3;
+        SceneDescription {
+            scene: self.name().to_string(),
+            profile: format!("{:?}", cfg.profile).to_lowercase(),
+            width: self.width,
+            height: self.height,
+            fov_y_deg: cfg.fov_deg,
+            frames: self.frames,
+            instance_counts: self.counts.clone(),
+            mesh: self.mesh_source.clone(),
+            pixel_error: cfg.pixel_error(self.kind, self.height),
+            schedule: self.schedule,
+            models: self.models.iter().map(|m| self.describe_model(m)).collect(),
+            motion: first.motion,
+            camera: self.camera_mode,
+            lod_generation_ms: self.lod_generation_ms,
+            instance_build_ms,
+            path: self.path(),
+            notes: self.notes(),
+            unified: self.unified().map(|u| u.data.preprocessing.clone()),
+        }
+    }
+
+    fn describe_model(&self, m: &Model) -> ModelDescription {
+        let path = self.path();
+        ModelDescription {
+            name: m.name.clone(),
+            radius: m.radius,
+            switch_source: m.switch_source,
+            lods: m
+                .chain
+                .info()
+                .into_iter()
+                .map(|info| LodDescription {
+                    switch_distance: info.lod.checked_sub(1).map(|j| m.switches[j]),
+                    note: match (info.lod, path) {
+                        (1.., Some(p)) if info.lod <= p.unreached => Some(NOT_REACHED),
+                        _ => None,
+                    },
+                    info,
+                })
+                .collect(),
+        }
+    }
+}

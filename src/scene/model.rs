@@ -1,0 +1,394 @@
+//! The data model of a scene ready to render: models with LOD chains, their instances, how they move, the
+//! camera, and the unified scenes' blocks, seams and cluster DAG. Everything a frame needs is a function of the
+//! frame number.
+
+use crate::geometry::blocks::PartitionMode;
+use crate::geometry::cluster_dag::ClusterDag;
+use crate::geometry::lod::LodChain;
+use crate::geometry::mesh::Mesh;
+use crate::scene::kind::{CameraMode, SceneKind};
+use crate::scene::schedule::ScheduleParams;
+use glam::{Mat4, Vec3};
+use serde::Serialize;
+use std::sync::Arc;
+
+/// Seed of the procedural scenes' models and layouts (tree shapes, instance jitter and yaw, the terrain):
+/// fixed, so a scene is the same picture whatever `--seed` drives (the methods' noise).
+pub const SCENE_SEED: u64 = 2008;
+
+/// Background colour (linear RGB) behind every scene.
+pub const BACKGROUND: [f32; 3] = [0.045, 0.05, 0.06];
+
+pub const ORBIT_AMPLITUDE_DEG: f32 = 30.0;
+pub const ORBIT_PERIOD_FRAMES: f32 = 240.0;
+
+/// A model: its LOD chain, colour and switch distances.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub name: String,
+    /// Base colour, linear RGB.
+    pub color: [f32; 3],
+    /// Colour per LOD (SIMPLE's LODs differ in colour); empty = `color` for every LOD.
+    pub lod_colors: Vec<[f32; 3]>,
+    /// Rotation of the animated parts (windmill blades) per frame, radians; 0 = not animated.
+    pub spin_per_frame: f32,
+    pub chain: LodChain,
+    /// Switch distance of LOD1, LOD2, ... in world units.
+    pub switches: Vec<f32>,
+    /// Where the switch distances came from: "pixel-error" or "override".
+    pub switch_source: &'static str,
+    /// Bounding-sphere centre (object space) and radius (world units, after scale).
+    pub center: Vec3,
+    pub radius: f32,
+    pub scale: f32,
+}
+
+impl Model {
+    /// Base colour of LOD `lod`, linear RGB.
+    pub fn color_of(&self, lod: u32) -> [f32; 3] {
+        self.lod_colors
+            .get(lod as usize)
+            .copied()
+            .unwrap_or(self.color)
+    }
+}
+
+/// What a scene family's builder makes once per scene: its models, where their mesh came from, and how long
+/// their LOD chains took to build.
+#[derive(Debug)]
+pub struct ModelSet {
+    pub models: Vec<Model>,
+    pub mesh_source: String,
+    /// Milliseconds spent building the models' LOD chains (once per scene, never per instance).
+    pub lod_generation_ms: f64,
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct Instance {
+    pub model: u32,
+    /// Position of the model's bounding-sphere centre at frame 0 (world).
+    pub position: Vec3,
+    /// Rotation about +y, radians.
+    pub yaw: f32,
+}
+
+/// How instances move over the frames.
+#[derive(Debug, Clone, Copy, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Motion {
+    Static,
+    /// Every instance moves along +x from `near` to `far` (distance from the camera) in the first half of the
+    /// frames and back in the second, at constant speed.
+    SweepX {
+        near: f32,
+        far: f32,
+    },
+}
+
+/// Constant-speed distance along the sweep: out from `near` to `far` over the first half of the frames, back
+/// over the second; frame f and frame N-1-f are at the same distance.
+pub fn sweep_distance(near: f32, far: f32, frames: u32, frame: u32) -> f32 {
+    if frames < 2 {
+        return near;
+    }
+    let half = (frames - 1) as f32 / 2.0;
+    let u = frame as f32 / half;
+    let u = if u <= 1.0 { u } else { 2.0 - u };
+    near + (far - near) * u
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub view: Mat4,
+    pub proj: Mat4,
+}
+
+impl Camera {
+    pub fn view_proj(&self) -> Mat4 {
+        self.proj * self.view
+    }
+}
+
+/// A camera that follows a track of its own whatever `--camera` says (the procedural and unified scenes).
+#[derive(Debug, Clone, Copy)]
+pub enum CameraTrack {
+    /// A flight from `.0` to `.1` at constant speed over the frames, looking along the scene's `forward`.
+    Flight(Vec3, Vec3),
+    /// Once around `center` at `distance` over the frames, `elevation` radians above it, looking at it.
+    Turntable {
+        center: Vec3,
+        distance: f32,
+        elevation: f32,
+    },
+}
+
+/// A scene ready to render: everything a frame needs is a function of the frame number.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub kind: SceneKind,
+    /// The `count` column of the CSVs: the instance count this block was built for.
+    pub count: u32,
+    pub models: Arc<[Model]>,
+    pub instances: Vec<Instance>,
+    pub motion: Motion,
+    pub frames: u32,
+    pub width: u32,
+    pub height: u32,
+    pub fov_y: f32,
+    pub near: f32,
+    pub far: f32,
+    pub eye: Vec3,
+    pub forward: Vec3,
+    pub camera_mode: CameraMode,
+    /// The camera's own track (a flight or a turntable); None = `camera_mode` from `eye` along `forward`.
+    pub track: Option<CameraTrack>,
+    pub schedule: ScheduleParams,
+    /// The unified-LOD scenes' blocks' mesh, seams and cluster DAG (every instance is a block at the identity
+    /// transform); None elsewhere.
+    pub unified: Option<Arc<Unified>>,
+    /// `--taa on`: every frame's projection is jittered ([`Scene::camera`]) and resolved (`gpu/taa_resolve.rs`).
+    pub taa: Option<crate::effects::taa::Taa>,
+    /// `--shadows on`: the shadow map's settings (`effects/shadow.rs`).
+    pub shadows: Option<crate::effects::shadow::Shadows>,
+    /// The instance that is the bunny scenes' ground with `--shadows on`: static, always LOD0, receives
+    /// shadows and casts none, left out of `lod_mean`.
+    pub ground: Option<usize>,
+}
+
+/// What a scene family's builder places for one instance count: the parts of [`Scene`] that differ between
+/// the families.
+#[derive(Debug)]
+pub struct Layout {
+    pub instances: Vec<Instance>,
+    pub motion: Motion,
+    pub near: f32,
+    pub far: f32,
+    pub eye: Vec3,
+    pub forward: Vec3,
+    pub track: Option<CameraTrack>,
+    pub unified: Option<Arc<Unified>>,
+}
+
+impl Scene {
+    /// The scene's name (the CSVs' `scene` column).
+    pub fn name(&self) -> &'static str {
+        self.kind.name()
+    }
+
+    /// Animation angle of instance `i` on `frame` (radians; windmill blades), with a fixed per-instance phase
+    /// so that neighbours do not turn in step.
+    pub fn animation_angle(&self, i: usize, frame: u32) -> f32 {
+        let m = &self.models[self.instances[i].model as usize];
+        if m.spin_per_frame == 0.0 {
+            return 0.0;
+        }
+        let phase = (i as f32 * 2.399_963).rem_euclid(std::f32::consts::TAU);
+        (phase + m.spin_per_frame * frame as f32).rem_euclid(std::f32::consts::TAU)
+    }
+
+    /// Where instance `i`'s centre is on `frame`.
+    pub fn instance_position(&self, i: usize, frame: u32) -> Vec3 {
+        let inst = &self.instances[i];
+        if self.ground == Some(i) {
+            return inst.position;
+        }
+        match self.motion {
+            Motion::Static => inst.position,
+            Motion::SweepX { near, far } => {
+                let d = match self.camera_mode {
+                    CameraMode::Dolly => near,
+                    _ => sweep_distance(near, far, self.frames, frame),
+                };
+                Vec3::new(self.eye.x + d, inst.position.y, inst.position.z)
+            }
+        }
+    }
+
+    /// Object-to-world matrix of instance `i` on `frame`: the model's bounding-sphere centre goes to the
+    /// instance position.
+    pub fn instance_matrix(&self, i: usize, frame: u32) -> Mat4 {
+        if self.unified.is_some() {
+            // Blocks and seams are in world space: every block shares one exact transform with its seams.
+            return Mat4::IDENTITY;
+        }
+        let inst = &self.instances[i];
+        let m = &self.models[inst.model as usize];
+        Mat4::from_translation(self.instance_position(i, frame))
+            * Mat4::from_rotation_y(inst.yaw)
+            * Mat4::from_scale(Vec3::splat(m.scale))
+            * Mat4::from_translation(-m.center)
+    }
+
+    /// Distance from the camera to instance `i`'s centre on `frame` (what LOD selection uses).
+    pub fn instance_distance(&self, i: usize, frame: u32) -> f32 {
+        self.instance_position(i, frame)
+            .distance(self.camera(frame).eye)
+    }
+
+    pub fn camera(&self, frame: u32) -> Camera {
+        let (eye, view) = match self.track {
+            Some(track) => self.track_view(track, frame),
+            None => self.mode_view(frame),
+        };
+        let mut proj = Mat4::perspective_rh(
+            self.fov_y,
+            self.width as f32 / self.height as f32,
+            self.near,
+            self.far,
+        );
+        if let Some(taa) = &self.taa {
+            let (x, y) = taa.jitter_ndc(frame, self.width, self.height);
+            proj = Mat4::from_translation(Vec3::new(x, y, 0.0)) * proj;
+        }
+        Camera { eye, view, proj }
+    }
+
+    /// The eye and view matrix on `frame` of a camera on `track`.
+    fn track_view(&self, track: CameraTrack, frame: u32) -> (Vec3, Mat4) {
+        match track {
+            CameraTrack::Turntable {
+                center,
+                distance,
+                elevation,
+            } => {
+                let theta = std::f32::consts::TAU * frame as f32 / self.frames.max(1) as f32;
+                let dir = Vec3::new(
+                    elevation.cos() * theta.sin(),
+                    elevation.sin(),
+                    elevation.cos() * theta.cos(),
+                );
+                let eye = center + dir * distance;
+                (eye, Mat4::look_at_rh(eye, center, Vec3::Y))
+            }
+            CameraTrack::Flight(from, to) => {
+                let t = if self.frames > 1 {
+                    frame as f32 / (self.frames - 1) as f32
+                } else {
+                    0.0
+                };
+                let eye = from.lerp(to, t);
+                (eye, Mat4::look_at_rh(eye, eye + self.forward, Vec3::Y))
+            }
+        }
+    }
+
+    /// The eye and view matrix on `frame` of the `--camera` mode's camera.
+    fn mode_view(&self, frame: u32) -> (Vec3, Mat4) {
+        match self.camera_mode {
+            CameraMode::Fixed => (
+                self.eye,
+                Mat4::look_at_rh(self.eye, self.eye + self.forward, Vec3::Y),
+            ),
+            CameraMode::Dolly => {
+                let eye = match self.motion {
+                    // Back from the bunny by as much as the fixed camera's bunny has moved away from it.
+                    Motion::SweepX { near, far } => {
+                        self.eye - Vec3::X * (sweep_distance(near, far, self.frames, frame) - near)
+                    }
+                    Motion::Static => self.eye,
+                };
+                (eye, Mat4::look_at_rh(eye, eye + self.forward, Vec3::Y))
+            }
+            CameraMode::Orbit => {
+                let target = match self.instances.first() {
+                    Some(_) => self.instance_position(0, frame),
+                    None => self.eye + self.forward,
+                };
+                let d = target.distance(self.eye);
+                let phase = std::f32::consts::TAU * frame as f32 / ORBIT_PERIOD_FRAMES;
+                let phi = ORBIT_AMPLITUDE_DEG.to_radians() * phase.sin();
+                let dir = glam::Quat::from_rotation_y(phi) * self.forward;
+                let eye = target - dir * d;
+                (eye, Mat4::look_at_rh(eye, target, Vec3::Y))
+            }
+        }
+    }
+}
+
+/// One seam mesh: the seam between two blocks at one pair of their LODs (empty where every quad is
+/// degenerate). Positions and normals are copies of the blocks' own, bit for bit, so the seam's edges are the
+/// blocks' edges exactly.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SeamMesh {
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Vec<[f32; 3]>,
+    pub indices: Vec<u32>,
+}
+
+/// The seams between blocks (models) `blocks.0` and `blocks.1`: `meshes[a * lods.1 + b]` joins the first at
+/// LOD a to the second at LOD b.
+#[derive(Debug, Clone)]
+pub struct Seam {
+    pub blocks: (u32, u32),
+    pub lods: (u32, u32),
+    pub meshes: Vec<SeamMesh>,
+}
+
+impl Seam {
+    pub fn mesh_index(&self, a: u32, b: u32) -> u32 {
+        a.min(self.lods.0 - 1) * self.lods.1 + b.min(self.lods.1 - 1)
+    }
+}
+
+/// What the preprocessing took and made (describe and run.json's scene descriptions).
+#[derive(Debug, Clone, Serialize)]
+pub struct Preprocessing {
+    pub partition: PartitionMode,
+    pub grid: [u32; 3],
+    pub block_size: f64,
+    pub blocks: usize,
+    pub input_triangles: usize,
+    /// Triangles of all blocks at full resolution (clipping adds some).
+    pub block_triangles: usize,
+    pub lod_targets: Vec<f32>,
+    pub seam_pairs: usize,
+    pub seam_edges: usize,
+    /// Seam triangles over every pair of LODs of every pair of blocks.
+    pub seam_triangles_all_lod_pairs: usize,
+    pub partition_ms: f64,
+    pub lod_chains_ms: f64,
+    pub seams_ms: f64,
+    /// Partition + LOD chains + seams: the blocks' whole preprocessing.
+    pub blocks_ms: f64,
+    /// Bytes of the blocks' LOD meshes and the seams as the GPU holds them (40-byte vertices, 4-byte indices).
+    pub blocks_bytes: u64,
+    pub seams_bytes: u64,
+    pub clusterlod_ms: f64,
+    pub clusterlod_bytes: u64,
+    pub clusters: usize,
+    pub cluster_groups: usize,
+    pub cluster_levels: u32,
+}
+
+/// A unified scene's mesh, seams and cluster DAG (shared by every block of the scene).
+#[derive(Debug)]
+pub struct Unified {
+    /// The whole mesh (clusterlod draws it).
+    pub mesh: Mesh,
+    pub dag: ClusterDag,
+    pub seams: Vec<Seam>,
+    /// `--pixel-error` as the blocks' switch distances and clusterlod's cut use it.
+    pub pixel_error: f32,
+    pub preprocessing: Preprocessing,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sweep_goes_out_and_back_at_constant_speed() {
+        let n = 11;
+        let d: Vec<f32> = (0..n).map(|f| sweep_distance(1.0, 6.0, n, f)).collect();
+        assert_eq!(d[0], 1.0);
+        assert_eq!(d[5], 6.0);
+        assert_eq!(d[10], 1.0);
+        for f in 0..n as usize {
+            assert!((d[f] - d[n as usize - 1 - f]).abs() < 1e-6);
+        }
+        for w in d[..6].windows(2) {
+            assert!((w[1] - w[0] - 1.0).abs() < 1e-5);
+        }
+    }
+}
