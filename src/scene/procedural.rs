@@ -59,17 +59,17 @@ fn model_chain(kind: SceneKind) -> Result<(ModelChain, f32, &'static str)> {
         SceneKind::Simple => (
             procgen::simple_chain()?,
             0.0,
-            "procedural (src/procgen.rs: sphere and box)",
+            "procedural (src/geometry/procgen.rs: sphere and box)",
         ),
         SceneKind::Windmills => (
             procgen::windmill_chain()?,
             WINDMILL_SPIN_PER_FRAME,
-            "procedural (src/procgen.rs: windmill)",
+            "procedural (src/geometry/procgen.rs: windmill)",
         ),
         _ => (
             procgen::tree_chain(SCENE_SEED)?,
             0.0,
-            "procedural (src/procgen.rs: tree, seed SCENE_SEED = 2008)",
+            "procedural (src/geometry/procgen.rs: tree, seed SCENE_SEED = 2008)",
         ),
     })
 }

@@ -126,7 +126,7 @@ fn load_mesh(kind: SceneKind, cfg: &SceneConfig) -> Result<(Mesh, String)> {
         }
         (None, _) => (
             crate::geometry::terrain::terrain_mesh(SCENE_SEED, quads)?,
-            format!("procedural (src/terrain.rs, seed SCENE_SEED = 2008, {quads} x {quads} cells)"),
+            format!("procedural (src/geometry/terrain.rs, seed SCENE_SEED = 2008, {quads} x {quads} cells)"),
         ),
     })
 }
