@@ -80,10 +80,6 @@ impl Grid {
         self.origin[axis] + (plane & 0x00ff_ffff) as f64 * self.cell
     }
 
-    pub fn block_count(&self) -> usize {
-        self.dims.iter().map(|&d| d as usize).product()
-    }
-
     /// Index of block `c` (x fastest).
     pub fn block_index(&self, c: [u32; 3]) -> usize {
         (c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])) as usize
