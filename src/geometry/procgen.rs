@@ -1136,11 +1136,23 @@ mod tests {
     #[test]
     fn leaf_masks_cut_a_pointed_leaf_and_leave_two_cluster_cells_empty() {
         assert!(leaf_mask(0.5, 0.5), "the leaf's centre");
-        assert!(!leaf_mask(0.95, 0.9) && !leaf_mask(0.05, 0.1), "the card's corners");
-        let centre = |cell: u32| ((cell % 3) as f32 / 3.0 + 1.0 / 6.0, (cell / 3) as f32 / 3.0 + 1.0 / 6.0);
+        assert!(
+            !leaf_mask(0.95, 0.9) && !leaf_mask(0.05, 0.1),
+            "the card's corners"
+        );
+        let centre = |cell: u32| {
+            (
+                (cell % 3) as f32 / 3.0 + 1.0 / 6.0,
+                (cell / 3) as f32 / 3.0 + 1.0 / 6.0,
+            )
+        };
         for cell in 0..9 {
             let (u, v) = centre(cell);
-            assert_eq!(leaf_cluster_mask(u, v), cell != 2 && cell != 6, "cell {cell}");
+            assert_eq!(
+                leaf_cluster_mask(u, v),
+                cell != 2 && cell != 6,
+                "cell {cell}"
+            );
         }
     }
 }

@@ -4,7 +4,6 @@
 use crate::common::{
     read_csv, render_frame, run_into, scene_config, static_scene, subdivided_bunny_obj,
 };
-use lodbench::gpu::GpuContext;
 use lodbench::scene::{SceneDef, SceneKind, NOT_REACHED};
 
 /// The bunny split to 14,696 triangles with a scan's fine noise: its LODs lose so little that the switch to
@@ -77,7 +76,7 @@ fn dense_mesh_sweep_starts_outside_the_model() {
 /// back faces culled (FSI's earlier choice) nearly all of them were.
 #[test]
 fn fsi_t_instances_show_the_inside_like_the_reference() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let probe = static_scene(&[1.0], [1.0, 2.0, 3.0], 3, "fixed");
     let d = probe.models[0].radius * 0.02;
     let mut scene = static_scene(&[d], [d, 2.0 * d, 3.0 * d], 3, "fixed");

@@ -16,12 +16,11 @@
 //! results/baseline/regress/). The full ci profile is a user command (`lodbench run --profile ci`) and the
 //! `ci_profile` module's ignored test.
 
-use crate::common::{read_csv, run_into, scene_config, snapshot_problem, Row};
+use crate::common::{read_csv, regress_run, scene_config, snapshot_problem, Row};
 use lodbench::measure::FrameDriver;
 use lodbench::scene::{SceneDef, SceneKind};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 /// Image figures come from exact integer sums, so on the adapter and driver the baseline was made on (recorded
 /// in `results/baseline/regress/adapter.json`) they are compared exactly: any difference is a real change. On
@@ -66,24 +65,6 @@ const BLOCK_EXACT: [&str; 6] = [
     "tri_alternation_max",
 ];
 const BLOCK_CLOSE: [&str; 3] = ["rmse_mean", "de2000_mean", "crack_px_mean"];
-
-pub(crate) fn regress_run() -> &'static PathBuf {
-    static OUT: OnceLock<PathBuf> = OnceLock::new();
-    OUT.get_or_init(|| {
-        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("regress");
-        run_into(
-            &out,
-            &[
-                "--profile",
-                "regress",
-                "--metrics",
-                "rmse,pop,de2000",
-                "--dump-frames",
-                "--dump-transitions",
-            ],
-        )
-    })
-}
 
 fn baseline_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baseline/regress")
