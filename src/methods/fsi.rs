@@ -30,7 +30,7 @@
 //!   the inside (the camera near or inside the bounds of a mesh with holes, or inside an open one), both hold
 //!   the back id and case 3 averages them, as the two-sided reference shows that inside. (Culling back faces,
 //!   the earlier choice, left background there: with the camera inside the bunny, on all 19,200 pixels the
-//!   reference covers at 160x120; `tests/it/fidelity.rs`.)
+//!   reference covers at 160x120; `tests/it/scene_fidelity.rs`.)
 //! - Formats: colour Rgba8UnormSrgb (4 B), depth Depth32Float (4 B, the depth attachment itself, read as a
 //!   texture by the combination pass), id R16Uint (2 B; R32Uint when a scene has 32,767 instances or more, as ids go to twice the count):
 //!   10 bytes per pixel per buffer against the paper's 7 (24-bit colour, 16-bit float depth, 16-bit float id),

@@ -3,7 +3,7 @@
 //!
 //! Adding a method: a new file with a type implementing [`Method`] (and, if it has flags, an options struct
 //! flattened into [`MethodOptions`]), plus its line in [`BUILTIN`]. docs/ARCHITECTURE.md walks through it;
-//! `tests/registry.rs` does it with a throwaway method. The methods' files import `common`, never this file, so
+//! `tests/it/methods_registry.rs` does it with a throwaway method. The methods' files import `common`, never this file, so
 //! the registry can name them without an import circle.
 
 pub mod alpha;

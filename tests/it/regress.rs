@@ -356,7 +356,7 @@ fn mid_transition_frames_match_snapshots() {
 /// half of alpha's lodpop on those frames. The swap frames come from `lod_mean` (lod_from + k on the single bunny
 /// of bunny-sweep). The depth-compare switch itself (less-equal before the swap, less after) changes only a few
 /// pixels of this sweep: removing it leaves this test passing and moves 5 figures of the exact regression above;
-/// `variants::alpha_zwrite_keeps_equal_depth_pixels_across_the_swap` is the test that isolates it.
+/// `methods_variants::alpha_zwrite_keeps_equal_depth_pixels_across_the_swap` is the test that isolates it.
 #[test]
 fn alpha_zwrite_does_not_pop_at_the_swap() {
     let rows: Vec<Row> = read_csv(&regress_run().join("frames.csv"))
