@@ -30,7 +30,7 @@ pub const AUX_LEAF: f32 = 1.0;
 /// An alpha-tested card showing a cluster of leaves (mask: [`crate::geometry::procgen::leaf_cluster_mask`]), for billboard clouds.
 pub const AUX_LEAF_CLUSTER: f32 = 2.0;
 /// A windmill blade vertex: rotated about the hub by the instance's animation angle after the object-space
-/// position FSI's visibility texture reads (seed 000 section 3.3).
+/// position FSI's visibility texture reads (Scherzer & Wimmer 2008 section 3.3).
 pub const AUX_BLADE: f32 = 3.0;
 
 impl Mesh {

@@ -1,4 +1,4 @@
-//! Procedural stand-ins for the three test scenes of seed 000 (Scherzer & Wimmer 2008, "Frame Sequential
+//! Procedural stand-ins for the three test scenes of Scherzer & Wimmer (2008, "Frame Sequential
 //! Interpolation"), section 4: SIMPLE (a red sphere and a blue box), WINDMILLS ("LODs ranging from 100 -
 //! 18,000 triangles") and TREES ("LODs ranging from 5,000 - 93,000 triangles"). The paper's models are not
 //! published, so they are generated here, on the CPU, deterministically (trees from a seed, with the in-house
@@ -25,7 +25,7 @@
 //! ## Colours: `lod_colors`
 //!
 //! Colour is per instance in the renderer, so [`ModelChain::lod_colors`] holds one linear-RGB base colour per
-//! LOD: an instance drawn at LOD k takes `lod_colors[k]`. SIMPLE's two LODs differ in colour (seed 000: the
+//! LOD: an instance drawn at LOD k takes `lod_colors[k]`. SIMPLE's two LODs differ in colour (Scherzer & Wimmer 2008: the
 //! objects "match neither in color nor in silhouettes"): LOD0 red, LOD1 blue. WINDMILLS and TREES use one
 //! colour for every LOD.
 //!

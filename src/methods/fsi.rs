@@ -1,5 +1,5 @@
 //! `fsi`, `fsi-noreproject`, `fsi-sameframe`: Frame Sequential Interpolation (Scherzer and Wimmer 2008,
-//! seed 000 sections 3.2-3.5 and 4.1), the reference implementation of this harness, and its two ablations.
+//! Scherzer & Wimmer 2008 sections 3.2-3.5 and 4.1), the reference implementation of this harness, and its two ablations.
 //!
 //! Two LOD buffers (colour, depth, instance id) are used ping-pong: frame f renders the whole scene into buffer
 //! f mod 2; the other still holds frame f-1. n-instances are drawn normally with id 0. A t-instance gets id
@@ -105,11 +105,11 @@ pub enum FsiCheck {
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
 #[serde(default, rename_all(deserialize = "kebab-case"))]
 pub struct FsiOptions {
-    /// Visibility texture of Frame Sequential Interpolation (`fsi*`, seed 000 section 3.3).
+    /// Visibility texture of Frame Sequential Interpolation (`fsi*`, Scherzer & Wimmer 2008 section 3.3).
     #[arg(long, value_enum, default_value_t = VisTexture::Noise)]
     pub vis_texture: VisTexture,
     /// `fsi` only, not in the paper: `forward` uses an older fragment only if, reprojected with its own depth,
-    /// it lands within a pixel of the pixel (rejects the disocclusion ghosts of seed 000 section 4.2).
+    /// it lands within a pixel of the pixel (rejects the disocclusion ghosts of Scherzer & Wimmer 2008 section 4.2).
     #[arg(long, value_enum, default_value_t = FsiCheck::None)]
     pub fsi_check: FsiCheck,
 }

@@ -1,5 +1,5 @@
-//! Frame Sequential Interpolation on the software adapter (issue 4's image tests a-d). The combination pass is
-//! checked pixel by pixel against a CPU implementation of seed 000 sections 3.4-3.5 and eq. 2 that reads the
+//! Frame Sequential Interpolation on the software adapter (image tests a-f). The combination pass is
+//! checked pixel by pixel against a CPU implementation of Scherzer & Wimmer 2008 sections 3.4-3.5 and eq. 2 that reads the
 //! same two LOD buffers (colour, depth, id) back from the GPU.
 
 use glam::{Mat4, Vec4};

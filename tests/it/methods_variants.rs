@@ -163,7 +163,7 @@ fn alpha_zwrite_keeps_equal_depth_pixels_across_the_swap() {
     );
 }
 
-/// alpha-linear is seed 003's eq. 2 with its double pass: during a transition both LODs are translucent, the
+/// alpha-linear is Sheliemietiev et al. 2023's eq. 2 with its double pass: during a transition both LODs are translucent, the
 /// outgoing LOD0 drawn over the frame with weight 1 - k, then the incoming LOD1 over that with weight k. So every
 /// pixel of the frame at k is `k L1 + (1 - k) (k BG + (1 - k) L0)` in linear light, L0 and L1 the pixel of the
 /// steady LOD0 and LOD1 frames (the background where a LOD does not cover it) and BG the background, with the
@@ -215,6 +215,6 @@ fn alpha_linear_blends_both_lods_with_weights_one_minus_k_and_k() {
     let (bad, both) = off(&giegl, 0.5);
     assert!(
         bad * 2 > both,
-        "alpha-2pass matches seed 003's linear blend on all but {bad} of {both} pixels: the check cannot tell them apart"
+        "alpha-2pass matches Sheliemietiev et al. 2023's linear blend on all but {bad} of {both} pixels: the check cannot tell them apart"
     );
 }

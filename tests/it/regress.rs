@@ -199,7 +199,7 @@ fn column(rows: &[Row], method: &str, name: &str) -> Vec<f64> {
 /// they still read the previous frame's buffer), every method saw the same schedule, and at every transition of
 /// the path every smooth method's largest lodpop (the pop with the pose held, docs/measurement.md) is below
 /// discrete's. FSI is not exempt: its larger `pop` is its one-frame lag of the moving bunny, which lodpop
-/// leaves out and `lag_rmse` measures. `alpha-linear` (seed 003's blend) is held to what it does: both LODs
+/// leaves out and `lag_rmse` measures. `alpha-linear` (Sheliemietiev et al. 2023's blend) is held to what it does: both LODs
 /// translucent let the background through with weight k (1 - k) over the whole silhouette, so each step of k
 /// changes the picture; on the path's short transitions (3 and 6 frames at this profile) its lodpop is above
 /// discrete's (lavapipe: 0.043 against 0.028 on the first), on the long ones (11 frames) below (0.0097 against

@@ -9,7 +9,7 @@ use lodbench::measure::{BlockRunner, QualityOptions};
 use lodbench::scene::SceneKind;
 use std::path::Path;
 
-/// Issue 2's "done means", on the ci profile: the three files; reference rows score 0; discrete scores 0 while
+/// The acceptance check of a run, on the ci profile: the three files; reference rows score 0; discrete scores 0 while
 /// LOD0 is shown and > 0 after the first switch; its pop peaks on switch frames.
 #[test]
 fn ci_sweep_reference_and_discrete() {

@@ -7,11 +7,10 @@ use crate::common::{
 use lodbench::scene::{SceneDef, SceneKind, NOT_REACHED};
 
 /// The bunny split to 14,696 triangles with a scan's fine noise: its LODs lose so little that the switch to
-/// LOD1 lies nearer than where the whole bunny fits the view (the case of issue 19, a 27,864-triangle scan).
+/// LOD1 lies nearer than where the whole bunny fits the view (as for a 27,864-triangle scan).
 /// The sweep must start outside the model, say which switch it never reaches, and FSI's first transition
-/// (LOD1 to LOD2) must stay within twice discrete's largest rmse. Before: the sweep started inside the bounding
-/// sphere and FSI showed background for the bunny's inside on that transition (rmse 0.18 against discrete's
-/// 0.026). At 160x120 and the quick profile's 600 frames fsi's is 1.4 times discrete's (lavapipe: 0.0177 against 0.0126); with
+/// (LOD1 to LOD2) must stay within twice discrete's largest rmse. Started inside the bounding sphere, FSI would
+/// show background for the bunny's inside on that transition. At 160x120 and the quick profile's 600 frames fsi's is 1.4 times discrete's (lavapipe: 0.0177 against 0.0126); with
 /// fewer frames the bunny moves faster and FSI's one-frame lag of the moving bunny grows.
 #[test]
 fn dense_mesh_sweep_starts_outside_the_model() {

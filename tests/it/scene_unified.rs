@@ -1,4 +1,4 @@
-//! The unified-LOD scenes on the software adapter: seed 004 Fig. 1 (bunny-halves), whose seam must keep the
+//! The unified-LOD scenes on the software adapter: Blow 2003b Fig. 1 (bunny-halves), whose seam must keep the
 //! cut closed where the two halves show different LODs, and the terrain's methods side by side.
 
 use crate::common::{read_csv, run_into, scene_config};
