@@ -104,7 +104,7 @@ pub trait Method {
     /// `--shadows on`, `--shadow-lod follow`: what instance `i` casts into the frame's shadow map given the
     /// states `states` (this frame's after `encode`; the earlier frame's for lodpop's counterfactual,
     /// `before` true). Called after `encode` of the frame. The default, the blending methods' choice: the LOD
-    /// out of transition, both LODs dithered at k in one (src/shadow.rs).
+    /// out of transition, both LODs dithered at k in one (src/effects/shadow.rs).
     fn shadow_caster(&self, states: &[InstanceState], i: usize, _before: bool) -> Caster {
         states[i].blended_caster()
     }

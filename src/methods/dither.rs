@@ -2,7 +2,7 @@
 //! fragment discard: a pixel keeps the incoming LOD (`lod_to`) where k > noise(x, y) and the outgoing LOD
 //! (`lod_from`) elsewhere. The two tests are complementary, so each pixel of the overlap shows exactly one of
 //! them, and depth writes stay on: no sorting, no translucency. The threshold pattern is `--noise`
-//! (`src/noise.rs`), tiled in screen space.
+//! (`src/methods/noise.rs`), tiled in screen space.
 
 use super::common::{instance_raw, FrameInput, Method};
 use crate::gpu::{DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
