@@ -92,7 +92,7 @@ fn vs_main(v: VertexIn, inst: InstanceIn) -> VsOut {
     return transform(v.position, v.normal, v.aux, inst);
 }
 
-// The leaf masks of src/mesh.rs (`leaf_mask`, `leaf_cluster_mask`): keep the two in step.
+// The leaf masks of src/geometry/procgen.rs (`leaf_mask`, `leaf_cluster_mask`): keep the two in step.
 fn leaf_mask(uv: vec2<f32>) -> bool {
     let x = uv.x * 2.0 - 1.0;
     let y = uv.y * 2.0 - 1.0;

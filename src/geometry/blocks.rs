@@ -1,4 +1,4 @@
-//! Dividing one large triangle mesh into a 3D grid of blocks (seed 004, "Clipping or Binning?" and "Building
+//! Dividing one large triangle mesh into a 3D grid of blocks (Blow 2003b, "Clipping or Binning?" and "Building
 //! Seams"), the first step of Blow's unified LOD: blocks change LOD independently, and degenerate quads (seams)
 //! join neighbouring blocks so no crack opens where they differ.
 //!
@@ -80,10 +80,6 @@ impl Grid {
         self.origin[axis] + (plane & 0x00ff_ffff) as f64 * self.cell
     }
 
-    pub fn block_count(&self) -> usize {
-        self.dims.iter().map(|&d| d as usize).product()
-    }
-
     /// Index of block `c` (x fastest).
     pub fn block_index(&self, c: [u32; 3]) -> usize {
         (c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])) as usize
@@ -143,7 +139,7 @@ pub struct SeamQuad {
     pub second: (usize, u32, u32),
 }
 
-/// How a mesh is divided into blocks (`--partition`; seed 004, "Clipping or Binning?").
+/// How a mesh is divided into blocks (`--partition`; Blow 2003b, "Clipping or Binning?").
 #[derive(
     Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
 )]
@@ -473,7 +469,7 @@ impl Partition {
     }
 
     /// Every block simplified to each of `targets` (fractions of its triangles; the first must be 1.0) with
-    /// meshopt, and its seam vertices cross-referenced into each LOD (seed 004, "Building Seams": seams are
+    /// meshopt, and its seam vertices cross-referenced into each LOD (Blow 2003b, "Building Seams": seams are
     /// built at full resolution, then cross-referenced into the reduced meshes).
     ///
     /// A block's border on a cut reduces like any open border: meshopt collapses a border vertex only along a
@@ -482,7 +478,7 @@ impl Partition {
     /// ([`BlockLod::drawn_at`]); that map is monotone along every border chain, so the seam quads of a pair of
     /// blocks at any two LODs close the gap between their borders (the unit tests check that the union is a
     /// closed surface). The vertices where seams meet are locked, so every block draws them where they are and
-    /// no hole opens there: those shared by three or more blocks (block edges and corners, the 3D case seed 004
+    /// no hole opens there: those shared by three or more blocks (block edges and corners, the 3D case Blow 2003b
     /// leaves for later), and the ends and forks of a block's seam chains (where a cut meets the mesh's own open
     /// border: without the lock, a block that reduces its border corner there leaves a notch beside the seam,
     /// measured on the terrain's skyline as up to 9 crack pixels a frame at 320x240).
@@ -914,7 +910,7 @@ mod tests {
         }
     }
 
-    /// Seed 004 Fig. 3: two triangles share an edge that lies on the plane x = 1, one on each side. Nothing is
+    /// Blow 2003b Fig. 3: two triangles share an edge that lies on the plane x = 1, one on each side. Nothing is
     /// clipped (no new vertex), but the shared edge is a seam: one quad.
     #[test]
     fn two_triangles_straddling_a_plane() {
@@ -1039,7 +1035,7 @@ mod tests {
         );
     }
 
-    /// Seed 004 Fig. 1: the bunny clipped in half by the plane x = its centre, both halves reduced to a quarter
+    /// Blow 2003b Fig. 1: the bunny clipped in half by the plane x = its centre, both halves reduced to a quarter
     /// of their triangles. The cut borders reduce too (fewer edges on the cut than at full resolution), and
     /// every seam vertex reduced away is drawn at a vertex its LOD still uses, on the cut.
     #[test]

@@ -4,7 +4,7 @@ use crate::error::{Error, Result};
 use crate::geometry::mesh::Mesh;
 use serde::Serialize;
 
-/// Default triangle targets, as fractions of LOD0 (issue 2: 100 / 50 / 25 / 10 %).
+/// Default triangle targets, as fractions of LOD0 (100 / 50 / 25 / 10 %).
 pub const DEFAULT_TARGETS: [f32; 4] = [1.0, 0.5, 0.25, 0.1];
 
 /// One level of detail: its own compact mesh and the simplifier's error in the mesh's own (absolute) units.

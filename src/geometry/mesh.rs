@@ -25,35 +25,13 @@ pub struct Mesh {
 
 /// `aux` kinds (the shader reads them as floats).
 pub const AUX_SOLID: f32 = 0.0;
-/// An alpha-tested card showing one leaf (mask: [`leaf_mask`] at (u, v)).
+/// An alpha-tested card showing one leaf (mask: [`crate::geometry::procgen::leaf_mask`] at (u, v)).
 pub const AUX_LEAF: f32 = 1.0;
-/// An alpha-tested card showing a cluster of leaves (mask: [`leaf_cluster_mask`]), for billboard clouds.
+/// An alpha-tested card showing a cluster of leaves (mask: [`crate::geometry::procgen::leaf_cluster_mask`]), for billboard clouds.
 pub const AUX_LEAF_CLUSTER: f32 = 2.0;
 /// A windmill blade vertex: rotated about the hub by the instance's animation angle after the object-space
-/// position FSI's visibility texture reads (seed 000 section 3.3).
+/// position FSI's visibility texture reads (Scherzer & Wimmer 2008 section 3.3).
 pub const AUX_BLADE: f32 = 3.0;
-
-/// The single-leaf alpha mask over a card's (u, v) in [0, 1]^2: a pointed leaf along v. Must match
-/// `leaf_mask` in shaders/mesh.wgsl.
-pub fn leaf_mask(u: f32, v: f32) -> bool {
-    let x = u * 2.0 - 1.0;
-    let y = v * 2.0 - 1.0;
-    x.abs() <= 0.8 * (1.0 - y * y)
-}
-
-/// The leaf-cluster mask: a 3x3 grid of leaves, each cell's leaf tilted by a fixed per-cell amount, with two
-/// cells left empty so the card does not read as a square. Must match `leaf_cluster_mask` in the shader.
-pub fn leaf_cluster_mask(u: f32, v: f32) -> bool {
-    let cu = (u * 3.0).floor().clamp(0.0, 2.0);
-    let cv = (v * 3.0).floor().clamp(0.0, 2.0);
-    let cell = cu + 3.0 * cv;
-    if cell == 2.0 || cell == 6.0 {
-        return false;
-    }
-    let fu = u * 3.0 - cu;
-    let fv = v * 3.0 - cv;
-    leaf_mask(fu, fv)
-}
 
 impl Mesh {
     /// Builds and validates a mesh. `name` is used in error messages (a file path or a generator's name).
@@ -500,51 +478,39 @@ fn read_buffer_uri(i: usize, uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
     })
 }
 
-/// Standard or URL-safe base64, padding optional; `None` for any other character.
+/// Standard or URL-safe base64 (the two alphabets may mix), padding optional; `None` for any other character
+/// or a length no base64 text has. Bits left over after the last whole byte are ignored.
 fn decode_base64(text: &str) -> Option<Vec<u8>> {
-    let text = text.trim_end_matches('=');
-    let mut out = Vec::with_capacity(text.len() / 4 * 3 + 2);
-    let (mut acc, mut bits) = (0u32, 0u32);
-    for c in text.bytes() {
-        let v = match c {
-            b'A'..=b'Z' => c - b'A',
-            b'a'..=b'z' => c - b'a' + 26,
-            b'0'..=b'9' => c - b'0' + 52,
-            b'+' | b'-' => 62,
-            b'/' | b'_' => 63,
-            _ => return None,
-        };
-        acc = (acc << 6) | u32::from(v);
-        bits += 6;
-        if bits >= 8 {
-            bits -= 8;
-            out.push((acc >> bits) as u8);
-            acc &= (1 << bits) - 1;
-        }
-    }
-    // One character left over (6 bits) cannot end a base64 text.
-    (bits < 6).then_some(out)
+    use base64::engine::{general_purpose, DecodePaddingMode, Engine, GeneralPurpose};
+    const ENGINE: GeneralPurpose = GeneralPurpose::new(
+        &base64::alphabet::STANDARD,
+        general_purpose::NO_PAD
+            .with_decode_padding_mode(DecodePaddingMode::RequireNone)
+            .with_decode_allow_trailing_bits(true),
+    );
+    let standard: String = text
+        .trim_end_matches('=')
+        .chars()
+        .map(|c| match c {
+            '-' => '+',
+            '_' => '/',
+            c => c,
+        })
+        .collect();
+    ENGINE.decode(standard).ok()
 }
 
 /// Decodes `%XX` escapes; `None` for a `%` not followed by two hex digits.
 fn percent_decode(text: &str) -> Option<Vec<u8>> {
+    // The crate leaves a malformed escape as it is; a URI with one is refused instead.
     let b = text.as_bytes();
-    let mut out = Vec::with_capacity(b.len());
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'%' {
-            let hex = b.get(i + 1..i + 3)?;
-            if !hex.iter().all(u8::is_ascii_hexdigit) {
-                return None;
-            }
-            out.push(u8::from_str_radix(std::str::from_utf8(hex).ok()?, 16).ok()?);
-            i += 3;
-        } else {
-            out.push(b[i]);
-            i += 1;
-        }
-    }
-    Some(out)
+    let malformed = b.iter().enumerate().any(|(i, &c)| {
+        c == b'%'
+            && !b
+                .get(i + 1..i + 3)
+                .is_some_and(|hex| hex.iter().all(u8::is_ascii_hexdigit))
+    });
+    (!malformed).then(|| percent_encoding::percent_decode(b).collect())
 }
 
 /// Checks that the crate's accessor reader can read `a` without panicking or coming up short: no sparse
@@ -859,21 +825,8 @@ mod tests {
     }
 
     fn encode_base64(bytes: &[u8]) -> String {
-        const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-        let mut out = String::new();
-        for c in bytes.chunks(3) {
-            let n = c
-                .iter()
-                .enumerate()
-                .fold(0u32, |n, (i, &b)| n | u32::from(b) << (16 - 8 * i));
-            for i in 0..=c.len() {
-                out.push(A[(n >> (18 - 6 * i) & 63) as usize] as char);
-            }
-        }
-        while !out.len().is_multiple_of(4) {
-            out.push('=');
-        }
-        out
+        use base64::Engine;
+        base64::engine::general_purpose::STANDARD.encode(bytes)
     }
 
     fn with_buffer(mut json: serde_json::Value, bytes: &[u8]) -> serde_json::Value {

@@ -1,4 +1,4 @@
-//! Geomorph correspondences (seed 003 sections 10-11): for every vertex of a finer LOD, the point of the next
+//! Geomorph correspondences (Sheliemietiev et al. 2023 sections 10-11): for every vertex of a finer LOD, the point of the next
 //! coarser LOD it moves to during a transition, with the normal it takes there.
 //!
 //! - `nearest` (the paper's): the nearest coarse vertex, with the normal difference in the distance:
@@ -23,7 +23,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 )]
 #[serde(rename_all = "lowercase")]
 pub enum Correspondence {
-    /// Nearest coarse vertex, normals in the distance (seed 003 section 11).
+    /// Nearest coarse vertex, normals in the distance (Sheliemietiev et al. 2023 section 11).
     Nearest,
     /// Closest point on the coarse surface.
     Surface,

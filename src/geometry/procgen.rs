@@ -1,4 +1,4 @@
-//! Procedural stand-ins for the three test scenes of seed 000 (Scherzer & Wimmer 2008, "Frame Sequential
+//! Procedural stand-ins for the three test scenes of Scherzer & Wimmer (2008, "Frame Sequential
 //! Interpolation"), section 4: SIMPLE (a red sphere and a blue box), WINDMILLS ("LODs ranging from 100 -
 //! 18,000 triangles") and TREES ("LODs ranging from 5,000 - 93,000 triangles"). The paper's models are not
 //! published, so they are generated here, on the CPU, deterministically (trees from a seed, with the in-house
@@ -25,7 +25,7 @@
 //! ## Colours: `lod_colors`
 //!
 //! Colour is per instance in the renderer, so [`ModelChain::lod_colors`] holds one linear-RGB base colour per
-//! LOD: an instance drawn at LOD k takes `lod_colors[k]`. SIMPLE's two LODs differ in colour (seed 000: the
+//! LOD: an instance drawn at LOD k takes `lod_colors[k]`. SIMPLE's two LODs differ in colour (Scherzer & Wimmer 2008: the
 //! objects "match neither in color nor in silhouettes"): LOD0 red, LOD1 blue. WINDMILLS and TREES use one
 //! colour for every LOD.
 //!
@@ -76,10 +76,8 @@
 //!
 //! Cluster cards are squares of that side; single-leaf cards are 0.6 as wide as long.
 //!
-//! Build time (release, including the error measurement; the caller times it, the `print_chains` test prints
-//! it with `cargo test --release --lib procgen -- --nocapture`): about 0.001 s for SIMPLE, 0.02 s for
-//! WINDMILLS and 0.18-0.2 s for a TREE (single-threaded, on the 2-core development machine; up to 3x that
-//! while other builds share the cores).
+//! Build time (release, including the error measurement): the caller times it; `lodbench describe` prints it
+//! as `lod_generation_ms`.
 
 use crate::error::{Error, Result};
 use crate::geometry::lod::LodChain;
@@ -105,6 +103,29 @@ pub const WINDMILL_BLADE_Z: f32 = 0.8;
 pub const TREE_HEIGHT: f32 = 8.0;
 /// Every tree LOD stays within this distance of the y axis in x and in z.
 pub const TREE_MAX_HALF_WIDTH: f32 = 4.0;
+
+/// The single-leaf alpha mask over a card's (u, v) in [0, 1]^2: a pointed leaf along v. Must match
+/// `leaf_mask` in shaders/mesh.wgsl (the mask of [`AUX_LEAF`] cards).
+pub fn leaf_mask(u: f32, v: f32) -> bool {
+    let x = u * 2.0 - 1.0;
+    let y = v * 2.0 - 1.0;
+    x.abs() <= 0.8 * (1.0 - y * y)
+}
+
+/// The leaf-cluster mask: a 3x3 grid of leaves, each cell's leaf tilted by a fixed per-cell amount, with two
+/// cells left empty so the card does not read as a square. Must match `leaf_cluster_mask` in the
+/// shader (the mask of [`AUX_LEAF_CLUSTER`] cards).
+pub fn leaf_cluster_mask(u: f32, v: f32) -> bool {
+    let cu = (u * 3.0).floor().clamp(0.0, 2.0);
+    let cv = (v * 3.0).floor().clamp(0.0, 2.0);
+    let cell = cu + 3.0 * cv;
+    if cell == 2.0 || cell == 6.0 {
+        return false;
+    }
+    let fu = u * 3.0 - cu;
+    let fv = v * 3.0 - cv;
+    leaf_mask(fu, fv)
+}
 
 /// A generated model: its LOD chain and one linear-RGB base colour per LOD (see the module docs).
 #[derive(Debug, Clone)]
@@ -901,7 +922,6 @@ fn flat_box(b: &mut Builder, centre: Vec3, half: Vec3) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::time::Instant;
 
     fn tris(m: &ModelChain) -> Vec<usize> {
         m.chain
@@ -1114,32 +1134,25 @@ mod tests {
     }
 
     #[test]
-    fn print_chains() {
-        let mut report = Vec::new();
-        for name in ["simple", "windmill", "tree"] {
-            let t = Instant::now();
-            let m = match name {
-                "simple" => simple_chain(),
-                "windmill" => windmill_chain(),
-                _ => tree_chain(1),
-            }
-            .unwrap();
-            let secs = t.elapsed().as_secs_f64();
-            let lods: Vec<String> = m
-                .chain
-                .info()
-                .iter()
-                .map(|i| format!("{} tris, err {:.4}", i.triangles, i.error_abs))
-                .collect();
-            let bounds: Vec<String> = m
-                .chain
-                .lods
-                .iter()
-                .map(|l| format!("{:.2?}", l.mesh.bounds()))
-                .collect();
-            report.push(format!("{name} bounds: {}", bounds.join(" | ")));
-            report.push(format!("{name}: {secs:.3} s: {}", lods.join(" | ")));
+    fn leaf_masks_cut_a_pointed_leaf_and_leave_two_cluster_cells_empty() {
+        assert!(leaf_mask(0.5, 0.5), "the leaf's centre");
+        assert!(
+            !leaf_mask(0.95, 0.9) && !leaf_mask(0.05, 0.1),
+            "the card's corners"
+        );
+        let centre = |cell: u32| {
+            (
+                (cell % 3) as f32 / 3.0 + 1.0 / 6.0,
+                (cell / 3) as f32 / 3.0 + 1.0 / 6.0,
+            )
+        };
+        for cell in 0..9 {
+            let (u, v) = centre(cell);
+            assert_eq!(
+                leaf_cluster_mask(u, v),
+                cell != 2 && cell != 6,
+                "cell {cell}"
+            );
         }
-        println!("{}", report.join("\n"));
     }
 }

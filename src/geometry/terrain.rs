@@ -1,5 +1,5 @@
-//! The `terrain` scene's mesh: a procedural heightfield, one large connected mesh for block LOD (seeds 001
-//! and 004) and cluster LOD to divide. Pure CPU, deterministic.
+//! The `terrain` scene's mesh: a procedural heightfield, one large connected mesh for block LOD (Blow 2003a
+//! and 2003b) and cluster LOD to divide. Pure CPU, deterministic.
 //!
 //! - A square of side [`TERRAIN_SIZE`] world units on the x-z plane (x, z in [0, size]), y up, sampled on a
 //!   regular grid of `quads` x `quads` cells, two triangles per cell (the diagonal from (i, j) to

@@ -1,4 +1,4 @@
-//! `alpha`: Giegl-Wimmer "unpopping" LOD blending (seed 000 section 3.1 and Fig. 2; seed 001 Fig. 1b; seed 003
+//! `alpha`: Giegl-Wimmer "unpopping" LOD blending (Scherzer & Wimmer 2008 section 3.1 and Fig. 2; Blow 2003a Fig. 1b; Sheliemietiev et al. 2023
 //! section 8). One LOD of a t-instance is always opaque; the other is drawn translucent over it (alpha 2k before
 //! the swap at k = 0.5, 2(1 - k) after). Opaque geometry first, then the translucent draws sorted back to front
 //! by instance distance, depth test on (less-equal, so a translucent surface coinciding with the opaque one

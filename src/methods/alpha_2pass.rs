@@ -1,18 +1,18 @@
-//! `alpha-2pass` and `alpha-linear`: the double pass of seed 003 section 11. Each translucent LOD contributes
+//! `alpha-2pass` and `alpha-linear`: the double pass of Sheliemietiev et al. 2023 section 11. Each translucent LOD contributes
 //! only its nearest surface, so its own back faces never show through: a depth-only pass writes the object's
 //! nearest depth, then a colour pass draws it again with a depth-equal test and blending.
 //!
 //! The two differ in their weights ([`Weights`]):
-//! - `alpha-2pass` keeps Giegl's unpopping schedule (seed 000 Fig. 2): one LOD of a t-instance is opaque (drawn
+//! - `alpha-2pass` keeps Giegl's unpopping schedule (Scherzer & Wimmer 2008 Fig. 2): one LOD of a t-instance is opaque (drawn
 //!   with the rest of the scene), the other translucent over it with alpha 2k or 2(1 - k), one double pass per
 //!   t-instance.
-//! - `alpha-linear` is seed 003's own blending (section 8, eq. 2, and the `DrawTransparentModelDoublePass`
+//! - `alpha-linear` is Sheliemietiev et al. 2023's own blending (section 8, eq. 2, and the `DrawTransparentModelDoublePass`
 //!   listing): during a transition both LODs are translucent, the outgoing one (`lod_from`) with weight 1 - k,
 //!   then the incoming one (`lod_to`) with weight k, each with its own double pass (depth cleared, depth only,
 //!   then colour with depth read-only and `colour = w src + (1 - w) dst`): 4 draw calls per t-instance. A LOD
 //!   whose weight is 0 is not drawn (the paper: "when the transparency of the old model reaches zero, the old
 //!   model is not drawn"). The listing's blend is over the frame, so what lies behind the object shows through
-//!   with weight k (1 - k) (a quarter at k = 0.5): seed 003's "translucent ghost" at close range. The paper
+//!   with weight k (1 - k) (a quarter at k = 0.5): Sheliemietiev et al. 2023's "translucent ghost" at close range. The paper
 //!   does not say which LOD is drawn first; here the outgoing one, so at k = 0 and k = 1 the frame is exactly
 //!   one LOD.
 //!
@@ -36,7 +36,7 @@ use crate::scene::Scene;
 pub enum Weights {
     /// Giegl's unpopping (`alpha-2pass`): one LOD opaque, the other translucent with alpha 2k or 2(1 - k).
     Unpop,
-    /// Seed 003's eq. 2 (`alpha-linear`): both translucent, `lod_from` with 1 - k, then `lod_to` with k.
+    /// Sheliemietiev et al. 2023's eq. 2 (`alpha-linear`): both translucent, `lod_from` with 1 - k, then `lod_to` with k.
     Linear,
 }
 
@@ -54,7 +54,7 @@ pub fn translucent_draws(weights: Weights, s: &InstanceState) -> [Option<(u32, f
     }
 }
 
-/// The opaque LOD of an instance under `weights`: Giegl's unpopping always has one, seed 003's blend only
+/// The opaque LOD of an instance under `weights`: Giegl's unpopping always has one, Sheliemietiev et al. 2023's blend only
 /// outside transitions.
 fn opaque_lod(weights: Weights, s: &InstanceState) -> Option<u32> {
     match weights {

@@ -1,4 +1,4 @@
-//! `alpha-zwrite`: Blow's variant of unpopping blending (seed 001, "Unified Rendering LOD, Part 2"). The
+//! `alpha-zwrite`: Blow's variant of unpopping blending (Blow 2003a, "Unified Rendering LOD, Part 2"). The
 //! translucent LOD is drawn after the opaque one with depth writes on, so its own far surfaces are hidden
 //! consistently from frame to frame. When the roles swap at k = 0.5 the draw order swaps with them, and the depth
 //! compare of the translucent draw switches from less-equal (before) to less (after): pixels where the two LODs
@@ -51,7 +51,7 @@ impl AlphaZWrite {
         }
     }
 
-    /// `blocks` (seeds 001 and 004): these rules per block of a unified scene, opaque blocks and the seams
+    /// `blocks` (Blow 2003a and 2003b): these rules per block of a unified scene, opaque blocks and the seams
     /// between their opaque LODs first, then the translucent blocks back to front.
     pub fn with_seams(gpu: &SceneGpu, scene: &Scene) -> Self {
         AlphaZWrite {

@@ -104,7 +104,7 @@ pub trait Method {
     /// `--shadows on`, `--shadow-lod follow`: what instance `i` casts into the frame's shadow map given the
     /// states `states` (this frame's after `encode`; the earlier frame's for lodpop's counterfactual,
     /// `before` true). Called after `encode` of the frame. The default, the blending methods' choice: the LOD
-    /// out of transition, both LODs dithered at k in one (src/shadow.rs).
+    /// out of transition, both LODs dithered at k in one (src/effects/shadow.rs).
     fn shadow_caster(&self, states: &[InstanceState], i: usize, _before: bool) -> Caster {
         states[i].blended_caster()
     }
@@ -146,7 +146,7 @@ pub fn shadow_list(input: &FrameInput<'_>, caster: impl Fn(usize) -> Caster, lis
     list.build();
 }
 
-/// The Giegl-Wimmer "unpopping" schedule (seed 000 Fig. 2, seed 001 Fig. 1b): one LOD is always opaque. For
+/// The Giegl-Wimmer "unpopping" schedule (Scherzer & Wimmer 2008 Fig. 2, Blow 2003a Fig. 1b): one LOD is always opaque. For
 /// k < 0.5 the incoming LOD (`lod_to`) is translucent with alpha 2k over the opaque outgoing one; from k = 0.5
 /// the incoming one is opaque and the outgoing one translucent with alpha 2(1 - k).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -295,7 +295,7 @@ pub fn instance_raw_with(
     )
 }
 
-/// The seams of a unified scene (seed 004), drawn opaque between the blocks' opaque LODs: seam s between
+/// The seams of a unified scene (Blow 2003b), drawn opaque between the blocks' opaque LODs: seam s between
 /// blocks a and b is drawn with its mesh for (LOD of a, LOD of b), at the blocks' shared identity transform.
 /// Empty seam meshes (every quad degenerate: both blocks at full resolution) are not drawn.
 pub struct SeamDraws {

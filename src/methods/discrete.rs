@@ -1,4 +1,4 @@
-//! `discrete`: plain discrete LOD switching, the popping baseline of seed 003 section 6 and seed 000 Fig. 8.
+//! `discrete`: plain discrete LOD switching, the popping baseline of Sheliemietiev et al. 2023 section 6 and Scherzer & Wimmer 2008 Fig. 8.
 //! Each instance shows one LOD; the switch is hard, at the centre of the schedule's band (k = 0.5, i.e. at the
 //! switch distance itself).
 
@@ -19,7 +19,7 @@ impl Discrete {
         }
     }
 
-    /// `blocks-discrete` (seeds 001 and 004 without the blending): each block of a unified scene switches
+    /// `blocks-discrete` (Blow 2003a and 2003b without the blending): each block of a unified scene switches
     /// hard, and the seams between the blocks' LODs close the cracks.
     pub fn with_seams(gpu: &SceneGpu, scene: &Scene) -> Self {
         Discrete {

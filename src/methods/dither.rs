@@ -1,8 +1,8 @@
-//! `dither`: noise blending (seed 003 section 9, eq. 3). Both LODs of a t-instance are drawn opaque, with
+//! `dither`: noise blending (Sheliemietiev et al. 2023 section 9, eq. 3). Both LODs of a t-instance are drawn opaque, with
 //! fragment discard: a pixel keeps the incoming LOD (`lod_to`) where k > noise(x, y) and the outgoing LOD
 //! (`lod_from`) elsewhere. The two tests are complementary, so each pixel of the overlap shows exactly one of
 //! them, and depth writes stay on: no sorting, no translucency. The threshold pattern is `--noise`
-//! (`src/noise.rs`), tiled in screen space.
+//! (`src/methods/noise.rs`), tiled in screen space.
 
 use super::common::{instance_raw, FrameInput, Method};
 use crate::gpu::{DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
@@ -19,7 +19,7 @@ pub struct DitherOptions {
     pub noise: NoisePattern,
     /// dither: move the pattern every frame, as engines do under TAA so the history averages the two LODs
     /// (tiled patterns: shifted by the Halton (2, 3) point of the frame, times the tile; ign: Jimenez's
-    /// offset of 5.588238 pixels a frame along x and y, over 64 frames). Default: a fixed pattern (seed 003).
+    /// offset of 5.588238 pixels a frame along x and y, over 64 frames). Default: a fixed pattern (Sheliemietiev et al. 2023).
     #[arg(long)]
     pub noise_temporal: bool,
 }

@@ -1,5 +1,5 @@
 //! `fsi`, `fsi-noreproject`, `fsi-sameframe`: Frame Sequential Interpolation (Scherzer and Wimmer 2008,
-//! seed 000 sections 3.2-3.5 and 4.1), the reference implementation of this harness, and its two ablations.
+//! Scherzer & Wimmer 2008 sections 3.2-3.5 and 4.1), the reference implementation of this harness, and its two ablations.
 //!
 //! Two LOD buffers (colour, depth, instance id) are used ping-pong: frame f renders the whole scene into buffer
 //! f mod 2; the other still holds frame f-1. n-instances are drawn normally with id 0. A t-instance gets id
@@ -30,7 +30,7 @@
 //!   the inside (the camera near or inside the bounds of a mesh with holes, or inside an open one), both hold
 //!   the back id and case 3 averages them, as the two-sided reference shows that inside. (Culling back faces,
 //!   the earlier choice, left background there: with the camera inside the bunny, on all 19,200 pixels the
-//!   reference covers at 160x120; `tests/it/fidelity.rs`.)
+//!   reference covers at 160x120; `tests/it/scene_fidelity.rs`.)
 //! - Formats: colour Rgba8UnormSrgb (4 B), depth Depth32Float (4 B, the depth attachment itself, read as a
 //!   texture by the combination pass), id R16Uint (2 B; R32Uint when a scene has 32,767 instances or more, as ids go to twice the count):
 //!   10 bytes per pixel per buffer against the paper's 7 (24-bit colour, 16-bit float depth, 16-bit float id),
@@ -105,11 +105,11 @@ pub enum FsiCheck {
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
 #[serde(default, rename_all(deserialize = "kebab-case"))]
 pub struct FsiOptions {
-    /// Visibility texture of Frame Sequential Interpolation (`fsi*`, seed 000 section 3.3).
+    /// Visibility texture of Frame Sequential Interpolation (`fsi*`, Scherzer & Wimmer 2008 section 3.3).
     #[arg(long, value_enum, default_value_t = VisTexture::Noise)]
     pub vis_texture: VisTexture,
     /// `fsi` only, not in the paper: `forward` uses an older fragment only if, reprojected with its own depth,
-    /// it lands within a pixel of the pixel (rejects the disocclusion ghosts of seed 000 section 4.2).
+    /// it lands within a pixel of the pixel (rejects the disocclusion ghosts of Scherzer & Wimmer 2008 section 4.2).
     #[arg(long, value_enum, default_value_t = FsiCheck::None)]
     pub fsi_check: FsiCheck,
 }

@@ -1,8 +1,8 @@
-//! `geomorph`: geomorphing between discrete LODs (seed 003 sections 10-11). A t-instance draws one mesh, the
+//! `geomorph`: geomorphing between discrete LODs (Sheliemietiev et al. 2023 sections 10-11). A t-instance draws one mesh, the
 //! finer of its two LODs, whose vertices the vertex shader moves towards their targets on the coarser LOD by the
 //! morph weight (k when coarsening, 1 - k when refining), normals interpolated and renormalised. When the
 //! transition ends the coarser LOD itself replaces the fully morphed finer one; what that swap leaves is
-//! measured by the `pop` column on those frames. Targets come from `--correspondence` (`src/morph.rs`), computed
+//! measured by the `pop` column on those frames. Targets come from `--correspondence` (`src/geometry/morph.rs`), computed
 //! once per LOD pair and cached.
 
 use super::common::{instance_raw, FrameInput, Method};

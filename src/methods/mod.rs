@@ -3,7 +3,7 @@
 //!
 //! Adding a method: a new file with a type implementing [`Method`] (and, if it has flags, an options struct
 //! flattened into [`MethodOptions`]), plus its line in [`BUILTIN`]. docs/ARCHITECTURE.md walks through it;
-//! `tests/registry.rs` does it with a throwaway method. The methods' files import `common`, never this file, so
+//! `tests/it/methods_registry.rs` does it with a throwaway method. The methods' files import `common`, never this file, so
 //! the registry can name them without an import circle.
 
 pub mod alpha;
@@ -80,14 +80,14 @@ pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "discrete", about: "discrete LOD switching: a hard switch at k = 0.5", create: |b| Ok(Box::new(discrete::Discrete::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "alpha", about: "Giegl's unpopping: one LOD opaque, the other blended over it", create: |b| Ok(Box::new(alpha::Alpha::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "alpha-2pass", about: "unpopping, double pass: each translucent LOD shows only its nearest surface", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene, alpha_2pass::Weights::Unpop))), options: no_options },
-    MethodEntry { name: "alpha-linear", about: "seed 003's alpha blending: both LODs translucent, 1 - k and k, double pass each", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene, alpha_2pass::Weights::Linear))), options: no_options },
+    MethodEntry { name: "alpha-linear", about: "Sheliemietiev et al. 2023's alpha blending: both LODs translucent, 1 - k and k, double pass each", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene, alpha_2pass::Weights::Linear))), options: no_options },
     MethodEntry { name: "alpha-zwrite", about: "Blow's unpopping: translucent with Z-writes, the compare switch", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "dither", about: "noise blending: complementary screen-space discard", create: |b| Ok(Box::new(dither::Dither::new(b.gpu, b.scene, &b.options.dither, b.seed))), options: |o| json(o.dither) },
     MethodEntry { name: "geomorph", about: "geomorphing: the finer LOD's vertices move to their targets on the coarser", create: |b| Ok(Box::new(geomorph::Geomorph::new(b.gpu, b.scene, &b.options.geomorph))), options: |o| json(o.geomorph) },
-    MethodEntry { name: "fsi", about: "Frame Sequential Interpolation (seed 000)", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::Sequential))), options: |o| json(o.fsi) },
+    MethodEntry { name: "fsi", about: "Frame Sequential Interpolation (Scherzer & Wimmer 2008)", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::Sequential))), options: |o| json(o.fsi) },
     MethodEntry { name: "fsi-noreproject", about: "FSI ablation: the older buffer read at the same pixel", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::NoReproject))), options: |o| json(o.fsi.vis_texture) },
     MethodEntry { name: "fsi-sameframe", about: "FSI ablation: both LOD buffers rendered every frame", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::SameFrame))), options: |o| json(o.fsi.vis_texture) },
-    MethodEntry { name: "blocks", about: "unified LOD (seeds 001, 004): per-block alpha-zwrite blending, seams between the blocks", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::with_seams(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "blocks", about: "unified LOD (Blow 2003a, 2003b): per-block alpha-zwrite blending, seams between the blocks", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::with_seams(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-noseams", about: "blocks without the seams (the ablation: cracks show where neighbours differ)", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-discrete", about: "blocks with seams, hard switches per block", create: |b| Ok(Box::new(discrete::Discrete::with_seams(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "clusterlod", about: "meshoptimizer's cluster DAG (Nanite-style), the per-frame cut at --pixel-error", create: |b| Ok(Box::new(clusterlod::ClusterLod::new(b.gpu, b.scene)?)), options: no_options },

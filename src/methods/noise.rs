@@ -1,4 +1,4 @@
-//! Threshold patterns for noise blending (`dither`, seed 003 section 9): values in (0, 1), tiled over the
+//! Threshold patterns for noise blending (`dither`, Sheliemietiev et al. 2023 section 9): values in (0, 1), tiled over the
 //! screen. All are deterministic; white noise is seeded by `--seed`, blue noise by a fixed seed.
 
 use crate::rng::SplitMix64;
@@ -37,7 +37,7 @@ pub fn threshold_texture(pattern: NoisePattern, seed: u64) -> Option<(u32, Vec<f
     }
 }
 
-/// `--vis-texture`: the visibility texture of FSI (seed 000 section 3.3, eq. 1). A t-instance's fragment is kept
+/// `--vis-texture`: the visibility texture of FSI (Scherzer & Wimmer 2008 section 3.3, eq. 1). A t-instance's fragment is kept
 /// where the texture's value at its object-space position is <= tau, so low values appear first while a LOD
 /// fades in and disappear last while it fades out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]

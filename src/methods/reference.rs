@@ -1,4 +1,4 @@
-//! `reference`: the high-poly baseline of seed 003 section 6: every instance at LOD0, always. The quality pass
+//! `reference`: the high-poly baseline of Sheliemietiev et al. 2023 section 6: every instance at LOD0, always. The quality pass
 //! compares every method against this.
 
 use super::common::{FrameInput, Method, OpaqueInstances};

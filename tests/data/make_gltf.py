@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes tetra.gltf and tetra.glb, the glTF fixtures of src/mesh.rs's tests (standard library only).
+"""Writes tetra.gltf and tetra.glb, the glTF fixtures of src/geometry/mesh.rs's tests (standard library only).
 
 Run from anywhere: python3 tests/data/make_gltf.py. Both files hold the same scene:
 

@@ -1,5 +1,6 @@
 //! Helpers every integration test shares: one way to build a run's or a scene's configuration from the flags a
-//! user would type, one way to run it, and one CSV reader.
+//! user would type, one way to run it (in-process or through the binary), one GPU context, one CSV reader, the
+//! sRGB transfer functions, and the regression set's run, which several files read.
 
 use clap::Parser;
 use glam::Vec3;
@@ -8,7 +9,77 @@ use lodbench::cli::{Cli, Command, RunArgs};
 use lodbench::scene::{Motion, Scene, SceneConfig, SceneDef, SceneKind};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::process::Output;
+use std::sync::{Arc, OnceLock};
+
+/// Runs the lodbench binary with ARGS and the environment variables ENV added; its output.
+pub fn lodbench(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_lodbench"));
+    c.args(args);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("lodbench runs")
+}
+
+/// Asserts failure with exactly one `error:` line mentioning every needle.
+pub fn fails_with(out: &Output, needles: &[&str]) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "expected failure, stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one line, got: {stderr}");
+    assert!(lines[0].starts_with("error:"), "{stderr}");
+    for n in needles {
+        assert!(lines[0].contains(n), "'{n}' not in: {stderr}");
+    }
+}
+
+/// The regression set (`--profile regress`, every scene and method at 96x72, with the transitions' dumps), run
+/// once per test binary into the target's temporary folder; the regression tests and the clips tests read it.
+pub fn regress_run() -> &'static PathBuf {
+    static OUT: OnceLock<PathBuf> = OnceLock::new();
+    OUT.get_or_init(|| {
+        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("regress");
+        run_into(
+            &out,
+            &[
+                "--profile",
+                "regress",
+                "--metrics",
+                "rmse,pop,de2000",
+                "--dump-frames",
+                "--dump-transitions",
+            ],
+        )
+    })
+}
+
+/// The GPU context of the tests (lavapipe on a machine without a GPU).
+pub fn gpu() -> lodbench::gpu::GpuContext {
+    lodbench::gpu::GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)")
+}
+
+/// An sRGB-encoded 8-bit channel as linear light in [0, 1] (IEC 61966-2-1).
+pub fn srgb_to_linear(c: u8) -> f64 {
+    let c = f64::from(c) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Linear light as an sRGB-encoded 8-bit channel, clamped to [0, 1] and rounded.
+pub fn linear_to_srgb8(l: f64) -> u8 {
+    let l = l.clamp(0.0, 1.0);
+    let c = if l <= 0.003_130_8 {
+        l * 12.92
+    } else {
+        1.055 * l.powf(1.0 / 2.4) - 0.055
+    };
+    (c * 255.0).round() as u8
+}
 
 /// The flags of `lodbench run ARGS`, parsed as the binary parses them.
 pub fn run_args(args: &[&str]) -> RunArgs {

@@ -1,5 +1,11 @@
-//! lodbench's integration tests, one binary (`cargo test --test it`; a module with `cargo test --test it
-//! render::`): the helpers every test shares are in `common.rs`.
+//! lodbench's integration tests, one binary (`cargo test --test it`; one file's tests with `cargo test --test it
+//! methods_fsi::`). The helpers every test shares are in `common.rs`, and only there.
+//!
+//! One rule says where a test goes (docs/ARCHITECTURE.md, "Contributing: where a test goes"): a file per folder
+//! of `src/` whose behaviour it checks, named `<folder>_<subject>.rs` (`methods_fsi.rs` checks
+//! `src/methods/fsi.rs`, `effects_taa.rs` the TAA of `src/effects/`); a test that checks every layer at once
+//! (a whole run against blessed figures or images) goes to one of the suites, and the checks of the source tree
+//! itself are named after what they read.
 
 #![allow(
     clippy::unwrap_used,
@@ -7,20 +13,31 @@
     reason = "a test fails by panicking"
 )]
 
-mod architecture;
-mod ci_profile;
-mod cli;
-mod clips;
 mod common;
-mod fidelity;
-mod fsi;
-mod lodpop;
-mod registry;
+
+// src/cli: flags, validation and the errors of bad input.
+mod cli_input;
+// src/commands: the subcommands through the binary.
+mod commands_clips;
+mod commands_experiment;
+// src/measure: the quality pass's figures.
+mod measure_lodpop;
+// src/methods: one method (or a family of variants) in images.
+mod methods_fsi;
+mod methods_registry;
+mod methods_variants;
+// src/scene: the scenes' paths and the unified scenes.
+mod scene_fidelity;
+mod scene_unified;
+// src/effects: TAA and shadows.
+mod effects_shadows;
+mod effects_taa;
+
+// The suites: whole runs against results/baseline/ and the snapshots.
+mod ci_profile;
 mod regress;
 mod render;
+
+// The source tree: the import graph of src/ and the WGSL of shaders/.
+mod architecture;
 mod shaders;
-mod shadows;
-mod sharding;
-mod taa;
-mod unified;
-mod variants;

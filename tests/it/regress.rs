@@ -16,12 +16,11 @@
 //! results/baseline/regress/). The full ci profile is a user command (`lodbench run --profile ci`) and the
 //! `ci_profile` module's ignored test.
 
-use crate::common::{read_csv, run_into, scene_config, snapshot_problem, Row};
+use crate::common::{read_csv, regress_run, scene_config, snapshot_problem, Row};
 use lodbench::measure::FrameDriver;
 use lodbench::scene::{SceneDef, SceneKind};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 /// Image figures come from exact integer sums, so on the adapter and driver the baseline was made on (recorded
 /// in `results/baseline/regress/adapter.json`) they are compared exactly: any difference is a real change. On
@@ -66,24 +65,6 @@ const BLOCK_EXACT: [&str; 6] = [
     "tri_alternation_max",
 ];
 const BLOCK_CLOSE: [&str; 3] = ["rmse_mean", "de2000_mean", "crack_px_mean"];
-
-pub(crate) fn regress_run() -> &'static PathBuf {
-    static OUT: OnceLock<PathBuf> = OnceLock::new();
-    OUT.get_or_init(|| {
-        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("regress");
-        run_into(
-            &out,
-            &[
-                "--profile",
-                "regress",
-                "--metrics",
-                "rmse,pop,de2000",
-                "--dump-frames",
-                "--dump-transitions",
-            ],
-        )
-    })
-}
 
 fn baseline_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baseline/regress")
@@ -218,7 +199,7 @@ fn column(rows: &[Row], method: &str, name: &str) -> Vec<f64> {
 /// they still read the previous frame's buffer), every method saw the same schedule, and at every transition of
 /// the path every smooth method's largest lodpop (the pop with the pose held, docs/measurement.md) is below
 /// discrete's. FSI is not exempt: its larger `pop` is its one-frame lag of the moving bunny, which lodpop
-/// leaves out and `lag_rmse` measures. `alpha-linear` (seed 003's blend) is held to what it does: both LODs
+/// leaves out and `lag_rmse` measures. `alpha-linear` (Sheliemietiev et al. 2023's blend) is held to what it does: both LODs
 /// translucent let the background through with weight k (1 - k) over the whole silhouette, so each step of k
 /// changes the picture; on the path's short transitions (3 and 6 frames at this profile) its lodpop is above
 /// discrete's (lavapipe: 0.043 against 0.028 on the first), on the long ones (11 frames) below (0.0097 against
@@ -375,7 +356,7 @@ fn mid_transition_frames_match_snapshots() {
 /// half of alpha's lodpop on those frames. The swap frames come from `lod_mean` (lod_from + k on the single bunny
 /// of bunny-sweep). The depth-compare switch itself (less-equal before the swap, less after) changes only a few
 /// pixels of this sweep: removing it leaves this test passing and moves 5 figures of the exact regression above;
-/// `variants::alpha_zwrite_keeps_equal_depth_pixels_across_the_swap` is the test that isolates it.
+/// `methods_variants::alpha_zwrite_keeps_equal_depth_pixels_across_the_swap` is the test that isolates it.
 #[test]
 fn alpha_zwrite_does_not_pop_at_the_swap() {
     let rows: Vec<Row> = read_csv(&regress_run().join("frames.csv"))

@@ -4,13 +4,12 @@ use crate::common::{col, read_csv, run_config, snapshot_problem};
 
 use indicatif::ProgressBar;
 use lodbench::commands::run;
-use lodbench::gpu::GpuContext;
 use lodbench::measure::metrics::SequenceMetrics;
 use lodbench::measure::{BlockRunner, QualityOptions};
 use lodbench::scene::SceneKind;
 use std::path::Path;
 
-/// Issue 2's "done means", on the ci profile: the three files; reference rows score 0; discrete scores 0 while
+/// The acceptance check of a run, on the ci profile: the three files; reference rows score 0; discrete scores 0 while
 /// LOD0 is shown and > 0 after the first switch; its pop peaks on switch frames.
 #[test]
 fn ci_sweep_reference_and_discrete() {
@@ -176,7 +175,7 @@ fn gpu_metrics_match_cpu_oracle() {
         "--switch-distances",
         "12,16,20",
     ]);
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let mut block = BlockRunner::new(
         &ctx,
         &scene,
@@ -247,7 +246,7 @@ fn snapshot_reference_frame() {
         "--switch-distances",
         "20,30,40",
     ]);
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let mut block =
         BlockRunner::new(&ctx, &scene, Default::default(), true, &Default::default()).unwrap();
     let mut frame0 = None;

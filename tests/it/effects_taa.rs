@@ -1,7 +1,7 @@
 //! `--taa on` on the software adapter: the resolve against a CPU model of it, and a static frame's convergence
 //! to the frame without TAA.
 
-use crate::common::{col, read_csv, run_into};
+use crate::common::{col, linear_to_srgb8, read_csv, run_into, srgb_to_linear};
 use std::path::Path;
 
 const W: u32 = 96;
@@ -44,29 +44,10 @@ fn frame(dir: &Path, f: u32) -> Vec<u8> {
         .into_raw()
 }
 
-fn to_linear(v: u8) -> f64 {
-    let c = v as f64 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-fn to_srgb8(l: f64) -> u8 {
-    let l = l.clamp(0.0, 1.0);
-    let c = if l <= 0.0031308 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
-    (c * 255.0).round() as u8
-}
-
 /// The resolve of shaders/taa.wgsl in f64: the history clamped to the current frame's 3x3 min/max, then
 /// h + alpha (c - h), in linear values; the first frame's history is the frame.
 fn resolve(history: &mut Option<Vec<f64>>, current: &[u8], alpha: f64) -> Vec<u8> {
-    let c: Vec<f64> = current.iter().map(|&v| to_linear(v)).collect();
+    let c: Vec<f64> = current.iter().map(|&v| srgb_to_linear(v)).collect();
     let h = history.get_or_insert_with(|| c.clone());
     let (w, hgt) = (W as i64, H as i64);
     for y in 0..hgt {
@@ -89,7 +70,14 @@ fn resolve(history: &mut Option<Vec<f64>>, current: &[u8], alpha: f64) -> Vec<u8
         }
     }
     h.chunks(4)
-        .flat_map(|p| [to_srgb8(p[0]), to_srgb8(p[1]), to_srgb8(p[2]), 255])
+        .flat_map(|p| {
+            [
+                linear_to_srgb8(p[0]),
+                linear_to_srgb8(p[1]),
+                linear_to_srgb8(p[2]),
+                255,
+            ]
+        })
         .collect()
 }
 

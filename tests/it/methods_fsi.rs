@@ -1,5 +1,5 @@
-//! Frame Sequential Interpolation on the software adapter (issue 4's image tests a-d). The combination pass is
-//! checked pixel by pixel against a CPU implementation of seed 000 sections 3.4-3.5 and eq. 2 that reads the
+//! Frame Sequential Interpolation on the software adapter (image tests a-f). The combination pass is
+//! checked pixel by pixel against a CPU implementation of Scherzer & Wimmer 2008 sections 3.4-3.5 and eq. 2 that reads the
 //! same two LOD buffers (colour, depth, id) back from the GPU.
 
 use glam::{Mat4, Vec4};
@@ -11,7 +11,7 @@ use lodbench::methods::fsi::{reprojection, Fsi, FsiCheck, LodBufferImage, Varian
 use lodbench::methods::{Method, MethodOptions};
 use lodbench::scene::{Scene, SceneDef, SceneKind};
 
-use crate::common::{near_distance, scene_config as scene_cfg, static_scene, H, W};
+use crate::common::{near_distance, scene_config as scene_cfg, srgb_to_linear, static_scene, H, W};
 
 struct Frame {
     out: Vec<u8>,
@@ -77,22 +77,13 @@ fn render_fsi_checked(
     }
 }
 
-fn srgb_to_linear(c: u8) -> f32 {
-    let c = c as f32 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-fn linear_to_srgb(c: f32) -> f32 {
+fn linear_to_srgb(c: f64) -> f32 {
     let s = if c <= 0.003_130_8 {
         c * 12.92
     } else {
         1.055 * c.powf(1.0 / 2.4) - 0.055
     };
-    s * 255.0
+    (s * 255.0) as f32
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -283,7 +274,7 @@ fn is_background(c: &[u8]) -> bool {
 /// reads), are bit-identical to `discrete`, with a moving camera too.
 #[test]
 fn a_no_transition_frames_match_discrete_bit_for_bit() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     for camera in ["fixed", "orbit"] {
         let cfg = scene_cfg(
             "bunny-sweep",
@@ -340,7 +331,7 @@ fn a_no_transition_frames_match_discrete_bit_for_bit() {
 /// LOD1), to 1/255.
 #[test]
 fn b_half_way_is_a_cross_dissolve() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let d = near_distance();
     let scene = static_scene(&[d], [d, d * 1.5, d * 2.0], 3, "fixed");
     let fr = render_fsi(&ctx, &scene, Variant::Sequential, 2);
@@ -375,7 +366,7 @@ fn b_half_way_is_a_cross_dissolve() {
 /// steady at LOD3.
 #[test]
 fn c_t_instance_in_front_wins_by_depth() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let d = near_distance();
     // Band 0.05: k = 0.25 at d = s (1 - 0.05 / 2).
     let s0 = d / (1.0 - 0.025);
@@ -415,7 +406,7 @@ fn c_t_instance_in_front_wins_by_depth() {
 /// the reprojection really moves lookups.
 #[test]
 fn d_reprojection_follows_equation_2() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let d = near_distance();
     let scene = static_scene(&[d], [d, d * 1.5, d * 2.0], 40, "orbit");
     // Frame 31: the eye moves about half a degree per frame around the bunny.
@@ -450,7 +441,7 @@ fn d_reprojection_follows_equation_2() {
 /// now 1,219 of 1,689 (the test asks 2/3).
 #[test]
 fn f_forward_check_finds_the_fragment_that_moved_here() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let d = near_distance();
     let s0 = d / (1.0 - 0.025);
     // Instance 0 (the orbit's centre) far at LOD3, instance 1 near, in the band of the first switch.
@@ -501,7 +492,7 @@ fn f_forward_check_finds_the_fragment_that_moved_here() {
 /// paper's 2 % between consecutive frames. Starting them all at the same phase would change it by ~50 %.
 #[test]
 fn e_static_transitions_toggle_out_of_phase() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     // All on the near side of their switch (k < 0.5): each starts with its finer LOD, so in step they would all
     // drop to the coarser one on the same frame.
     let distances = [9.6, 9.7, 9.8, 9.9, 19.4, 19.7, 38.5, 39.4];

@@ -46,7 +46,7 @@ fn shadow_map(
 /// the LOD it shows), and half way it is neither; the two LODs' maps differ, so the test can tell them apart.
 #[test]
 fn follow_shadow_at_k_0_and_1_is_discretes() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let cfg = scene_config(
         "bunny-sweep",
         &[

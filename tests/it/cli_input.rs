@@ -1,29 +1,8 @@
 //! Bad input ends in one clear `error:` line and a non-zero exit, never a panic.
 
+use crate::common::{fails_with, lodbench};
 use std::path::Path;
-use std::process::{Command, Output};
-
-pub(crate) fn lodbench(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_lodbench"));
-    c.args(args);
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    c.output().expect("lodbench runs")
-}
-
-/// Asserts failure with exactly one `error:` line mentioning every needle.
-pub(crate) fn fails_with(out: &Output, needles: &[&str]) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "expected failure, stderr: {stderr}");
-    assert!(!stderr.contains("panicked"), "panic: {stderr}");
-    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "expected one line, got: {stderr}");
-    assert!(lines[0].starts_with("error:"), "{stderr}");
-    for n in needles {
-        assert!(lines[0].contains(n), "'{n}' not in: {stderr}");
-    }
-}
+use std::process::Command;
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
     let p = dir.join(name);

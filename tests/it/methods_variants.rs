@@ -2,7 +2,7 @@
 //! (LOD0 red, LOD1 green), rendered at a fixed k in the middle of a transition and compared pixel by pixel with
 //! the same bunny drawn steadily at each of the two LODs.
 
-use crate::common::{near_distance, render_frame, static_scene};
+use crate::common::{linear_to_srgb8, near_distance, render_frame, srgb_to_linear, static_scene};
 use lodbench::gpu::GpuContext;
 use lodbench::scene::Scene;
 
@@ -31,7 +31,7 @@ fn pixels(img: &[u8]) -> impl Iterator<Item = &[u8]> {
 /// Blending (alpha) fails the first part, a one-sided discard the second.
 #[test]
 fn dither_takes_each_pixel_from_exactly_one_lod() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let d = near_distance();
     let (mid, lod0, lod1) = scenes(d, d);
     let (m, f, t) = (
@@ -71,16 +71,6 @@ fn dither_takes_each_pixel_from_exactly_one_lod() {
     assert!(mixed > 100, "alpha mixed only {mixed} pixels");
 }
 
-/// Linear value of an sRGB-encoded byte.
-fn linear(b: u8) -> f32 {
-    let v = b as f32 / 255.0;
-    if v <= 0.04045 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// alpha-2pass: the translucent LOD shows only its nearest surface, once. Between LOD2 and LOD3 at k = 0.75 the
 /// coarse LOD3 is opaque and LOD2 is drawn over it with alpha 0.5. Where LOD2 covers a pixel, the frame must be
 /// either LOD3's pixel (LOD2's nearest surface lies behind LOD3's there) or one 50/50 mix of the two LODs'
@@ -91,7 +81,7 @@ fn linear(b: u8) -> f32 {
 /// and at least 0.5 % for alpha, so it fails if alpha-2pass degrades into alpha.
 #[test]
 fn alpha_2pass_blends_only_the_nearest_surface() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let d = near_distance();
     // LOD3 beyond the third switch s; k = (d - 0.95 s) / (0.1 s) = 0.75 at s = d / 1.025.
     let scene = |s: f32| static_scene(&[d], [0.3 * d, 0.6 * d, s], 2, "fixed");
@@ -112,15 +102,7 @@ fn alpha_2pass_blends_only_the_nearest_surface() {
             covered += 1;
             let near = |x: &[u8]| (0..3).all(|c| p[c].abs_diff(x[c]) <= 2);
             let mix: Vec<u8> = (0..3)
-                .map(|c| {
-                    let l = 0.5 * linear(a[c]) + 0.5 * linear(b[c]);
-                    let s = if l <= 0.0031308 {
-                        l * 12.92
-                    } else {
-                        1.055 * l.powf(1.0 / 2.4) - 0.055
-                    };
-                    (s * 255.0).round() as u8
-                })
+                .map(|c| linear_to_srgb8(0.5 * srgb_to_linear(a[c]) + 0.5 * srgb_to_linear(b[c])))
                 .collect();
             other += (!near(a) && !near(&mix)) as usize;
         }
@@ -160,7 +142,7 @@ fn flips(a: &[u8], b: &[u8]) -> usize {
 /// so the test fails when the switch goes.
 #[test]
 fn alpha_zwrite_keeps_equal_depth_pixels_across_the_swap() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let d = near_distance();
     // k = (d - 0.95 s) / (0.1 s) at switch distance s: s = d / (0.95 + 0.1 k).
     let at = |k: f32| static_scene(&[d], [d / (0.95 + 0.1 * k), 3.0 * d, 4.0 * d], 2, "fixed");
@@ -181,17 +163,7 @@ fn alpha_zwrite_keeps_equal_depth_pixels_across_the_swap() {
     );
 }
 
-/// sRGB encoding of a linear value, as the 8-bit target stores it.
-fn encode(l: f32) -> u8 {
-    let s = if l <= 0.0031308 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
-    (s.clamp(0.0, 1.0) * 255.0).round() as u8
-}
-
-/// alpha-linear is seed 003's eq. 2 with its double pass: during a transition both LODs are translucent, the
+/// alpha-linear is Sheliemietiev et al. 2023's eq. 2 with its double pass: during a transition both LODs are translucent, the
 /// outgoing LOD0 drawn over the frame with weight 1 - k, then the incoming LOD1 over that with weight k. So every
 /// pixel of the frame at k is `k L1 + (1 - k) (k BG + (1 - k) L0)` in linear light, L0 and L1 the pixel of the
 /// steady LOD0 and LOD1 frames (the background where a LOD does not cover it) and BG the background, with the
@@ -202,7 +174,7 @@ fn encode(l: f32) -> u8 {
 /// test fails when alpha-linear degrades into Giegl's schedule.
 #[test]
 fn alpha_linear_blends_both_lods_with_weights_one_minus_k_and_k() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let d = near_distance();
     let (_, lod0, lod1) = scenes(d, d);
     let (f, t) = (
@@ -216,8 +188,11 @@ fn alpha_linear_blends_both_lods_with_weights_one_minus_k_and_k() {
         for ((p, a), b) in pixels(m).zip(pixels(&f)).zip(pixels(&t)) {
             both += (a != bg.as_slice() && b != bg.as_slice()) as usize;
             let bad = (0..3).any(|c| {
-                let first = encode((1.0 - k) * linear(a[c]) + k * linear(bg[c]));
-                let want = encode(k * linear(b[c]) + (1.0 - k) * linear(first));
+                let k = f64::from(k);
+                let first =
+                    linear_to_srgb8((1.0 - k) * srgb_to_linear(a[c]) + k * srgb_to_linear(bg[c]));
+                let want =
+                    linear_to_srgb8(k * srgb_to_linear(b[c]) + (1.0 - k) * srgb_to_linear(first));
                 p[c].abs_diff(want) > 1
             });
             off += bad as usize;
@@ -240,6 +215,6 @@ fn alpha_linear_blends_both_lods_with_weights_one_minus_k_and_k() {
     let (bad, both) = off(&giegl, 0.5);
     assert!(
         bad * 2 > both,
-        "alpha-2pass matches seed 003's linear blend on all but {bad} of {both} pixels: the check cannot tell them apart"
+        "alpha-2pass matches Sheliemietiev et al. 2023's linear blend on all but {bad} of {both} pixels: the check cannot tell them apart"
     );
 }

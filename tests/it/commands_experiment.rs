@@ -1,16 +1,9 @@
 //! `lodbench experiment --shard i/n`, `lodbench merge` and `lodbench experiment --resume`, through the binary
 //! on the software adapter: a small bunny-sweep experiment of four runs (a `band` sweep).
 
-use crate::common::{read_csv, Rows};
+use crate::common::{lodbench, read_csv, Rows};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn lodbench(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lodbench"))
-        .args(args)
-        .output()
-        .expect("lodbench runs")
-}
 
 fn ok(out: Output) -> Output {
     assert!(
@@ -73,13 +66,10 @@ fn s(p: &Path) -> &str {
 fn three_shards_merged_equal_one_unsharded_run() {
     let dir = tempfile::tempdir().unwrap();
     let file = experiment_file(dir.path(), 24);
-    let list = ok(lodbench(&[
-        "experiment",
-        s(&file),
-        "--list",
-        "--shard",
-        "1/3",
-    ]));
+    let list = ok(lodbench(
+        &["experiment", s(&file), "--list", "--shard", "1/3"],
+        &[],
+    ));
     let text = String::from_utf8_lossy(&list.stdout);
     for (value, shard) in [("0.02", 1), ("0.05", 2), ("0.1", 3), ("0.15", 1)] {
         assert!(
@@ -88,18 +78,21 @@ fn three_shards_merged_equal_one_unsharded_run() {
         );
     }
     let whole = dir.path().join("whole");
-    ok(lodbench(&["experiment", s(&file), "--out", s(&whole)]));
+    ok(lodbench(&["experiment", s(&file), "--out", s(&whole)], &[]));
     let mut shards = Vec::new();
     for i in 1..=3 {
         let out = dir.path().join(format!("shard-{i}"));
-        ok(lodbench(&[
-            "experiment",
-            s(&file),
-            "--shard",
-            &format!("{i}/3"),
-            "--out",
-            s(&out),
-        ]));
+        ok(lodbench(
+            &[
+                "experiment",
+                s(&file),
+                "--shard",
+                &format!("{i}/3"),
+                "--out",
+                s(&out),
+            ],
+            &[],
+        ));
         shards.push(out);
     }
     assert!(shards[0].join("runs/band=0.15/run.json").is_file());
@@ -108,7 +101,7 @@ fn three_shards_merged_equal_one_unsharded_run() {
     let mut args = vec!["merge"];
     args.extend(shards.iter().map(|p| s(p)));
     args.extend(["--out", s(&merged)]);
-    ok(lodbench(&args));
+    ok(lodbench(&args, &[]));
     for file in ["frames.csv", "summary.csv"] {
         let (a, b) = (read_csv(&whole.join(file)), read_csv(&merged.join(file)));
         assert_eq!(a.len(), b.len(), "{file}");
@@ -136,29 +129,32 @@ fn merge_refuses_what_does_not_fit() {
     let file = experiment_file(dir.path(), 12);
     let shard = |i: u32| {
         let out = dir.path().join(format!("shard-{i}"));
-        ok(lodbench(&[
-            "experiment",
-            s(&file),
-            "--shard",
-            &format!("{i}/2"),
-            "--out",
-            s(&out),
-        ]));
+        ok(lodbench(
+            &[
+                "experiment",
+                s(&file),
+                "--shard",
+                &format!("{i}/2"),
+                "--out",
+                s(&out),
+            ],
+            &[],
+        ));
         out
     };
     let (a, b) = (shard(1), shard(2));
     let out = dir.path().join("merged");
-    let e = failure(lodbench(&["merge", s(&a), s(&a), s(&b), "--out", s(&out)]));
+    let e = failure(lodbench(
+        &["merge", s(&a), s(&a), s(&b), "--out", s(&out)],
+        &[],
+    ));
     assert!(e.contains("band=0.02") && e.contains("duplicate"), "{e}");
-    let e = failure(lodbench(&["merge", s(&a), "--out", s(&out)]));
+    let e = failure(lodbench(&["merge", s(&a), "--out", s(&out)], &[]));
     assert!(e.contains("missing: band=0.05, band=0.15"), "{e}");
-    let partial = ok(lodbench(&[
-        "merge",
-        s(&a),
-        "--out",
-        s(&out),
-        "--allow-partial",
-    ]));
+    let partial = ok(lodbench(
+        &["merge", s(&a), "--out", s(&out), "--allow-partial"],
+        &[],
+    ));
     let note = String::from_utf8_lossy(&partial.stderr);
     assert!(note.contains("left out band=0.05: missing"), "{note}");
     assert_eq!(
@@ -187,10 +183,16 @@ fn merge_refuses_what_does_not_fit() {
         "lodbench_version",
         "9.9.9",
     );
-    let e = failure(lodbench(&["merge", s(&a), s(&other), "--out", s(&out)]));
+    let e = failure(lodbench(
+        &["merge", s(&a), s(&other), "--out", s(&out)],
+        &[],
+    ));
     assert!(e.contains("9.9.9") && e.contains("one version"), "{e}");
     let failed = edit(&b, "failed", "band=0.15", "status", "failed");
-    let e = failure(lodbench(&["merge", s(&a), s(&failed), "--out", s(&out)]));
+    let e = failure(lodbench(
+        &["merge", s(&a), s(&failed), "--out", s(&out)],
+        &[],
+    ));
     assert!(
         e.contains("not complete: band=0.15") && e.contains("failed"),
         "{e}"
@@ -202,7 +204,10 @@ fn merge_refuses_what_does_not_fit() {
         .unwrap()
         .replace("\"shards\"", "\"other\"");
     std::fs::write(&p, text).unwrap();
-    let e = failure(lodbench(&["merge", s(&a), s(&renamed), "--out", s(&out)]));
+    let e = failure(lodbench(
+        &["merge", s(&a), s(&renamed), "--out", s(&out)],
+        &[],
+    ));
     assert!(
         e.contains("another experiment") && e.contains("name"),
         "{e}"
@@ -236,17 +241,18 @@ fn resume_after_sigterm_ends_like_an_uninterrupted_run() {
         .spawn()
         .unwrap();
     let first = out.join("runs/band=0.02/run.json");
-    let started = std::time::Instant::now();
+    // Wait for the first run to complete, without a clock: an experiment that ends first fails the test.
     loop {
         let done =
             std::fs::read_to_string(&first).is_ok_and(|t| t.contains("\"status\": \"complete\""));
         if done {
             break;
         }
-        assert!(
-            started.elapsed().as_secs() < 120,
-            "the first run did not complete"
-        );
+        if let Some(status) = child.try_wait().unwrap() {
+            let mut err = String::new();
+            std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+            panic!("the experiment ended ({status}) before its first run completed: {err}");
+        }
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
     let pid = child.id().to_string();
@@ -261,13 +267,10 @@ fn resume_after_sigterm_ends_like_an_uninterrupted_run() {
     assert!(!second.contains("\"status\": \"complete\""), "{second}");
     assert!(!out.join("frames.csv").exists());
 
-    let resumed = ok(lodbench(&[
-        "experiment",
-        s(&file),
-        "--out",
-        s(&out),
-        "--resume",
-    ]));
+    let resumed = ok(lodbench(
+        &["experiment", s(&file), "--out", s(&out), "--resume"],
+        &[],
+    ));
     let note = String::from_utf8_lossy(&resumed.stderr);
     assert!(
         note.contains("band=0.02: complete, skipped (--resume)"),
@@ -275,7 +278,7 @@ fn resume_after_sigterm_ends_like_an_uninterrupted_run() {
     );
     assert!(!note.contains("band=0.05: complete"), "{note}");
     let whole = dir.path().join("whole");
-    ok(lodbench(&["experiment", s(&file), "--out", s(&whole)]));
+    ok(lodbench(&["experiment", s(&file), "--out", s(&whole)], &[]));
     assert_eq!(
         deterministic(&read_csv(&out.join("frames.csv"))),
         deterministic(&read_csv(&whole.join("frames.csv")))
@@ -302,7 +305,7 @@ fn the_parallel_recipe_merges_to_the_unsharded_run() {
         String::from_utf8_lossy(&run.stderr)
     );
     let whole = dir.path().join("whole");
-    ok(lodbench(&["experiment", s(&file), "--out", s(&whole)]));
+    ok(lodbench(&["experiment", s(&file), "--out", s(&whole)], &[]));
     assert_eq!(
         deterministic(&read_csv(&out.join("merged/frames.csv"))),
         deterministic(&read_csv(&whole.join("frames.csv")))

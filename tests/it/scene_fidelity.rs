@@ -4,15 +4,13 @@
 use crate::common::{
     read_csv, render_frame, run_into, scene_config, static_scene, subdivided_bunny_obj,
 };
-use lodbench::gpu::GpuContext;
 use lodbench::scene::{SceneDef, SceneKind, NOT_REACHED};
 
 /// The bunny split to 14,696 triangles with a scan's fine noise: its LODs lose so little that the switch to
-/// LOD1 lies nearer than where the whole bunny fits the view (the case of issue 19, a 27,864-triangle scan).
+/// LOD1 lies nearer than where the whole bunny fits the view (as for a 27,864-triangle scan).
 /// The sweep must start outside the model, say which switch it never reaches, and FSI's first transition
-/// (LOD1 to LOD2) must stay within twice discrete's largest rmse. Before: the sweep started inside the bounding
-/// sphere and FSI showed background for the bunny's inside on that transition (rmse 0.18 against discrete's
-/// 0.026). At 160x120 and the quick profile's 600 frames fsi's is 1.4 times discrete's (lavapipe: 0.0177 against 0.0126); with
+/// (LOD1 to LOD2) must stay within twice discrete's largest rmse. Started inside the bounding sphere, FSI would
+/// show background for the bunny's inside on that transition. At 160x120 and the quick profile's 600 frames fsi's is 1.4 times discrete's (lavapipe: 0.0177 against 0.0126); with
 /// fewer frames the bunny moves faster and FSI's one-frame lag of the moving bunny grows.
 #[test]
 fn dense_mesh_sweep_starts_outside_the_model() {
@@ -77,7 +75,7 @@ fn dense_mesh_sweep_starts_outside_the_model() {
 /// back faces culled (FSI's earlier choice) nearly all of them were.
 #[test]
 fn fsi_t_instances_show_the_inside_like_the_reference() {
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let probe = static_scene(&[1.0], [1.0, 2.0, 3.0], 3, "fixed");
     let d = probe.models[0].radius * 0.02;
     let mut scene = static_scene(&[d], [d, 2.0 * d, 3.0 * d], 3, "fixed");

@@ -1,9 +1,9 @@
-//! The unified-LOD scenes on the software adapter: seed 004 Fig. 1 (bunny-halves), whose seam must keep the
+//! The unified-LOD scenes on the software adapter: Blow 2003b Fig. 1 (bunny-halves), whose seam must keep the
 //! cut closed where the two halves show different LODs, and the terrain's methods side by side.
 
 use crate::common::{read_csv, run_into, scene_config};
 use indicatif::ProgressBar;
-use lodbench::gpu::{GpuContext, SceneGpu};
+use lodbench::gpu::SceneGpu;
 use lodbench::measure::metrics::SequenceMetrics;
 use lodbench::measure::{BlockRunner, QualityOptions};
 use lodbench::scene::{SceneDef, SceneKind};
@@ -25,7 +25,7 @@ fn bunny_halves_seam_leaves_no_crack_and_its_ablation_does() {
     .unwrap()
     .instantiate(1);
     assert_eq!(scene.instances.len(), 2);
-    let ctx = GpuContext::new(None).expect("an adapter (install mesa-vulkan-drivers)");
+    let ctx = crate::common::gpu();
     let background = SceneGpu::new(&ctx, &scene)
         .unwrap()
         .background_bytes(&ctx)
