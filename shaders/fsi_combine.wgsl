@@ -1,4 +1,4 @@
-// FSI combination pass (seed 000 sections 3.4-3.5), a compute pass over the pixels (a full-screen-triangle
+// FSI combination pass (Scherzer & Wimmer 2008 sections 3.4-3.5), a compute pass over the pixels (a full-screen-triangle
 // render pass was recompiled by llvmpipe on every draw, costing milliseconds and ~1 MB of memory per frame). The newer LOD buffer is read at
 // the pixel; the older one through reprojection by eq. 2, p_old = P_old V_old V_new^-1 P_new^-1 p_new, using
 // the newer buffer's stored depth (or at the same pixel when `mode` = 1, the `fsi-noreproject` ablation).

@@ -6,7 +6,7 @@
 // Per-vertex `aux` = (u, v, kind, hub_y) (src/mesh.rs): kind 1 and 2 are alpha-tested leaf cards (masks over
 // (u, v) below), kind 3 a windmill blade vertex, rotated about the axis parallel to +z through (0, hub_y) by the
 // instance's animation angle. Animation happens after the object-space position is taken (`object`), which is
-// what FSI's visibility texture reads (seed 000 section 3.3, Fig. 5).
+// what FSI's visibility texture reads (Scherzer & Wimmer 2008 section 3.3, Fig. 5).
 
 // Set per scene when its models have alpha-tested geometry (every fragment entry then applies the mask), so
 // scenes without it keep shaders with no discard.
@@ -122,7 +122,7 @@ fn masked(in: VsOut) -> bool {
     return false;
 }
 
-// Geomorphing (seed 003 sections 10-11): each vertex of the finer LOD moves towards its target on the coarser
+// Geomorphing (Sheliemietiev et al. 2023 sections 10-11): each vertex of the finer LOD moves towards its target on the coarser
 // LOD by the morph weight params.x; the normal is interpolated and renormalised.
 struct MorphIn {
     @location(8) target_position: vec3<f32>,
@@ -235,7 +235,7 @@ fn fs_translucent_occluded(in: VsOut, @builtin(front_facing) front: bool) -> @lo
     return vec4<f32>(shade(in, front), in.params.y);
 }
 
-// Noise blending (seed 003 section 9, eq. 3): a pixel of a t-instance keeps the incoming LOD where
+// Noise blending (Sheliemietiev et al. 2023 section 9, eq. 3): a pixel of a t-instance keeps the incoming LOD where
 // k > noise(x, y) and the outgoing LOD elsewhere. params.x = k; params.y = role: 1 incoming, 0 outgoing.
 struct NoiseParams {
     // Side of the tiled threshold texture; 0 = interleaved gradient noise computed here.
@@ -268,7 +268,7 @@ fn fs_dither(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4
     return vec4<f32>(shade(in, front), 1.0);
 }
 
-// Frame Sequential Interpolation (seed 000 sections 3.2-3.5): the scene is drawn into a LOD buffer of colour,
+// Frame Sequential Interpolation (Scherzer & Wimmer 2008 sections 3.2-3.5): the scene is drawn into a LOD buffer of colour,
 // depth and instance id. n-instances write id 0; a t-instance writes its own id (params.w) and keeps a fragment
 // only where visTex(p) <= tau (eq. 1: discard where visTex(p) > tau), p the object-space position before
 // animation, the texture read at (p.x + p.z, p.y + p.z) * params.x (params.x = texture repeats per object-space

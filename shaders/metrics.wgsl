@@ -1,5 +1,5 @@
 // Per-frame image metrics on the GPU, reduced to exact integer sums so the CPU oracle (src/metrics.rs) can be
-// matched to 1e-5 (seed 003 section 6 steps 5-6 for rmse; lodbench's temporal popping score for pop).
+// matched to 1e-5 (Sheliemietiev et al. 2023 section 6 steps 5-6 for rmse; lodbench's temporal popping score for pop).
 //
 // Both images are read through Rgba8Unorm views of the sRGB targets, i.e. as the stored sRGB-encoded bytes.
 // (Reading storage-buffer copies of the two frames instead measured no faster on lavapipe: docs/findings/timing.md.)
