@@ -202,10 +202,7 @@ pub fn reference_ms_per_frame(timed: &[TimedMethod<'_>]) -> Option<f64> {
         .map(TimedMethod::ms_per_frame)
 }
 
-/// Whether a run's label names the reference (`reference`, `reference#2`, ...).
-pub fn is_reference(label: &str) -> bool {
-    crate::methods::base_name(label) == "reference"
-}
+pub use crate::methods::is_reference;
 
 /// The frames every method renders untimed before the rounds: the first `warmup` frames of the path (wrapping),
 /// then the first frame of each distinct transition of the path (`lod_from -> lod_to` pair) and the two frames
