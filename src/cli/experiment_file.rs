@@ -249,7 +249,12 @@ impl Experiment {
 }
 
 /// Applies `--set KEY=VALUE` (`o`) to the file's `[run]` table.
-fn apply_override(source: &Source, file: &mut ExperimentFile, keys: &[String], o: &str) -> Result<()> {
+fn apply_override(
+    source: &Source,
+    file: &mut ExperimentFile,
+    keys: &[String],
+    o: &str,
+) -> Result<()> {
     let Some((key, value)) = o.split_once('=') else {
         return Err(source.bad(format!("--set {o}: expected KEY=VALUE")));
     };
@@ -315,9 +320,9 @@ fn variants(
         if var == VIEWPORT {
             let pair = v.as_array().filter(|a| a.len() == 2);
             let Some(pair) = pair else {
-                return Err(source.bad(format!(
-                    "[sweep] viewport value {v} is not [width, height]"
-                )));
+                return Err(
+                    source.bad(format!("[sweep] viewport value {v} is not [width, height]"))
+                );
             };
             table.insert("width".into(), pair[0].clone());
             table.insert("height".into(), pair[1].clone());

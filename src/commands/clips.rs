@@ -20,6 +20,7 @@
 //! The folder is built as `clips.partial/` and renamed to `clips/` only when every clip is written, so a
 //! folder named `clips/` is always complete.
 
+use crate::cli::ClipsArgs;
 use crate::error::{Error, Result};
 use crate::measure::records::TransitionRecord;
 use crate::methods::is_reference;
@@ -76,6 +77,48 @@ impl Default for ClipSettings {
             mp4: Mp4::Auto,
         }
     }
+}
+
+impl ClipSettings {
+    /// The settings `lodbench clips` was given.
+    pub fn from_args(args: &ClipsArgs) -> ClipSettings {
+        ClipSettings {
+            methods: args.methods.clone(),
+            columns: args.columns,
+            scale: args.scale,
+            fps: args.fps,
+            max_frames: args.max_frames,
+            transitions: args.transitions.clone(),
+            full_frame: args.full_frame,
+            gif: args.gif,
+            mp4: args.mp4,
+        }
+    }
+}
+
+/// `lodbench clips`: makes the clips and prints each with its frames and files.
+pub fn execute(args: &ClipsArgs) -> Result<()> {
+    let index = make(&args.dir, &ClipSettings::from_args(args))?;
+    for c in &index.clips {
+        outln!(
+            "{}: {} frames ({}-{}), {}{}",
+            c.name,
+            c.frames.len(),
+            c.frames.first().copied().unwrap_or_default(),
+            c.frames.last().copied().unwrap_or_default(),
+            c.apng,
+            [&c.gif, &c.mp4]
+                .iter()
+                .filter_map(|f| f.as_ref().map(|f| format!(", {f}")))
+                .collect::<String>()
+        );
+    }
+    outln!(
+        "{} clips in {}",
+        index.clips.len(),
+        args.dir.join(CLIPS_DIR).display()
+    );
+    Ok(())
 }
 
 /// Pictures lower than this are upscaled (by default) until they are at least this high.
@@ -516,7 +559,12 @@ impl ClipJob<'_> {
     }
 
     /// Frame `f`'s pictures and heat-maps (made from the pictures where the run dumped none), all one size.
-    fn load_frame(&self, t: &TransitionRecord, methods: &[String], f: u32) -> Result<FramePictures> {
+    fn load_frame(
+        &self,
+        t: &TransitionRecord,
+        methods: &[String],
+        f: u32,
+    ) -> Result<FramePictures> {
         let mut pictures = vec![load(&self.dump(t, &methods[0], f, DumpKind::Reference))?];
         let mut errors = Vec::new();
         for m in methods {
@@ -588,7 +636,11 @@ impl ClipJob<'_> {
             let frame_grid = grid(
                 &format!("{header}  [frame]"),
                 &entry.methods,
-                &frame.pictures.iter().map(|p| view.of(p)).collect::<Vec<_>>(),
+                &frame
+                    .pictures
+                    .iter()
+                    .map(|p| view.of(p))
+                    .collect::<Vec<_>>(),
                 self.settings.columns,
             );
             // The same layout: the two headers are as long.

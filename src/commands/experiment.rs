@@ -2,6 +2,7 @@
 //! and validates it) into one results folder, with a column per swept variable.
 
 use crate::cli::config::RunConfig;
+use crate::cli::ExperimentArgs;
 use crate::error::Result;
 use crate::results::files::{FRAMES_CSV, RUN_JSON, SUMMARY_CSV};
 use crate::results::manifest::{read_json, ExperimentRecord, RunManifestRecord, RunStatus};
@@ -17,6 +18,68 @@ pub struct RunOptions {
     pub shard: Option<Shard>,
     /// Skip the runs whose run.json says complete with the planned configuration.
     pub resume: bool,
+}
+
+/// `lodbench experiment`: loads the file with its `--set`s, prints the plan, and with `--check` or `--list`
+/// stops there, else runs this shard's runs into the folder.
+pub fn execute(args: &ExperimentArgs) -> Result<()> {
+    let mut e = Experiment::load_with(&args.file, &args.set)?;
+    if let Some(a) = &args.adapter {
+        for r in &mut e.runs {
+            r.config.adapter = Some(a.clone());
+        }
+    }
+    outln!(
+        "experiment {} ({} run{}{}): {}",
+        e.name,
+        e.runs.len(),
+        if e.runs.len() == 1 { "" } else { "s" },
+        e.variable
+            .as_deref()
+            .map_or(String::new(), |v| format!(", sweeping {v}")),
+        e.description
+    );
+    let shard = args.shard.as_deref().map(Shard::parse).transpose()?;
+    if args.check || args.list {
+        print_plan(&e, shard, args.list);
+        return Ok(());
+    }
+    crate::commands::run::stop_on_signal();
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| crate::commands::run::default_out_dir(&[e.name.as_str()]));
+    let options = RunOptions {
+        shard,
+        resume: args.resume,
+    };
+    let folders = e.run_with(&out, &options)?;
+    outln!("{} run(s) in {}", folders.len(), out.display());
+    Ok(())
+}
+
+/// `--check` and `--list`: a line per planned run (with `list`, its shard among `shard`'s count) with each
+/// scene's methods.
+fn print_plan(e: &Experiment, shard: Option<Shard>, list: bool) {
+    let n = shard.map_or(1, |s| s.count);
+    for (k, r) in e.runs.iter().enumerate() {
+        let part = if list {
+            format!(" shard {}/{n}", k % n as usize + 1)
+        } else {
+            String::new()
+        };
+        let per_scene: Vec<String> = r
+            .config
+            .scenes
+            .iter()
+            .map(|&k| format!("{}: {}", k.name(), r.config.methods_for(k).join(", ")))
+            .collect();
+        outln!(
+            "  {}{part} {}",
+            r.value.as_deref().unwrap_or("-"),
+            per_scene.join("; ")
+        );
+    }
 }
 
 impl Experiment {
@@ -78,8 +141,7 @@ impl Experiment {
 /// Whether `folder` holds a complete run of `cfg`: its run.json says `complete` and records the same
 /// configuration.
 fn completed(folder: &Path, cfg: &RunConfig) -> bool {
-    let Ok(Ok(run)) = read_json::<RunManifestRecord>(&folder.join(RUN_JSON))
-    else {
+    let Ok(Ok(run)) = read_json::<RunManifestRecord>(&folder.join(RUN_JSON)) else {
         return false;
     };
     // Compared as written: an f32 flag reads back from its text as another f64 than it converts to.

@@ -16,6 +16,7 @@
 //! and `experiment.json` with `merged_from`. Nothing is averaged: runs on different adapters stay apart by the
 //! `adapter` column.
 
+use crate::cli::MergeArgs;
 use crate::commands::experiment::{concat_csv, CsvPart};
 use crate::error::{Error, Result};
 use crate::results::files::{
@@ -104,6 +105,16 @@ impl Census {
     }
 }
 
+/// `lodbench merge`: merges, notes what was left out, prints how many runs went where.
+pub fn execute(args: &MergeArgs) -> Result<()> {
+    let m = merge(&args.dirs, &args.out, args.allow_partial)?;
+    for l in &m.left_out {
+        eprintln!("note: left out {l}");
+    }
+    outln!("{} run(s) merged into {}", m.runs, args.out.display());
+    Ok(())
+}
+
 /// Merges the experiment folders `inputs` into `out`; see the module docs.
 pub fn merge(inputs: &[PathBuf], out: &Path, allow_partial: bool) -> Result<MergeSummary> {
     if inputs.is_empty() {
@@ -173,7 +184,14 @@ fn check_one_experiment(inputs: &[PathBuf], experiments: &[Record]) -> Result<()
     let first_runs = comparable(&first.runs);
     for (dir, e) in inputs.iter().zip(experiments).skip(1) {
         let differs = if e.name != first.name {
-            Some(("name", format!(" ({} against {})", json_text(&e.name), json_text(&first.name))))
+            Some((
+                "name",
+                format!(
+                    " ({} against {})",
+                    json_text(&e.name),
+                    json_text(&first.name)
+                ),
+            ))
         } else if e.variable != first.variable {
             Some(("variable", String::new()))
         } else if comparable(&e.runs) != first_runs {
@@ -205,7 +223,8 @@ fn find_runs(inputs: &[PathBuf], plan: &Plan<'_>) -> Result<Census> {
             if !run_json.is_file() {
                 continue;
             }
-            let run: RunManifestRecord = read_json(&run_json)?.map_err(|e| not_json(&run_json, e))?;
+            let run: RunManifestRecord =
+                read_json(&run_json)?.map_err(|e| not_json(&run_json, e))?;
             if run.status != Some(RunStatus::Complete) {
                 census.not_complete.push(format!(
                     "{} in {}: {}",

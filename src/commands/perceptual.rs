@@ -6,6 +6,7 @@
 //! authors against the PyTorch reference to 3e-6 JOD). It reads only the PNGs, not lodbench's numbers, and
 //! writes `perceptual.csv` beside them with each transition's lodpop for comparison.
 
+use crate::cli::PerceptualArgs;
 use crate::error::{Error, Result};
 use crate::measure::records::TransitionRecord;
 use crate::methods::is_reference;
@@ -56,6 +57,22 @@ fn load(path: &Path) -> Result<Image> {
         .map(|b| b as f32 / 255.0)
         .collect();
     Image::new(w as usize, h as usize, 3, data).map_err(|e| Error::Perceptual(e.to_string()))
+}
+
+/// `lodbench perceptual`: scores the clips, prints the table and where perceptual.csv is.
+pub fn execute(args: &PerceptualArgs) -> Result<()> {
+    let settings = PerceptualSettings {
+        display: args.display.clone(),
+        fps: args.fps,
+    };
+    let records = check(&args.dir, &settings)?;
+    out!("{}", table(&records));
+    outln!(
+        "{} clips scored; {}",
+        records.len(),
+        args.dir.join(PERCEPTUAL_CSV).display()
+    );
+    Ok(())
 }
 
 /// ColorVideoVDP on the display `settings.display` names.

@@ -2,6 +2,7 @@
 //! (`crate::measure`), writing frames.csv as blocks finish and summary.csv at the end.
 
 use crate::cli::config::RunConfig;
+use crate::cli::RunArgs;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::measure::records::{
@@ -18,8 +19,29 @@ use crate::results::png::{DumpImages, FrameDumper, FrameId};
 use crate::scene::{Scene, SceneDef};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
 
 pub use crate::measure::INTERRUPTED;
+
+/// `lodbench run`: checks the flags, runs, prints the summary table and the results folder.
+pub fn execute(args: &RunArgs) -> Result<()> {
+    let cfg = RunConfig::from_args(args)?;
+    stop_on_signal();
+    let summary = run(&cfg)?;
+    out!("{}", summary_table(&summary));
+    outln!("results in {}", summary.out_dir.display());
+    Ok(())
+}
+
+/// On Ctrl-C, the run stops after the frame in progress (run.json says interrupted); a second signal while
+/// the first is being handled ends the process at once.
+pub fn stop_on_signal() {
+    let _ = ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+}
 
 /// What a finished run produced.
 pub struct RunSummary {

@@ -7,8 +7,8 @@ use crate::measure::records::{FrameRecord, RoundRecord, SummaryRecord, Transitio
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-pub use super::files::{FRAMES_CSV, PARTIAL_SUFFIX, ROUNDS_CSV, SUMMARY_CSV, TRANSITIONS_CSV};
 use super::files::partial;
+pub use super::files::{FRAMES_CSV, PARTIAL_SUFFIX, ROUNDS_CSV, SUMMARY_CSV, TRANSITIONS_CSV};
 
 /// Appends frame rows to `frames.csv.partial`; `finish` renames it to `frames.csv`.
 pub struct FramesWriter {

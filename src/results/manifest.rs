@@ -214,5 +214,6 @@ impl ExperimentRecord<PlannedRunRecord> {
 /// Writes `value` as `dir/experiment.json`.
 pub fn write_experiment_json<T: Serialize + ?Sized>(dir: &Path, value: &T) -> Result<()> {
     let path = dir.join(EXPERIMENT_JSON);
-    std::fs::write(&path, serde_json::to_string_pretty(value)? + "\n").map_err(|e| Error::io(&path, e))
+    std::fs::write(&path, serde_json::to_string_pretty(value)? + "\n")
+        .map_err(|e| Error::io(&path, e))
 }
