@@ -271,6 +271,22 @@ def cost(scene, summary, path):
     plt.close(fig)
 
 
+# The frames of a transition's clip, from CLIP_LEAD before its first frame to CLIP_TAIL after its last: the frames
+# `--dump-transitions` dumps around it. Mirrors results::files::ClipWindow (TRANSITION_LEAD and TRANSITION_TAIL of
+# the Rust source); scripts/tests/test_plot.py checks that they agree.
+CLIP_LEAD = 2
+CLIP_TAIL = 2
+# crop_box: pixels kept around what the pictures draw, and the share of the frame above which the whole frame is
+# shown. Mirror CROP_MARGIN and CROP_MAX_SHARE of src/commands/clips.rs (its crop_box), also checked by test_plot.py.
+CROP_MARGIN = 8
+CROP_MAX_SHARE = 0.5
+
+
+def clip_window(episode):
+    """The frames of the clip of a transition whose frames are `episode` (ascending), as `lodbench clips` shows."""
+    return range(max(0, episode[0] - CLIP_LEAD), episode[-1] + CLIP_TAIL + 1)
+
+
 def transitions(rows):
     """Episodes of the path with an instance in transition: lists of consecutive frame numbers."""
     episodes = []
@@ -292,7 +308,7 @@ def pick_transition(by_method, dumped, which):
     first = next(iter(by_method.values()))
     episodes = transitions(first)
     dumped = set(dumped)
-    shown = [(n, e) for n, e in enumerate(episodes, 1) if dumped.intersection(range(e[0] - 2, e[-1] + 3))]
+    shown = [(n, e) for n, e in enumerate(episodes, 1) if dumped.intersection(clip_window(e))]
     if not shown:
         return None
     if which == "first":
@@ -316,9 +332,9 @@ def pick_transition(by_method, dumped, which):
     return max(((n, f) for n, e in shown for f in e), key=lambda nf: spread(nf[1]))
 
 
-def crop_box(images, margin=8):
+def crop_box(images, margin=CROP_MARGIN):
     """The box holding everything that is not background (the first image's top-left colour) in any of the
-    images, with a margin; None when that is most of the frame anyway."""
+    images, with a margin; None when it covers more than CROP_MAX_SHARE of the frame (as clips.rs's crop_box)."""
     arrays = [np.asarray(im.convert("RGB"), dtype=np.int16) for im in images]
     h, w = arrays[0].shape[:2]
     bg = arrays[0][0, 0]
@@ -331,7 +347,7 @@ def crop_box(images, margin=8):
     ys, xs = np.nonzero(mask)
     box = (max(0, xs.min() - margin), max(0, ys.min() - margin), min(w, xs.max() + 1 + margin),
            min(h, ys.max() + 1 + margin))
-    if (box[2] - box[0]) * (box[3] - box[1]) > 0.6 * w * h:
+    if (box[2] - box[0]) * (box[3] - box[1]) > CROP_MAX_SHARE * w * h:
         return None
     return box
 

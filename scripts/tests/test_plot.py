@@ -97,3 +97,28 @@ def test_pixel_error_experiment_gets_the_unified_figure(pixel_error_experiment, 
     assert "crack_px_mean" in report
     with Image.open(folder / "figures" / "unified_terrain.png") as im:
         assert im.width > 600
+
+
+def rust_const(name: str) -> str:
+    """The value of `const NAME: TYPE = VALUE;` in the Rust source (wherever under src/ it is)."""
+    import re
+    pattern = re.compile(rf"const {name}: \w+ = ([^;]+);")
+    for path in sorted((SCRIPT.parents[1] / "src").rglob("*.rs")):
+        m = pattern.search(path.read_text())
+        if m:
+            return m.group(1)
+    raise AssertionError(f"no const {name} in src/")
+
+
+def test_clip_window_and_crop_mirror_the_rust():
+    import importlib.util
+    sys.path.insert(0, str(SCRIPT.parent))
+    spec = importlib.util.spec_from_file_location("plot", SCRIPT)
+    plot_module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(plot_module)
+    assert plot_module.CLIP_LEAD == int(rust_const("TRANSITION_LEAD"))
+    assert plot_module.CLIP_TAIL == int(rust_const("TRANSITION_TAIL"))
+    assert plot_module.CROP_MARGIN == int(rust_const("CROP_MARGIN"))
+    assert plot_module.CROP_MAX_SHARE == float(rust_const("CROP_MAX_SHARE"))
+    assert list(plot_module.clip_window([10, 11, 12])) == list(range(8, 15))
+    assert list(plot_module.clip_window([1]))[0] == 0

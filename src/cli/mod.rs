@@ -5,6 +5,7 @@
 //! (`crate::defaults::clap_defaults`), so a file and a command line with the same settings are the same run.
 
 pub mod config;
+pub mod experiment_file;
 
 use crate::geometry::blocks::PartitionMode;
 use crate::measure::metrics::{Metric, MetricReduction};

@@ -1,8 +1,8 @@
 //! `lodbench clips RUN_DIR`: animated side-by-side clips of every transition of a run, from its frame dumps
 //! (`--dump-frames --dump-transitions`).
 //!
-//! For each transition of transitions.csv, the dumped frames from [`TRANSITION_LEAD`] before its first frame
-//! to [`TRANSITION_TAIL`] after its last form one clip. Each frame of the clip is two grids of the same
+//! For each transition of transitions.csv, the dumped frames of its [`ClipWindow`] (from `TRANSITION_LEAD`
+//! before its first frame to `TRANSITION_TAIL` after its last) form one clip. Each frame of the clip is two grids of the same
 //! layout, one tile per picture, labelled, upscaled by an integer factor (nearest neighbour):
 //! - the frame grid: the reference's frame, then each method's;
 //! - the error grid: a legend of the heat-map's scale in the reference's tile, then each method's error
@@ -20,10 +20,15 @@
 //! The folder is built as `clips.partial/` and renamed to `clips/` only when every clip is written, so a
 //! folder named `clips/` is always complete.
 
+use crate::cli::ClipsArgs;
 use crate::error::{Error, Result};
-use crate::measure::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use crate::measure::records::TransitionRecord;
+use crate::methods::is_reference;
 use crate::results::csv::read_transitions;
-use crate::results::png::{heatmap, FrameDumper, HEATMAP_FULL_SCALE};
+use crate::results::files::{
+    partial, ClipFiles, ClipWindow, DumpKind, EXPERIMENT_JSON, FRAMES_CSV, TRANSITIONS_CSV,
+};
+use crate::results::png::{heatmap, FrameDumper, FrameId, HEATMAP_FULL_SCALE};
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, Rgba, RgbaImage};
 use serde::Serialize;
@@ -32,8 +37,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-pub const CLIPS_DIR: &str = "clips";
-pub const INDEX_JSON: &str = "index.json";
+pub use crate::results::files::{CLIPS_DIR, INDEX_JSON};
 
 pub use crate::cli::Mp4;
 
@@ -73,6 +77,48 @@ impl Default for ClipSettings {
             mp4: Mp4::Auto,
         }
     }
+}
+
+impl ClipSettings {
+    /// The settings `lodbench clips` was given.
+    pub fn from_args(args: &ClipsArgs) -> ClipSettings {
+        ClipSettings {
+            methods: args.methods.clone(),
+            columns: args.columns,
+            scale: args.scale,
+            fps: args.fps,
+            max_frames: args.max_frames,
+            transitions: args.transitions.clone(),
+            full_frame: args.full_frame,
+            gif: args.gif,
+            mp4: args.mp4,
+        }
+    }
+}
+
+/// `lodbench clips`: makes the clips and prints each with its frames and files.
+pub fn execute(args: &ClipsArgs) -> Result<()> {
+    let index = make(&args.dir, &ClipSettings::from_args(args))?;
+    for c in &index.clips {
+        outln!(
+            "{}: {} frames ({}-{}), {}{}",
+            c.name,
+            c.frames.len(),
+            c.frames.first().copied().unwrap_or_default(),
+            c.frames.last().copied().unwrap_or_default(),
+            c.apng,
+            [&c.gif, &c.mp4]
+                .iter()
+                .filter_map(|f| f.as_ref().map(|f| format!(", {f}")))
+                .collect::<String>()
+        );
+    }
+    outln!(
+        "{} clips in {}",
+        index.clips.len(),
+        args.dir.join(CLIPS_DIR).display()
+    );
+    Ok(())
 }
 
 /// Pictures lower than this are upscaled (by default) until they are at least this high.
@@ -183,12 +229,26 @@ pub struct ClipEntry {
     pub tiles: Vec<[u32; 4]>,
 }
 
-/// Per (scene, count, frame): k_mean and t_instances from frames.csv (of any method: they are the schedule's,
-/// the same for every method).
-type FrameFactsMap = BTreeMap<(String, u32, u32), (Option<f64>, Option<u32>)>;
+/// A frame of one scene block.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+struct FrameKey {
+    scene: String,
+    count: u32,
+    frame: u32,
+}
+
+/// A frame's schedule facts from frames.csv: the mean k of the instances in transition and their number.
+#[derive(Debug, Clone, Copy, Default)]
+struct FrameFacts {
+    k: Option<f64>,
+    t_instances: Option<u32>,
+}
+
+/// Per frame: its facts from frames.csv (of any method: they are the schedule's, the same for every method).
+type FrameFactsMap = BTreeMap<FrameKey, FrameFacts>;
 
 fn frame_facts(dir: &Path) -> Result<FrameFactsMap> {
-    let path = dir.join("frames.csv");
+    let path = dir.join(FRAMES_CSV);
     let mut map = BTreeMap::new();
     if !path.is_file() {
         return Ok(map);
@@ -212,27 +272,23 @@ fn frame_facts(dir: &Path) -> Result<FrameFactsMap> {
                 format!("frames.csv: a row without a count or frame: {rec:?}"),
             ));
         };
-        let key = (rec.get(scene).unwrap_or_default().to_string(), c, f);
-        map.entry(key).or_insert((
-            k.and_then(|i| rec.get(i))
+        let key = FrameKey {
+            scene: rec.get(scene).unwrap_or_default().to_string(),
+            count: c,
+            frame: f,
+        };
+        map.entry(key).or_insert(FrameFacts {
+            k: k.and_then(|i| rec.get(i))
                 .and_then(|v| v.parse::<f64>().ok()),
-            t.and_then(parse_u32),
-        ));
+            t_instances: t.and_then(parse_u32),
+        });
     }
     Ok(map)
 }
 
 /// Makes every clip of `dir` and returns the index written to `dir/clips/index.json`.
 pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
-    if !dir.is_dir() {
-        return Err(Error::results(dir, "is not a folder"));
-    }
-    if dir.join("experiment.json").is_file() && !dir.join("transitions.csv").is_file() {
-        return Err(Error::results(
-            dir,
-            "is an experiment's folder: give one of its run folders",
-        ));
-    }
+    check_run_folder(dir)?;
     let rows = read_transitions(dir)?;
     let frames_dir = FrameDumper::dumps_of(dir)?;
     if settings.columns == 0 || settings.fps == 0 || settings.scale == Some(0) {
@@ -240,25 +296,97 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
             "clips: --columns, --fps and --scale must be at least 1".into(),
         ));
     }
+    let methods = shown_methods(dir, &rows, settings)?;
+    let paths = transitions_shown(dir, &rows, settings)?;
+    let job = ClipJob {
+        dir,
+        frames_dir,
+        rows: &rows,
+        methods,
+        facts: frame_facts(dir)?,
+        settings,
+        ffmpeg: ffmpeg_wanted(settings.mp4)?,
+        partial: dir.join(partial(CLIPS_DIR)),
+    };
+    let out = dir.join(CLIPS_DIR);
+    if job.partial.exists() {
+        std::fs::remove_dir_all(&job.partial).map_err(|e| Error::io(&job.partial, e))?;
+    }
+    std::fs::create_dir_all(&job.partial).map_err(|e| Error::io(&job.partial, e))?;
+    let mut index = ClipIndex {
+        run: dir
+            .canonicalize()
+            .ok()
+            .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .unwrap_or_default(),
+        fps: settings.fps,
+        heatmap_full_scale: HEATMAP_FULL_SCALE,
+        clips: Vec::new(),
+    };
+    let result = paths.into_iter().try_for_each(|t| {
+        index.clips.extend(job.clip(t)?);
+        Ok(())
+    });
+    if let Err(e) = result {
+        // No half-written folder stays behind.
+        let _ = std::fs::remove_dir_all(&job.partial);
+        return Err(e);
+    }
+    if index.clips.is_empty() {
+        let _ = std::fs::remove_dir_all(&job.partial);
+        return Err(Error::results(
+            dir,
+            "no scene of the run has a method shown and a transition",
+        ));
+    }
+    let index_path = job.partial.join(INDEX_JSON);
+    let json = serde_json::to_string_pretty(&index)?;
+    std::fs::write(&index_path, json).map_err(|e| Error::io(&index_path, e))?;
+    if out.exists() {
+        std::fs::remove_dir_all(&out).map_err(|e| Error::io(&out, e))?;
+    }
+    std::fs::rename(&job.partial, &out).map_err(|e| Error::io(&out, e))?;
+    Ok(index)
+}
+
+/// `dir` is a run folder (not an experiment's).
+fn check_run_folder(dir: &Path) -> Result<()> {
+    if !dir.is_dir() {
+        return Err(Error::results(dir, "is not a folder"));
+    }
+    if dir.join(EXPERIMENT_JSON).is_file() && !dir.join(TRANSITIONS_CSV).is_file() {
+        return Err(Error::results(
+            dir,
+            "is an experiment's folder: give one of its run folders",
+        ));
+    }
+    Ok(())
+}
+
+/// The methods the clips show, in order: `--methods`, each a method of the run, or every method of
+/// transitions.csv but the reference.
+fn shown_methods(
+    dir: &Path,
+    rows: &[TransitionRecord],
+    settings: &ClipSettings,
+) -> Result<Vec<String>> {
     let mut run_methods: Vec<String> = Vec::new();
-    for r in &rows {
-        if r.method != "reference" && !run_methods.contains(&r.method) {
+    for r in rows {
+        if !is_reference(&r.method) && !run_methods.contains(&r.method) {
             run_methods.push(r.method.clone());
         }
     }
     let methods = match &settings.methods {
-        None => run_methods.clone(),
+        None => run_methods,
         Some(list) => {
-            for m in list {
-                if !run_methods.contains(m) {
-                    return Err(Error::results(
-                        dir,
-                        format!(
-                            "--methods {m}: not a method of this run (its methods: {})",
-                            run_methods.join(", ")
-                        ),
-                    ));
-                }
+            if let Some(m) = list.iter().find(|m| !run_methods.contains(m)) {
+                return Err(Error::results(
+                    dir,
+                    format!(
+                        "--methods {m}: not a method of this run (its methods: {})",
+                        run_methods.join(", ")
+                    ),
+                ));
             }
             list.clone()
         }
@@ -269,9 +397,18 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
             "has no method but the reference to show",
         ));
     }
-    // One transition of the path per (scene, count, index): the rows of every method share its frames.
+    Ok(methods)
+}
+
+/// One transition of the path per (scene, count, index) (the rows of every method share its frames), only
+/// those of `--transitions` when given.
+fn transitions_shown<'r>(
+    dir: &Path,
+    rows: &'r [TransitionRecord],
+    settings: &ClipSettings,
+) -> Result<Vec<&'r TransitionRecord>> {
     let mut paths: Vec<&TransitionRecord> = Vec::new();
-    for r in &rows {
+    for r in rows {
         if !paths
             .iter()
             .any(|p| p.scene == r.scene && p.count == r.count && p.transition == r.transition)
@@ -295,64 +432,118 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
         }
         paths.retain(|p| wanted.contains(&p.transition));
     }
-    let facts = frame_facts(dir)?;
-    let dump = |scene: &str, method: &str, count: u32, f: u32, kind: &str| -> PathBuf {
-        FrameDumper::path(&frames_dir, (scene, method, count, f), kind)
-    };
+    Ok(paths)
+}
 
-    let ffmpeg = match settings.mp4 {
-        Mp4::Off => false,
-        Mp4::Auto => ffmpeg_available(),
-        Mp4::On if ffmpeg_available() => true,
-        Mp4::On => {
-            return Err(Error::Config(
-                "clips --mp4 on: ffmpeg is not on the PATH (Debian: apt install ffmpeg)".into(),
-            ))
-        }
-    };
-
-    let out = dir.join(CLIPS_DIR);
-    let partial = dir.join(format!("{CLIPS_DIR}.partial"));
-    if partial.exists() {
-        std::fs::remove_dir_all(&partial).map_err(|e| Error::io(&partial, e))?;
+/// Whether to write MP4s: `--mp4 auto` when ffmpeg is there; `--mp4 on` without it is an error.
+fn ffmpeg_wanted(mp4: Mp4) -> Result<bool> {
+    match mp4 {
+        Mp4::Off => Ok(false),
+        Mp4::Auto => Ok(ffmpeg_available()),
+        Mp4::On if ffmpeg_available() => Ok(true),
+        Mp4::On => Err(Error::Config(
+            "clips --mp4 on: ffmpeg is not on the PATH (Debian: apt install ffmpeg)".into(),
+        )),
     }
-    std::fs::create_dir_all(&partial).map_err(|e| Error::io(&partial, e))?;
-    let mut index = ClipIndex {
-        run: dir
-            .canonicalize()
-            .ok()
-            .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-            .unwrap_or_default(),
-        fps: settings.fps,
-        heatmap_full_scale: HEATMAP_FULL_SCALE,
-        clips: Vec::new(),
-    };
-    let result = (|| -> Result<()> {
-        for t in paths {
-            // The methods shown that ran on this scene block, in the order shown.
-            let methods: Vec<String> = methods
-                .iter()
-                .filter(|m| {
-                    rows.iter()
-                        .any(|r| r.scene == t.scene && r.count == t.count && &r.method == *m)
-                })
-                .cloned()
-                .collect();
-            if methods.is_empty() {
-                continue;
-            }
-            let first = t.first_frame.saturating_sub(TRANSITION_LEAD);
-            let last = t.last_frame + TRANSITION_TAIL;
-            let mut frames: Vec<u32> = (first..=last)
-                .filter(|&f| {
-                    methods
-                        .iter()
-                        .all(|m| dump(&t.scene, m, t.count, f, "method").is_file())
-                })
-                .collect();
-            if frames.is_empty() {
-                return Err(Error::results(
-                dir,
+}
+
+/// What every clip of a run is made from, and where it goes.
+struct ClipJob<'a> {
+    dir: &'a Path,
+    frames_dir: PathBuf,
+    rows: &'a [TransitionRecord],
+    /// The methods shown, in order.
+    methods: Vec<String>,
+    facts: FrameFactsMap,
+    settings: &'a ClipSettings,
+    ffmpeg: bool,
+    /// `clips.partial/`, renamed to `clips/` when every clip is written.
+    partial: PathBuf,
+}
+
+/// One frame's pictures (the reference's, then each method's) and each method's error heat-map.
+struct FramePictures {
+    pictures: Vec<RgbaImage>,
+    errors: Vec<RgbaImage>,
+}
+
+/// The part of the frames a clip shows, and its upscaling.
+#[derive(Clone, Copy)]
+struct View {
+    crop: Crop,
+    scale: u32,
+}
+
+impl View {
+    fn of(&self, img: &RgbaImage) -> RgbaImage {
+        let c = self.crop;
+        upscale(
+            &image::imageops::crop_imm(img, c.x, c.y, c.w, c.h).to_image(),
+            self.scale,
+        )
+    }
+}
+
+impl ClipJob<'_> {
+    fn dump(&self, t: &TransitionRecord, method: &str, f: u32, kind: DumpKind) -> PathBuf {
+        let id = FrameId {
+            scene: &t.scene,
+            method,
+            count: t.count,
+            frame: f,
+        };
+        FrameDumper::path(&self.frames_dir, &id, kind)
+    }
+
+    /// The clip of transition `t`, or None when no method shown ran on its scene block.
+    fn clip(&self, t: &TransitionRecord) -> Result<Option<ClipEntry>> {
+        // The methods shown that ran on this scene block, in the order shown.
+        let methods: Vec<String> = self
+            .methods
+            .iter()
+            .filter(|m| {
+                self.rows
+                    .iter()
+                    .any(|r| r.scene == t.scene && r.count == t.count && &r.method == *m)
+            })
+            .cloned()
+            .collect();
+        if methods.is_empty() {
+            return Ok(None);
+        }
+        let frames = self.frames(t, &methods)?;
+        let files = ClipFiles::new(&t.scene, t.count, t.transition);
+        let clip_dir = self.partial.join(files.folder());
+        std::fs::create_dir_all(&clip_dir).map_err(|e| Error::io(&clip_dir, e))?;
+        let mut tiles = vec![DumpKind::Reference.name().to_string()];
+        tiles.extend(methods.iter().cloned());
+        let mut entry = new_entry(t, &files, tiles, frames, self.settings.gif);
+        let loaded = entry
+            .frames
+            .iter()
+            .map(|&f| self.load_frame(t, &methods, f))
+            .collect::<Result<Vec<_>>>()?;
+        let view = self.view(t, &loaded)?;
+        entry.crop = [view.crop.x, view.crop.y, view.crop.w, view.crop.h];
+        entry.scale = view.scale;
+        let movie = self.write_frames(t, &files, &mut entry, &loaded, view)?;
+        self.write_animations(&files, &mut entry, &movie)?;
+        Ok(Some(entry))
+    }
+
+    /// The frames of `t`'s [`ClipWindow`] dumped for every method shown, at most `--max-frames` of them.
+    fn frames(&self, t: &TransitionRecord, methods: &[String]) -> Result<Vec<u32>> {
+        let frames: Vec<u32> = ClipWindow::of(t)
+            .frames()
+            .filter(|&f| {
+                methods
+                    .iter()
+                    .all(|m| self.dump(t, m, f, DumpKind::Method).is_file())
+            })
+            .collect();
+        if frames.is_empty() {
+            return Err(Error::results(
+                self.dir,
                 format!(
                     "frames/ has no dumps of {} {} around transition {} (frames {}-{}) for every method shown: \
                      run with --dump-frames --dump-transitions",
@@ -363,164 +554,183 @@ pub fn make(dir: &Path, settings: &ClipSettings) -> Result<ClipIndex> {
                     t.last_frame
                 ),
             ));
-            }
-            frames = spread(&frames, settings.max_frames);
-            let name = format!("{}_c{}_t{:02}", t.scene, t.count, t.transition);
-            let clip_dir = partial.join(&name);
-            std::fs::create_dir_all(&clip_dir).map_err(|e| Error::io(&clip_dir, e))?;
-            let mut tiles = vec!["reference".to_string()];
-            tiles.extend(methods.iter().cloned());
-            let mut entry = ClipEntry {
-                name: name.clone(),
+        }
+        Ok(spread(&frames, self.settings.max_frames))
+    }
+
+    /// Frame `f`'s pictures and heat-maps (made from the pictures where the run dumped none), all one size.
+    fn load_frame(
+        &self,
+        t: &TransitionRecord,
+        methods: &[String],
+        f: u32,
+    ) -> Result<FramePictures> {
+        let mut pictures = vec![load(&self.dump(t, &methods[0], f, DumpKind::Reference))?];
+        let mut errors = Vec::new();
+        for m in methods {
+            let picture = load(&self.dump(t, m, f, DumpKind::Method))?;
+            let err_path = self.dump(t, m, f, DumpKind::Error);
+            let error = if err_path.is_file() {
+                load(&err_path)?
+            } else {
+                heatmap_of(&picture, &pictures[0])
+            };
+            pictures.push(picture);
+            errors.push(error);
+        }
+        let size = pictures[0].dimensions();
+        if pictures
+            .iter()
+            .chain(&errors)
+            .any(|p| p.dimensions() != size)
+        {
+            return Err(Error::results(
+                self.dir,
+                format!("the dumps of frame {f} of {} differ in size", t.scene),
+            ));
+        }
+        Ok(FramePictures { pictures, errors })
+    }
+
+    /// The part of the frames shown (the box around what any picture of the clip draws, or the whole frame
+    /// with `--full-frame`) and its upscaling.
+    fn view(&self, t: &TransitionRecord, loaded: &[FramePictures]) -> Result<View> {
+        let (w, h) = loaded[0].pictures[0].dimensions();
+        if loaded.iter().any(|l| l.pictures[0].dimensions() != (w, h)) {
+            return Err(Error::results(
+                self.dir,
+                format!("the dumps of {} differ in size between frames", t.scene),
+            ));
+        }
+        let crop = if self.settings.full_frame {
+            Crop { x: 0, y: 0, w, h }
+        } else {
+            crop_box(loaded.iter().flat_map(|l| l.pictures.iter()), w, h)
+        };
+        let scale = self.settings.scale.unwrap_or_else(|| auto_scale(&crop, w));
+        Ok(View { crop, scale })
+    }
+
+    /// Writes each frame's two grids and records them in `entry`; returns the animation's frames (the frame
+    /// grid over the error grid).
+    fn write_frames(
+        &self,
+        t: &TransitionRecord,
+        files: &ClipFiles,
+        entry: &mut ClipEntry,
+        loaded: &[FramePictures],
+        view: View,
+    ) -> Result<Vec<RgbaImage>> {
+        let mut movie: Vec<RgbaImage> = Vec::with_capacity(loaded.len());
+        let frames = entry.frames.clone();
+        for (&f, frame) in frames.iter().zip(loaded) {
+            let key = FrameKey {
                 scene: t.scene.clone(),
                 count: t.count,
-                transition: t.transition,
-                lods: t.lods.clone(),
-                first_frame: t.first_frame,
-                last_frame: t.last_frame,
-                methods: tiles.clone(),
-                frames: frames.clone(),
-                k: Vec::new(),
-                t_instances: Vec::new(),
-                frame_images: Vec::new(),
-                error_images: Vec::new(),
-                apng: format!("{name}.png"),
-                gif: settings.gif.then(|| format!("{name}.gif")),
-                mp4: None,
-                width: 0,
-                height: 0,
-                crop: [0, 0, 0, 0],
-                scale: 1,
-                tiles: Vec::new(),
+                frame: f,
             };
-            // Every picture of the clip first: the crop box spans all of them.
-            let mut loaded: Vec<(Vec<RgbaImage>, Vec<RgbaImage>)> =
-                Vec::with_capacity(frames.len());
-            for &f in &frames {
-                let mut pictures =
-                    vec![load(&dump(&t.scene, &methods[0], t.count, f, "reference"))?];
-                let mut errors = Vec::new();
-                for m in &methods {
-                    let picture = load(&dump(&t.scene, m, t.count, f, "method"))?;
-                    let err_path = dump(&t.scene, m, t.count, f, "error");
-                    let error = if err_path.is_file() {
-                        load(&err_path)?
-                    } else {
-                        heatmap_of(&picture, &pictures[0])
-                    };
-                    pictures.push(picture);
-                    errors.push(error);
-                }
-                let size = pictures[0].dimensions();
-                if pictures
+            let facts = self.facts.get(&key).copied().unwrap_or_default();
+            let header = header(t, f, facts);
+            let mut error_tiles = vec![legend(view.crop.w * view.scale, view.crop.h * view.scale)];
+            error_tiles.extend(frame.errors.iter().map(|e| view.of(e)));
+            let frame_grid = grid(
+                &format!("{header}  [frame]"),
+                &entry.methods,
+                &frame
+                    .pictures
                     .iter()
-                    .chain(&errors)
-                    .any(|p| p.dimensions() != size)
-                {
-                    return Err(Error::results(
-                        dir,
-                        format!("the dumps of frame {f} of {} differ in size", t.scene),
-                    ));
-                }
-                loaded.push((pictures, errors));
-            }
-            let (w, h) = loaded[0].0[0].dimensions();
-            if loaded.iter().any(|(p, _)| p[0].dimensions() != (w, h)) {
-                return Err(Error::results(
-                    dir,
-                    format!("the dumps of {} differ in size between frames", t.scene),
-                ));
-            }
-            let crop = if settings.full_frame {
-                Crop { x: 0, y: 0, w, h }
-            } else {
-                crop_box(loaded.iter().flat_map(|(p, _)| p.iter()), w, h)
-            };
-            let scale = settings.scale.unwrap_or_else(|| auto_scale(&crop, w));
-            entry.crop = [crop.x, crop.y, crop.w, crop.h];
-            entry.scale = scale;
-            let view = |img: &RgbaImage| {
-                upscale(
-                    &image::imageops::crop_imm(img, crop.x, crop.y, crop.w, crop.h).to_image(),
-                    scale,
-                )
-            };
-            let mut movie: Vec<RgbaImage> = Vec::with_capacity(frames.len());
-            for (&f, (pictures, errors)) in frames.iter().zip(&loaded) {
-                let (k, t_inst) = facts
-                    .get(&(t.scene.clone(), t.count, f))
-                    .copied()
-                    .unwrap_or((None, None));
-                let header = format!(
-                    "{} c{}  transition {} ({})  frame {f}  k {}  in transition {}",
-                    t.scene,
-                    t.count,
-                    t.transition,
-                    t.lods,
-                    k.map_or("-".to_string(), |k| format!("{k:.3}")),
-                    t_inst.map_or("-".to_string(), |n| n.to_string()),
-                );
-                let mut error_tiles = vec![legend(crop.w * scale, crop.h * scale)];
-                error_tiles.extend(errors.iter().map(view));
-                let (frame_grid, boxes) = grid(
-                    &format!("{header}  [frame]"),
-                    &tiles,
-                    &pictures.iter().map(view).collect::<Vec<_>>(),
-                    settings.columns,
-                );
-                // The same layout: the two headers are as long.
-                let (error_grid, _) = grid(
-                    &format!("{header}  [error]"),
-                    &tiles,
-                    &error_tiles,
-                    settings.columns,
-                );
-                let frame_file = format!("{name}/frame_{f:05}.png");
-                let error_file = format!("{name}/error_{f:05}.png");
-                save(&partial.join(&frame_file), &frame_grid)?;
-                save(&partial.join(&error_file), &error_grid)?;
-                entry.width = frame_grid.width();
-                entry.height = frame_grid.height();
-                entry.tiles = boxes;
-                entry.frame_images.push(frame_file);
-                entry.error_images.push(error_file);
-                entry.k.push(k);
-                entry.t_instances.push(t_inst);
-                movie.push(stack(&frame_grid, &error_grid));
-            }
-            write_apng(&partial.join(&entry.apng), &movie, settings.fps)?;
-            if let Some(gif) = &entry.gif {
-                write_gif(&partial.join(gif), &movie, settings.fps)?;
-            }
-            if ffmpeg {
-                let mp4 = format!("{name}.mp4");
-                write_mp4(&partial.join(&mp4), &movie, settings.fps)?;
-                entry.mp4 = Some(mp4);
-            }
-            index.clips.push(entry);
+                    .map(|p| view.of(p))
+                    .collect::<Vec<_>>(),
+                self.settings.columns,
+            );
+            // The same layout: the two headers are as long.
+            let error_grid = grid(
+                &format!("{header}  [error]"),
+                &entry.methods,
+                &error_tiles,
+                self.settings.columns,
+            );
+            let frame_file = files.frame_image(f);
+            let error_file = files.error_image(f);
+            save(&self.partial.join(&frame_file), &frame_grid.image)?;
+            save(&self.partial.join(&error_file), &error_grid.image)?;
+            entry.width = frame_grid.image.width();
+            entry.height = frame_grid.image.height();
+            entry.tiles = frame_grid.boxes;
+            entry.frame_images.push(frame_file);
+            entry.error_images.push(error_file);
+            entry.k.push(facts.k);
+            entry.t_instances.push(facts.t_instances);
+            movie.push(stack(&frame_grid.image, &error_grid.image));
+        }
+        Ok(movie)
+    }
+
+    /// The animated PNG, and the GIF and the MP4 where asked for.
+    fn write_animations(
+        &self,
+        files: &ClipFiles,
+        entry: &mut ClipEntry,
+        movie: &[RgbaImage],
+    ) -> Result<()> {
+        let fps = self.settings.fps;
+        write_apng(&self.partial.join(&entry.apng), movie, fps)?;
+        if let Some(gif) = &entry.gif {
+            write_gif(&self.partial.join(gif), movie, fps)?;
+        }
+        if self.ffmpeg {
+            let mp4 = files.animation("mp4");
+            write_mp4(&self.partial.join(&mp4), movie, fps)?;
+            entry.mp4 = Some(mp4);
         }
         Ok(())
-    })();
-    if let Err(e) = result {
-        // No half-written folder stays behind.
-        let _ = std::fs::remove_dir_all(&partial);
-        return Err(e);
     }
-    if index.clips.is_empty() {
-        let _ = std::fs::remove_dir_all(&partial);
-        return Err(Error::results(
-            dir,
-            "no scene of the run has a method shown and a transition",
-        ));
+}
+
+/// The entry of `t`'s clip before its frames are drawn.
+fn new_entry(
+    t: &TransitionRecord,
+    files: &ClipFiles,
+    tiles: Vec<String>,
+    frames: Vec<u32>,
+    gif: bool,
+) -> ClipEntry {
+    ClipEntry {
+        name: files.name.clone(),
+        scene: t.scene.clone(),
+        count: t.count,
+        transition: t.transition,
+        lods: t.lods.clone(),
+        first_frame: t.first_frame,
+        last_frame: t.last_frame,
+        methods: tiles,
+        frames,
+        k: Vec::new(),
+        t_instances: Vec::new(),
+        frame_images: Vec::new(),
+        error_images: Vec::new(),
+        apng: files.animation("png"),
+        gif: gif.then(|| files.animation("gif")),
+        mp4: None,
+        width: 0,
+        height: 0,
+        crop: [0, 0, 0, 0],
+        scale: 1,
+        tiles: Vec::new(),
     }
-    let index_path = partial.join(INDEX_JSON);
-    let json = serde_json::to_string_pretty(&index)?;
-    std::fs::write(&index_path, json).map_err(|e| Error::io(&index_path, e))?;
-    if out.exists() {
-        std::fs::remove_dir_all(&out).map_err(|e| Error::io(&out, e))?;
-    }
-    std::fs::rename(&partial, &out).map_err(|e| Error::io(&out, e))?;
-    Ok(index)
+}
+
+/// The line above frame `f`'s grids: the scene, the transition, the frame, k and the instances in transition.
+fn header(t: &TransitionRecord, f: u32, facts: FrameFacts) -> String {
+    format!(
+        "{} c{}  transition {} ({})  frame {f}  k {}  in transition {}",
+        t.scene,
+        t.count,
+        t.transition,
+        t.lods,
+        facts.k.map_or("-".to_string(), |k| format!("{k:.3}")),
+        facts.t_instances.map_or("-".to_string(), |n| n.to_string()),
+    )
 }
 
 /// At most `max` of `frames` (0: all), evenly spread, the first and the last always among them.
@@ -650,14 +860,15 @@ fn text_size(s: &str, width: u32) -> u32 {
     }
 }
 
-/// A labelled grid: a header line, then `pictures` (all one size) in rows of `columns`, each under its label;
-/// with each picture's box `[x, y, width, height]` in the grid.
-fn grid(
-    header: &str,
-    labels: &[String],
-    pictures: &[RgbaImage],
-    columns: u32,
-) -> (RgbaImage, Vec<[u32; 4]>) {
+/// A labelled grid of pictures, and where each picture lies in it.
+struct Grid {
+    image: RgbaImage,
+    /// Each picture's box `[x, y, width, height]` in the grid.
+    boxes: Vec<[u32; 4]>,
+}
+
+/// A labelled grid: a header line, then `pictures` (all one size) in rows of `columns`, each under its label.
+fn grid(header: &str, labels: &[String], pictures: &[RgbaImage], columns: u32) -> Grid {
     let (pw, ph) = pictures.first().map_or((1, 1), |p| p.dimensions());
     let cols = columns.min(pictures.len() as u32).max(1);
     let rows = (pictures.len() as u32).div_ceil(cols);
@@ -679,7 +890,7 @@ fn grid(
         image::imageops::replace(&mut img, picture, x as i64, (y + label_h) as i64);
         boxes.push([x, y + label_h, pw, ph]);
     }
-    (img, boxes)
+    Grid { image: img, boxes }
 }
 
 fn stack(top: &RgbaImage, bottom: &RgbaImage) -> RgbaImage {
@@ -876,7 +1087,7 @@ mod tests {
     fn grid_places_tiles_by_columns() {
         let tile = |v: u8| RgbaImage::from_pixel(10, 6, Rgba([v, v, v, 255]));
         let labels: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
-        let (g, boxes) = grid(
+        let Grid { image: g, boxes } = grid(
             "a long header",
             &labels,
             &[tile(50), tile(100), tile(150)],

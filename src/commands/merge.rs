@@ -16,8 +16,16 @@
 //! and `experiment.json` with `merged_from`. Nothing is averaged: runs on different adapters stay apart by the
 //! `adapter` column.
 
+use crate::cli::MergeArgs;
+use crate::commands::experiment::{concat_csv, CsvPart};
 use crate::error::{Error, Result};
-use serde_json::Value;
+use crate::results::files::{
+    run_folder_of, EXPERIMENT_JSON, RUNS_DIR, RUN_CSVS, RUN_JSON, UNSWEPT_RUN_DIR,
+};
+use crate::results::manifest::{
+    json_text, read_json, write_experiment_json, ExperimentRecord, PlannedRunRecord,
+    RunManifestRecord, RunStatus,
+};
 use std::path::{Path, PathBuf};
 
 /// What a merge did.
@@ -32,22 +40,79 @@ fn bad(problem: String) -> Error {
     Error::Config(format!("merge: {problem}"))
 }
 
-fn read_json(path: &Path) -> Result<Value> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    serde_json::from_str(&text)
-        .map_err(|e| bad(format!("{} is not valid JSON ({e})", path.display())))
+fn not_json(path: &Path, e: serde_json::Error) -> Error {
+    bad(format!("{} is not valid JSON ({e})", path.display()))
 }
+
+/// An input's experiment.json.
+type Record = ExperimentRecord<PlannedRunRecord>;
 
 /// One planned run found in an input.
 struct Found {
     input: PathBuf,
     folder: PathBuf,
-    run: Value,
+    run: RunManifestRecord,
 }
 
-/// The folder planned run `value` of `variable` has under `dir` (as `Experiment::run_folder` names it).
-fn run_folder(dir: &Path, variable: &Value, value: &Value) -> PathBuf {
-    crate::commands::experiment::run_folder_of(dir, variable.as_str(), value.as_str())
+/// A complete run to merge: its index in the plan and where it was found.
+struct MergedRun<'a> {
+    k: usize,
+    found: &'a Found,
+}
+
+/// The experiment's plan, as the first input records it.
+struct Plan<'a> {
+    variable: Option<&'a str>,
+    runs: &'a [PlannedRunRecord],
+}
+
+impl Plan<'_> {
+    /// How messages name planned run `k`: `variable=value`.
+    fn label(&self, k: usize) -> String {
+        match (self.variable, self.runs[k].value.as_deref()) {
+            (Some(var), Some(v)) => format!("{var}={v}"),
+            _ => "the experiment's run".to_string(),
+        }
+    }
+
+    /// The swept value of planned run `k` as its CSV column writes it.
+    fn value_of(&self, k: usize) -> String {
+        self.runs[k].value.clone().unwrap_or_default()
+    }
+}
+
+/// Which input holds each planned run, and which runs are there but not complete (`value in DIR: status`).
+struct Census {
+    found: Vec<Option<Found>>,
+    not_complete: Vec<String>,
+}
+
+impl Census {
+    /// The planned runs no input holds complete, by label.
+    fn missing(&self, plan: &Plan<'_>) -> Vec<String> {
+        (0..self.found.len())
+            .filter(|&k| self.found[k].is_none())
+            .map(|k| plan.label(k))
+            .collect()
+    }
+
+    fn complete(&self) -> Vec<MergedRun<'_>> {
+        self.found
+            .iter()
+            .enumerate()
+            .filter_map(|(k, f)| f.as_ref().map(|found| MergedRun { k, found }))
+            .collect()
+    }
+}
+
+/// `lodbench merge`: merges, notes what was left out, prints how many runs went where.
+pub fn execute(args: &MergeArgs) -> Result<()> {
+    let m = merge(&args.dirs, &args.out, args.allow_partial)?;
+    for l in &m.left_out {
+        eprintln!("note: left out {l}");
+    }
+    outln!("{} run(s) merged into {}", m.runs, args.out.display());
+    Ok(())
 }
 
 /// Merges the experiment folders `inputs` into `out`; see the module docs.
@@ -55,190 +120,216 @@ pub fn merge(inputs: &[PathBuf], out: &Path, allow_partial: bool) -> Result<Merg
     if inputs.is_empty() {
         return Err(bad("no input folders".into()));
     }
-    let mut experiments = Vec::new();
-    for dir in inputs {
-        let path = dir.join("experiment.json");
-        if !path.is_file() {
-            return Err(bad(format!(
-                "{} has no experiment.json (not a folder of `lodbench experiment`)",
-                dir.display()
-            )));
-        }
-        experiments.push(read_json(&path)?);
-    }
-    // The adapter a shard was pointed at (`--adapter`) may differ between shards: it is not the experiment.
-    let comparable = |e: &Value| -> Value {
-        let mut e = e.clone();
-        for r in e["runs"].as_array_mut().into_iter().flatten() {
-            if let Some(c) = r["config"].as_object_mut() {
-                c.remove("adapter");
-                c.remove("out");
-            }
-        }
-        e
-    };
+    let experiments = read_experiments(inputs)?;
+    check_one_experiment(inputs, &experiments)?;
     let first = &experiments[0];
-    let first_cmp = comparable(first);
-    for (dir, e) in inputs.iter().zip(&experiments).skip(1) {
-        let e = comparable(e);
-        for key in ["name", "variable", "runs"] {
-            if e[key] != first_cmp[key] {
-                return Err(bad(format!(
-                    "{} is another experiment than {}: its {key} differs{}",
-                    dir.display(),
-                    inputs[0].display(),
-                    if key == "name" {
-                        format!(" ({} against {})", e[key], first_cmp[key])
-                    } else {
-                        String::new()
-                    }
-                )));
-            }
-        }
-    }
-    let variable = &first["variable"];
-    let planned = first["runs"].as_array().ok_or_else(|| {
-        bad(format!(
-            "{}: experiment.json has no runs",
-            inputs[0].display()
-        ))
-    })?;
-    let label = |k: usize| -> String {
-        match (variable.as_str(), planned[k]["value"].as_str()) {
-            (Some(var), Some(v)) => format!("{var}={v}"),
-            _ => "the experiment's run".to_string(),
-        }
+    let plan = Plan {
+        variable: first.variable.as_deref(),
+        runs: &first.runs,
     };
-
-    // Which input holds each planned run, and in what state.
-    let mut found: Vec<Option<Found>> = (0..planned.len()).map(|_| None).collect();
-    let mut not_complete = Vec::new();
-    for dir in inputs {
-        for (k, p) in planned.iter().enumerate() {
-            let folder = run_folder(dir, variable, &p["value"]);
-            let run_json = folder.join("run.json");
-            if !run_json.is_file() {
-                continue;
-            }
-            let run = read_json(&run_json)?;
-            if run["status"] != "complete" {
-                not_complete.push(format!(
-                    "{} in {}: {}",
-                    label(k),
-                    dir.display(),
-                    run["status"].as_str().unwrap_or("unknown status")
-                ));
-                continue;
-            }
-            if let Some(other) = &found[k] {
-                return Err(bad(format!(
-                    "{} is in both {} and {} (a duplicate run)",
-                    label(k),
-                    other.input.display(),
-                    dir.display()
-                )));
-            }
-            found[k] = Some(Found {
-                input: dir.clone(),
-                folder,
-                run,
-            });
-        }
+    let census = find_runs(inputs, &plan)?;
+    let missing = census.missing(&plan);
+    if !allow_partial && (!missing.is_empty() || !census.not_complete.is_empty()) {
+        return Err(refuse_partial(&census.not_complete, &missing));
     }
-    let missing: Vec<String> = (0..planned.len())
-        .filter(|&k| found[k].is_none())
-        .map(label)
-        .collect();
-    if !allow_partial && (!missing.is_empty() || !not_complete.is_empty()) {
-        let mut why = Vec::new();
-        if !not_complete.is_empty() {
-            why.push(format!("not complete: {}", not_complete.join("; ")));
-        }
-        if !missing.is_empty() {
-            why.push(format!("missing: {}", missing.join(", ")));
-        }
-        return Err(bad(format!(
-            "{} (--allow-partial merges the complete runs and lists the others)",
-            why.join("; ")
-        )));
-    }
-    let runs: Vec<(usize, &Found)> = found
-        .iter()
-        .enumerate()
-        .filter_map(|(k, f)| f.as_ref().map(|f| (k, f)))
-        .collect();
+    let runs = census.complete();
     if runs.is_empty() {
         return Err(bad("no complete run in the inputs".into()));
     }
-    let version = |r: &Value| (r["lodbench_version"].clone(), r["git_commit"].clone());
-    let v0 = version(&runs[0].1.run);
-    for (k, f) in &runs[1..] {
-        if version(&f.run) != v0 {
-            return Err(bad(format!(
-                "{} in {} was made by lodbench {} ({}), {} in {} by {} ({}): merge runs of one version",
-                label(*k),
-                f.input.display(),
-                f.run["lodbench_version"],
-                f.run["git_commit"],
-                label(runs[0].0),
-                runs[0].1.input.display(),
-                v0.0,
-                v0.1
-            )));
-        }
-    }
-
-    crate::commands::run::prepare_output(out)?;
-    for (_, f) in &runs {
-        copy_run(&f.folder, &destination(out, f))?;
-    }
-    let mut lead_header: Vec<&str> = variable.as_str().into_iter().collect();
-    lead_header.push("adapter");
-    for file in crate::commands::experiment::RUN_CSVS {
-        let parts: Vec<(Vec<String>, PathBuf)> = runs
-            .iter()
-            .filter(|(_, f)| f.folder.join(file).is_file())
-            .map(|(k, f)| {
-                let adapter = f.run["adapter"]["name"].as_str().unwrap_or("unknown");
-                let lead = variable
-                    .as_str()
-                    .map(|_| value_of(&planned[*k]))
-                    .into_iter()
-                    .chain([adapter.to_string()])
-                    .collect();
-                (lead, f.folder.join(file))
-            })
-            .collect();
-        crate::commands::experiment::concat_csv(&out.join(file), &lead_header, &parts)?;
-    }
-    let mut record = first.clone();
-    record["shard"] = Value::Null;
-    record["merged_from"] = Value::from(
-        inputs
-            .iter()
-            .map(|d| d.display().to_string())
-            .collect::<Vec<_>>(),
-    );
+    check_one_version(&plan, &runs)?;
     let left_out: Vec<String> = missing
         .iter()
         .map(|m| format!("{m}: missing"))
-        .chain(not_complete.iter().cloned())
+        .chain(census.not_complete.iter().cloned())
         .collect();
-    record["left_out"] = Value::from(left_out.clone());
-    std::fs::write(
-        out.join("experiment.json"),
-        serde_json::to_string_pretty(&record)? + "\n",
-    )
-    .map_err(|e| Error::io(out.join("experiment.json"), e))?;
+    write_merged(out, inputs, first, &plan, &runs, &left_out)?;
     Ok(MergeSummary {
         runs: runs.len(),
         left_out,
     })
 }
 
-/// The swept value of a planned run as its CSV column writes it.
-fn value_of(planned: &Value) -> String {
-    planned["value"].as_str().unwrap_or_default().to_string()
+/// Every input's experiment.json.
+fn read_experiments(inputs: &[PathBuf]) -> Result<Vec<Record>> {
+    let mut experiments = Vec::new();
+    for dir in inputs {
+        let path = dir.join(EXPERIMENT_JSON);
+        if !path.is_file() {
+            return Err(bad(format!(
+                "{} has no experiment.json (not a folder of `lodbench experiment`)",
+                dir.display()
+            )));
+        }
+        experiments.push(Record::read(dir)?.map_err(|e| not_json(&path, e))?);
+    }
+    Ok(experiments)
+}
+
+/// The planned runs as the inputs must agree on them: without the adapter a shard was pointed at
+/// (`--adapter`, which may differ between shards: it is not the experiment) and the output folder.
+fn comparable(runs: &[PlannedRunRecord]) -> Vec<PlannedRunRecord> {
+    let mut runs = runs.to_vec();
+    for r in &mut runs {
+        if let Some(c) = r.config.as_object_mut() {
+            c.remove("adapter");
+            c.remove("out");
+        }
+    }
+    runs
+}
+
+/// Every input is the same experiment as the first: the same name, swept variable and planned runs.
+fn check_one_experiment(inputs: &[PathBuf], experiments: &[Record]) -> Result<()> {
+    let first = &experiments[0];
+    let first_runs = comparable(&first.runs);
+    for (dir, e) in inputs.iter().zip(experiments).skip(1) {
+        let differs = if e.name != first.name {
+            Some((
+                "name",
+                format!(
+                    " ({} against {})",
+                    json_text(&e.name),
+                    json_text(&first.name)
+                ),
+            ))
+        } else if e.variable != first.variable {
+            Some(("variable", String::new()))
+        } else if comparable(&e.runs) != first_runs {
+            Some(("runs", String::new()))
+        } else {
+            None
+        };
+        if let Some((key, detail)) = differs {
+            return Err(bad(format!(
+                "{} is another experiment than {}: its {key} differs{detail}",
+                dir.display(),
+                inputs[0].display(),
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Looks for every planned run in every input: a complete run in two inputs is an error (a duplicate).
+fn find_runs(inputs: &[PathBuf], plan: &Plan<'_>) -> Result<Census> {
+    let mut census = Census {
+        found: (0..plan.runs.len()).map(|_| None).collect(),
+        not_complete: Vec::new(),
+    };
+    for dir in inputs {
+        for (k, p) in plan.runs.iter().enumerate() {
+            let folder = run_folder_of(dir, plan.variable, p.value.as_deref());
+            let run_json = folder.join(RUN_JSON);
+            if !run_json.is_file() {
+                continue;
+            }
+            let run: RunManifestRecord =
+                read_json(&run_json)?.map_err(|e| not_json(&run_json, e))?;
+            if run.status != Some(RunStatus::Complete) {
+                census.not_complete.push(format!(
+                    "{} in {}: {}",
+                    plan.label(k),
+                    dir.display(),
+                    run.status.map_or("unknown status", RunStatus::name)
+                ));
+                continue;
+            }
+            if let Some(other) = &census.found[k] {
+                return Err(bad(format!(
+                    "{} is in both {} and {} (a duplicate run)",
+                    plan.label(k),
+                    other.input.display(),
+                    dir.display()
+                )));
+            }
+            census.found[k] = Some(Found {
+                input: dir.clone(),
+                folder,
+                run,
+            });
+        }
+    }
+    Ok(census)
+}
+
+/// The error of a merge without `--allow-partial` that misses runs or finds some not complete.
+fn refuse_partial(not_complete: &[String], missing: &[String]) -> Error {
+    let mut why = Vec::new();
+    if !not_complete.is_empty() {
+        why.push(format!("not complete: {}", not_complete.join("; ")));
+    }
+    if !missing.is_empty() {
+        why.push(format!("missing: {}", missing.join(", ")));
+    }
+    bad(format!(
+        "{} (--allow-partial merges the complete runs and lists the others)",
+        why.join("; ")
+    ))
+}
+
+/// Every run was made by the same lodbench (`lodbench_version` and `git_commit` of its run.json).
+fn check_one_version(plan: &Plan<'_>, runs: &[MergedRun<'_>]) -> Result<()> {
+    let first = &runs[0];
+    let v0 = first.found.run.version();
+    for r in &runs[1..] {
+        let v = r.found.run.version();
+        if v != v0 {
+            return Err(bad(format!(
+                "{} in {} was made by lodbench {} ({}), {} in {} by {} ({}): merge runs of one version",
+                plan.label(r.k),
+                r.found.input.display(),
+                json_text(&v.lodbench_version),
+                json_text(&v.git_commit),
+                plan.label(first.k),
+                first.found.input.display(),
+                json_text(&v0.lodbench_version),
+                json_text(&v0.git_commit)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Writes the merged folder: each run's folder under `runs/`, the joined CSVs, and experiment.json.
+fn write_merged(
+    out: &Path,
+    inputs: &[PathBuf],
+    first: &Record,
+    plan: &Plan<'_>,
+    runs: &[MergedRun<'_>],
+    left_out: &[String],
+) -> Result<()> {
+    crate::commands::run::prepare_output(out)?;
+    for r in runs {
+        copy_run(&r.found.folder, &destination(out, r.found))?;
+    }
+    let mut lead_header: Vec<&str> = plan.variable.into_iter().collect();
+    lead_header.push("adapter");
+    for file in RUN_CSVS {
+        let parts: Vec<CsvPart> = runs
+            .iter()
+            .filter(|r| r.found.folder.join(file).is_file())
+            .map(|r| {
+                let adapter = r.found.run.adapter.as_ref().and_then(|a| a.name.as_deref());
+                CsvPart {
+                    lead: plan
+                        .variable
+                        .map(|_| plan.value_of(r.k))
+                        .into_iter()
+                        .chain([adapter.unwrap_or("unknown").to_string()])
+                        .collect(),
+                    source: r.found.folder.join(file),
+                }
+            })
+            .collect();
+        concat_csv(&out.join(file), &lead_header, &parts)?;
+    }
+    let mut record = first.clone();
+    record.shard = None;
+    record.merged_from = Some(inputs.iter().map(|d| d.display().to_string()).collect());
+    record.left_out = Some(left_out.to_vec());
+    // Through a JSON value, so the keys are in alphabetical order, as merge has always written them.
+    write_experiment_json(out, &serde_json::to_value(&record)?)
 }
 
 /// Where run `f` goes under `out`: the place it had in its input (`runs/run/` for an experiment without a
@@ -246,10 +337,9 @@ fn value_of(planned: &Value) -> String {
 fn destination(out: &Path, f: &Found) -> PathBuf {
     match f.folder.strip_prefix(&f.input) {
         Ok(rel) if !rel.as_os_str().is_empty() => out.join(rel),
-        _ => out.join("runs").join("run"),
+        _ => out.join(RUNS_DIR).join(UNSWEPT_RUN_DIR),
     }
 }
-
 /// Copies the files of run folder `from` (not its subfolders) into `to`.
 fn copy_run(from: &Path, to: &Path) -> Result<()> {
     std::fs::create_dir_all(to).map_err(|e| Error::io(to, e))?;

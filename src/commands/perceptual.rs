@@ -6,15 +6,18 @@
 //! authors against the PyTorch reference to 3e-6 JOD). It reads only the PNGs, not lodbench's numbers, and
 //! writes `perceptual.csv` beside them with each transition's lodpop for comparison.
 
+use crate::cli::PerceptualArgs;
 use crate::error::{Error, Result};
-use crate::measure::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use crate::measure::records::TransitionRecord;
+use crate::methods::is_reference;
 use crate::results::csv::read_transitions;
-use crate::results::png::FrameDumper;
+use crate::results::files::{ClipWindow, DumpKind};
+use crate::results::png::{FrameDumper, FrameId};
 use colorvideovdp::{Color, Cvvdp, DisplayModel, Execution, Image, Options};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-pub const PERCEPTUAL_CSV: &str = "perceptual.csv";
+pub use crate::results::files::PERCEPTUAL_CSV;
 
 /// One row of perceptual.csv: one method's clip of one transition.
 #[derive(Debug, Clone, Serialize, PartialEq)]
@@ -56,10 +59,24 @@ fn load(path: &Path) -> Result<Image> {
     Image::new(w as usize, h as usize, 3, data).map_err(|e| Error::Perceptual(e.to_string()))
 }
 
-/// Scores every method's clip of every transition in `dir` and writes `dir/perceptual.csv`.
-pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<PerceptualRecord>> {
-    let transitions = read_transitions(dir)?;
-    let frames_dir = FrameDumper::dumps_of(dir)?;
+/// `lodbench perceptual`: scores the clips, prints the table and where perceptual.csv is.
+pub fn execute(args: &PerceptualArgs) -> Result<()> {
+    let settings = PerceptualSettings {
+        display: args.display.clone(),
+        fps: args.fps,
+    };
+    let records = check(&args.dir, &settings)?;
+    out!("{}", table(&records));
+    outln!(
+        "{} clips scored; {}",
+        records.len(),
+        args.dir.join(PERCEPTUAL_CSV).display()
+    );
+    Ok(())
+}
+
+/// ColorVideoVDP on the display `settings.display` names.
+fn metric(settings: &PerceptualSettings) -> Result<Cvvdp> {
     let display = DisplayModel::from_name(&settings.display).map_err(|e| {
         let names = DisplayModel::names().unwrap_or_default().join(", ");
         Error::Perceptual(format!(
@@ -67,38 +84,60 @@ pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<Perceptual
             settings.display
         ))
     })?;
-    let metric = Cvvdp::new(
+    Cvvdp::new(
         display,
         Options::default().with_execution(Execution::Parallel),
     )
-    .map_err(|e| Error::Perceptual(e.to_string()))?;
-    // The last frame of each block, so the clip stops at the end of the path.
-    let last_frame = |t: &TransitionRecord| -> u32 {
-        transitions
+    .map_err(|e| Error::Perceptual(e.to_string()))
+}
+
+/// A run's transitions and its dumps, where the clips come from.
+struct Clips<'a> {
+    dir: &'a Path,
+    frames_dir: PathBuf,
+    transitions: &'a [TransitionRecord],
+}
+
+impl Clips<'_> {
+    fn path(&self, t: &TransitionRecord, f: u32, kind: DumpKind) -> PathBuf {
+        let id = FrameId {
+            scene: &t.scene,
+            method: &t.method,
+            count: t.count,
+            frame: f,
+        };
+        FrameDumper::path(&self.frames_dir, &id, kind)
+    }
+
+    /// The clip of `t`: its [`ClipWindow`], stopped at the end of the path (the last window of its block) and
+    /// at the last frame dumped there.
+    fn window(&self, t: &TransitionRecord) -> ClipWindow {
+        let end = self
+            .transitions
             .iter()
             .filter(|o| o.scene == t.scene && o.count == t.count)
-            .map(|o| o.last_frame + TRANSITION_TAIL)
+            .map(|o| ClipWindow::of(o).last)
             .max()
-            .unwrap_or(t.last_frame)
-    };
-    let path_of = |t: &TransitionRecord, method: &str, f: u32, kind: &str| -> PathBuf {
-        FrameDumper::path(&frames_dir, (&t.scene, method, t.count, f), kind)
-    };
-    let mut out = Vec::new();
-    for t in transitions.iter().filter(|t| t.method != "reference") {
-        let first = t.first_frame.saturating_sub(TRANSITION_LEAD);
-        let mut last = (t.last_frame + TRANSITION_TAIL).min(last_frame(t));
+            .unwrap_or(t.last_frame);
+        let mut w = ClipWindow::of(t);
+        w.last = w.last.min(end);
         // The path may end inside the tail: keep the frames that were dumped at the end.
-        while last > t.last_frame && !path_of(t, &t.method, last, "method").is_file() {
-            last -= 1;
+        while w.last > t.last_frame && !self.path(t, w.last, DumpKind::Method).is_file() {
+            w.last -= 1;
         }
+        w
+    }
+
+    /// The method's and the reference's clip of `t`, every frame of `window` dumped.
+    fn load(&self, t: &TransitionRecord, window: ClipWindow) -> Result<ClipPair> {
+        let (first, last) = (window.first, window.last);
         let mut test = Vec::new();
         let mut reference = Vec::new();
-        for f in first..=last {
-            let m = path_of(t, &t.method, f, "method");
+        for f in window.frames() {
+            let m = self.path(t, f, DumpKind::Method);
             if !m.is_file() {
                 return Err(Error::results(
-                    dir,
+                    self.dir,
                     format!(
                         "{} is missing: the clip of transition {} needs every frame from {first} to {last} \
                          (run with --dump-frames --dump-transitions and --dump-every 1)",
@@ -108,18 +147,41 @@ pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<Perceptual
                 ));
             }
             test.push(load(&m)?);
-            reference.push(load(&path_of(t, &t.method, f, "reference"))?);
+            reference.push(load(&self.path(t, f, DumpKind::Reference))?);
         }
+        Ok(ClipPair { test, reference })
+    }
+}
+
+/// The frames of one transition's clip: the method's (the test) and the reference's.
+struct ClipPair {
+    test: Vec<Image>,
+    reference: Vec<Image>,
+}
+
+/// Scores every method's clip of every transition in `dir` and writes `dir/perceptual.csv`.
+pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<PerceptualRecord>> {
+    let transitions = read_transitions(dir)?;
+    let clips = Clips {
+        dir,
+        frames_dir: FrameDumper::dumps_of(dir)?,
+        transitions: &transitions,
+    };
+    let metric = metric(settings)?;
+    let mut out = Vec::new();
+    for t in transitions.iter().filter(|t| !is_reference(&t.method)) {
+        let window = clips.window(t);
+        let clip = clips.load(t, window)?;
         let p = metric
-            .predict_video(&test, &reference, settings.fps, Color::Srgb)
+            .predict_video(&clip.test, &clip.reference, settings.fps, Color::Srgb)
             .map_err(|e| Error::Perceptual(e.to_string()))?;
         out.push(PerceptualRecord {
             scene: t.scene.clone(),
             method: t.method.clone(),
             count: t.count,
             transition: t.transition,
-            clip_first: first,
-            clip_last: last,
+            clip_first: window.first,
+            clip_last: window.last,
             jod: p.jod as f64,
             lodpop_max: t.lodpop_max,
             pop_max: t.pop_max,
@@ -155,18 +217,35 @@ pub fn kendall_tau(a: &[f64], b: &[f64]) -> Option<f64> {
     (denominator > 0.0).then(|| (concordant - discordant) / denominator.sqrt())
 }
 
+/// One transition of one scene block.
+#[derive(PartialEq)]
+struct TransitionKey<'a> {
+    scene: &'a str,
+    count: u32,
+    transition: u32,
+}
+
 /// The table `lodbench perceptual` prints: per transition, each method's JOD and lodpop, and Kendall's tau
 /// between the ranking by JOD (higher is better) and by lodpop (lower is better).
 pub fn table(records: &[PerceptualRecord]) -> String {
     let mut out = String::new();
-    let mut keys: Vec<(String, u32, u32)> = Vec::new();
+    let mut keys: Vec<TransitionKey> = Vec::new();
     for r in records {
-        let k = (r.scene.clone(), r.count, r.transition);
+        let k = TransitionKey {
+            scene: &r.scene,
+            count: r.count,
+            transition: r.transition,
+        };
         if !keys.contains(&k) {
             keys.push(k);
         }
     }
-    for (scene, count, transition) in keys {
+    for TransitionKey {
+        scene,
+        count,
+        transition,
+    } in keys
+    {
         let rows: Vec<&PerceptualRecord> = records
             .iter()
             .filter(|r| r.scene == scene && r.count == count && r.transition == transition)

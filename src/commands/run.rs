@@ -2,21 +2,46 @@
 //! (`crate::measure`), writing frames.csv as blocks finish and summary.csv at the end.
 
 use crate::cli::config::RunConfig;
+use crate::cli::RunArgs;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
-use crate::measure::records::{round_records, BlockInfo, FrameRecord, SummaryRecord};
-use crate::measure::{
-    is_reference, reference_ms_per_frame, BlockRunner, MethodSetup, QualityOptions,
+use crate::measure::records::{
+    round_records, BlockInfo, FrameRecord, RoundRecord, SummaryRecord, TransitionRecord,
 };
-use crate::methods::Registry;
+use crate::measure::{
+    reference_ms_per_frame, BlockRunner, FrameImages, MethodSetup, QualityOptions,
+};
+use crate::methods::{is_reference, Registry};
 use crate::results::csv::{write_rounds, write_summary, write_transitions, FramesWriter};
+use crate::results::files::{stale_run_files, WRITE_PROBE};
 use crate::results::manifest::{now_rfc3339, RunManifest, RunStatus};
-use crate::results::png::FrameDumper;
-use crate::scene::SceneDef;
+use crate::results::png::{DumpImages, FrameDumper, FrameId};
+use crate::scene::{Scene, SceneDef};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
 
 pub use crate::measure::INTERRUPTED;
+
+/// `lodbench run`: checks the flags, runs, prints the summary table and the results folder.
+pub fn execute(args: &RunArgs) -> Result<()> {
+    let cfg = RunConfig::from_args(args)?;
+    stop_on_signal();
+    let summary = run(&cfg)?;
+    out!("{}", summary_table(&summary));
+    outln!("results in {}", summary.out_dir.display());
+    Ok(())
+}
+
+/// On Ctrl-C, the run stops after the frame in progress (run.json says interrupted); a second signal while
+/// the first is being handled ends the process at once.
+pub fn stop_on_signal() {
+    let _ = ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+}
 
 /// What a finished run produced.
 pub struct RunSummary {
@@ -46,16 +71,10 @@ pub fn prepare_output(dir: &Path) -> Result<()> {
         return Err(out_err("exists and is not a folder".into()));
     }
     std::fs::create_dir_all(dir).map_err(|e| out_err(format!("cannot be created ({e})")))?;
-    let probe = dir.join(".lodbench-write-test");
+    let probe = dir.join(WRITE_PROBE);
     std::fs::write(&probe, b"").map_err(|e| out_err(format!("is not writable ({e})")))?;
     let _ = std::fs::remove_file(&probe);
-    for stale in [
-        "frames.csv",
-        "summary.csv",
-        "transitions.csv",
-        "rounds.csv",
-        "frames.csv.partial",
-    ] {
+    for stale in stale_run_files() {
         let p = dir.join(stale);
         if p.exists() {
             std::fs::remove_file(&p).map_err(|e| Error::io(&p, e))?;
@@ -114,6 +133,30 @@ pub fn run_with(cfg: &RunConfig, registry: &Registry) -> Result<RunSummary> {
     })
 }
 
+/// What the blocks of a run add up to, written at the end (frames.csv as each block finishes).
+struct RunOutput {
+    frames_csv: FramesWriter,
+    summaries: Vec<SummaryRecord>,
+    transitions: Vec<TransitionRecord>,
+    rounds: Vec<RoundRecord>,
+}
+
+/// What every block of a run shares.
+struct RunJob<'a> {
+    cfg: &'a RunConfig,
+    registry: &'a Registry,
+    ctx: GpuContext,
+    dumper: Option<FrameDumper>,
+    progress: ProgressBar,
+    out_dir: &'a Path,
+}
+
+/// One method's quality pass over a block: its frame rows and its extra targets' size.
+struct MeasuredMethod {
+    rows: Vec<FrameRecord>,
+    extra_target_bytes: u64,
+}
+
 fn run_blocks(
     cfg: &RunConfig,
     registry: &Registry,
@@ -132,14 +175,39 @@ fn run_blocks(
     } else {
         None
     };
-    let mut frames_csv = FramesWriter::create(out_dir)?;
-    let mut summaries = Vec::new();
-    let mut transitions = Vec::new();
+    let mut output = RunOutput {
+        frames_csv: FramesWriter::create(out_dir)?,
+        summaries: Vec::new(),
+        transitions: Vec::new(),
+        rounds: Vec::new(),
+    };
+    let job = RunJob {
+        cfg,
+        registry,
+        ctx,
+        dumper,
+        progress: progress_bar(total_frames(cfg, defs)),
+        out_dir,
+    };
+    let mut block_index = 0u64;
+    for def in defs {
+        for &count in &def.counts {
+            block_index += 1;
+            job.run_block(def, count, block_index, manifest, &mut output)?;
+        }
+    }
+    job.progress.finish_and_clear();
+    output.frames_csv.finish()?;
+    write_summary(out_dir, &output.summaries)?;
+    write_transitions(out_dir, &output.transitions)?;
+    write_rounds(out_dir, &output.rounds)?;
+    Ok(output.summaries)
+}
 
-    // Per block: every method's warm-up, timed and quality frames, and the reference's warm-up and timed frames
-    // when it is timed without being reported.
-    let total: u64 = defs
-        .iter()
+/// The frames the progress bar counts: per block, every method's warm-up, timed and quality frames, and the
+/// reference's warm-up and timed frames when it is timed without being reported.
+fn total_frames(cfg: &RunConfig, defs: &[SceneDef]) -> u64 {
+    defs.iter()
         .map(|d| {
             let pv = cfg.resolved(d.kind);
             let methods = cfg.methods_for(d.kind);
@@ -148,7 +216,10 @@ fn run_blocks(
             d.counts.len() as u64
                 * (methods.len() as u64 * (warmup + 2 * frames) + timed_only * (warmup + frames))
         })
-        .sum();
+        .sum()
+}
+
+fn progress_bar(total: u64) -> ProgressBar {
     let progress = ProgressBar::new(total);
     progress.set_style(
         ProgressStyle::with_template(
@@ -156,100 +227,132 @@ fn run_blocks(
         )
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
+    progress
+}
 
-    let mut rounds = Vec::new();
-    let mut block_index = 0u64;
-    for def in defs {
+impl RunJob<'_> {
+    /// Scene block `def` with `count` instances, the `block_index`-th of the run: the timing rounds of its
+    /// methods, then each reported method's quality pass, its summaries and its rounds.
+    fn run_block(
+        &self,
+        def: &SceneDef,
+        count: u32,
+        block_index: u64,
+        manifest: &mut RunManifest,
+        output: &mut RunOutput,
+    ) -> Result<()> {
+        let cfg = self.cfg;
         let warmup = cfg.resolved(def.kind).warmup;
         let methods = cfg.methods_for(def.kind);
         let baseline = cfg.baseline_for(&methods);
-        for &count in &def.counts {
-            let scene = def.instantiate(count);
-            let setup = MethodSetup {
-                registry: registry.clone(),
-                options: cfg.method_options,
-                seed: cfg.seed,
-            };
-            let quality = QualityOptions {
-                metrics: cfg.metrics.clone(),
-                reduction: cfg.metric_reduction,
-            };
-            let mut block = BlockRunner::new(&ctx, &scene, setup, dumper.is_some(), &quality)?;
-            block.dump_transitions_only(cfg.dump_transitions);
-            progress.set_message(format!("{} n={} timing rounds", def.name(), count));
-            // Each block's shuffles have their own seed, derived from --seed and the block's position.
-            block_index += 1;
-            let rounds_seed = crate::rng::SplitMix64::new(cfg.seed ^ 0x524F_554E_4453)
-                .next_u64()
-                .wrapping_add(block_index);
-            let (timed, block_rounds) =
-                block.time_methods(&methods, warmup, cfg.rounds, rounds_seed, &progress)?;
-            let reference_ms = reference_ms_per_frame(&timed);
-            let mut block_rows: Vec<Vec<FrameRecord>> = Vec::new();
-            let mut extras = Vec::new();
-            for m in timed {
-                if block_rounds.timed_only.contains(&m.label) {
-                    continue;
-                }
-                let method = m.label.clone();
-                progress.set_message(format!("{} n={} {} quality", def.name(), count, method));
-                let out = block.measure_quality(
-                    m,
-                    reference_ms,
-                    cfg.dump_every,
-                    &progress,
-                    |f, (mi, r, x)| match &dumper {
-                        Some(d) => d.write(
-                            scene.name(),
-                            &method,
-                            count,
-                            f,
-                            scene.width,
-                            scene.height,
-                            mi,
-                            r,
-                            x,
-                        ),
-                        None => Ok(()),
-                    },
-                )?;
-                frames_csv.write_block(&out.rows)?;
-                transitions.extend(out.transitions);
-                extras.push(out.info.extra_target_bytes);
-                block_rows.push(out.rows);
-                manifest.blocks.push(out.info);
-                manifest.write(out_dir)?;
+        let scene = def.instantiate(count);
+        let setup = MethodSetup {
+            registry: self.registry.clone(),
+            options: cfg.method_options,
+            seed: cfg.seed,
+        };
+        let quality = QualityOptions {
+            metrics: cfg.metrics.clone(),
+            reduction: cfg.metric_reduction,
+        };
+        let mut block =
+            BlockRunner::new(&self.ctx, &scene, setup, self.dumper.is_some(), &quality)?;
+        block.dump_transitions_only(cfg.dump_transitions);
+        self.progress
+            .set_message(format!("{} n={} timing rounds", def.name(), count));
+        // Each block's shuffles have their own seed, derived from --seed and the block's position.
+        let rounds_seed = crate::rng::SplitMix64::new(cfg.seed ^ 0x524F_554E_4453)
+            .next_u64()
+            .wrapping_add(block_index);
+        let (timed, block_rounds) =
+            block.time_methods(&methods, warmup, cfg.rounds, rounds_seed, &self.progress)?;
+        let reference_ms = reference_ms_per_frame(&timed);
+        let mut measured = Vec::new();
+        for m in timed {
+            if block_rounds.timed_only.contains(&m.label) {
+                continue;
             }
-            let baseline_rows = baseline.as_ref().and_then(|b| {
-                block_rows
-                    .iter()
-                    .find(|r| r.first().is_some_and(|r| &r.method == b))
+            let method = m.label.clone();
+            self.progress
+                .set_message(format!("{} n={} {} quality", def.name(), count, method));
+            let out = block.measure_quality(
+                m,
+                reference_ms,
+                cfg.dump_every,
+                &self.progress,
+                |f, (mi, r, x)| self.dump(&scene, &method, f, (mi, r, x)),
+            )?;
+            output.frames_csv.write_block(&out.rows)?;
+            output.transitions.extend(out.transitions);
+            measured.push(MeasuredMethod {
+                extra_target_bytes: out.info.extra_target_bytes,
+                rows: out.rows,
             });
-            for (rows, extra) in block_rows.iter().zip(extras) {
-                // Each block's bootstrap has its own seed, derived from --seed and the block's position.
-                let block_seed = cfg.seed.wrapping_add(summaries.len() as u64 + 1);
-                if let Some(mut s) = SummaryRecord::from_frames(rows, extra, block_seed) {
-                    if let (Some(b), Some(base)) = (&baseline, baseline_rows) {
-                        s.set_ratios(b, rows, base);
-                    }
-                    summaries.push(s);
-                }
+            manifest.blocks.push(out.info);
+            manifest.write(self.out_dir)?;
+        }
+        summarise(cfg, baseline.as_deref(), &measured, &mut output.summaries);
+        let block_rows: Vec<Vec<FrameRecord>> = measured.into_iter().map(|m| m.rows).collect();
+        output.rounds.extend(round_records(
+            &block_rows,
+            &block_rounds,
+            baseline.as_deref(),
+        ));
+        manifest.timing_rounds.push(block_rounds);
+        manifest.write(self.out_dir)
+    }
+
+    /// Writes one frame's dumps (with `--dump-frames`).
+    fn dump(
+        &self,
+        scene: &Scene,
+        method: &str,
+        frame: u32,
+        (method_rgba, reference_rgba, extras): FrameImages<'_>,
+    ) -> Result<()> {
+        let Some(d) = &self.dumper else {
+            return Ok(());
+        };
+        let id = FrameId {
+            scene: scene.name(),
+            method,
+            count: scene.count,
+            frame,
+        };
+        let images = DumpImages {
+            width: scene.width,
+            height: scene.height,
+            method: method_rgba,
+            reference: reference_rgba,
+            extras,
+        };
+        d.write(&id, &images)
+    }
+}
+
+/// Each measured method's summary row, with its ratios to the baseline where the baseline was measured too.
+fn summarise(
+    cfg: &RunConfig,
+    baseline: Option<&str>,
+    measured: &[MeasuredMethod],
+    summaries: &mut Vec<SummaryRecord>,
+) {
+    let baseline_rows = baseline.and_then(|b| {
+        measured
+            .iter()
+            .map(|m| &m.rows)
+            .find(|r| r.first().is_some_and(|r| r.method == b))
+    });
+    for m in measured {
+        // Each block's bootstrap has its own seed, derived from --seed and the block's position.
+        let block_seed = cfg.seed.wrapping_add(summaries.len() as u64 + 1);
+        if let Some(mut s) = SummaryRecord::from_frames(&m.rows, m.extra_target_bytes, block_seed) {
+            if let (Some(b), Some(base)) = (baseline, baseline_rows) {
+                s.set_ratios(b, &m.rows, base);
             }
-            rounds.extend(round_records(
-                &block_rows,
-                &block_rounds,
-                baseline.as_deref(),
-            ));
-            manifest.timing_rounds.push(block_rounds);
-            manifest.write(out_dir)?;
+            summaries.push(s);
         }
     }
-    progress.finish_and_clear();
-    frames_csv.finish()?;
-    write_summary(out_dir, &summaries)?;
-    write_transitions(out_dir, &transitions)?;
-    write_rounds(out_dir, &rounds)?;
-    Ok(summaries)
 }
 
 /// The table printed at the end of a run.

@@ -72,7 +72,4 @@ impl Default for MethodSetup {
     }
 }
 
-/// Whether a run's label names the reference (`reference`, `reference#2`, ...).
-pub fn is_reference(label: &str) -> bool {
-    crate::methods::base_name(label) == "reference"
-}
+pub use crate::methods::is_reference;

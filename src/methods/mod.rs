@@ -158,6 +158,11 @@ pub fn base_name(label: &str) -> &str {
     }
 }
 
+/// Whether a run's label names the reference (`reference`, `reference#2`, ...).
+pub fn is_reference(label: &str) -> bool {
+    base_name(label) == "reference"
+}
+
 /// The methods that need a scene of one large mesh in blocks (`SceneKind::is_unified`): they draw its seams or
 /// its cluster DAG.
 pub const UNIFIED_ONLY: [&str; 4] = ["blocks", "blocks-noseams", "blocks-discrete", "clusterlod"];

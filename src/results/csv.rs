@@ -7,11 +7,8 @@ use crate::measure::records::{FrameRecord, RoundRecord, SummaryRecord, Transitio
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-pub const FRAMES_CSV: &str = "frames.csv";
-pub const SUMMARY_CSV: &str = "summary.csv";
-pub const TRANSITIONS_CSV: &str = "transitions.csv";
-pub const ROUNDS_CSV: &str = "rounds.csv";
-pub const PARTIAL_SUFFIX: &str = ".partial";
+use super::files::partial;
+pub use super::files::{FRAMES_CSV, PARTIAL_SUFFIX, ROUNDS_CSV, SUMMARY_CSV, TRANSITIONS_CSV};
 
 /// Appends frame rows to `frames.csv.partial`; `finish` renames it to `frames.csv`.
 pub struct FramesWriter {
@@ -23,7 +20,7 @@ pub struct FramesWriter {
 impl FramesWriter {
     pub fn create(dir: &Path) -> Result<FramesWriter> {
         let done = dir.join(FRAMES_CSV);
-        let partial = dir.join(format!("{FRAMES_CSV}{PARTIAL_SUFFIX}"));
+        let partial = dir.join(partial(FRAMES_CSV));
         let file = File::create(&partial).map_err(|e| Error::io(&partial, e))?;
         Ok(FramesWriter {
             writer: ::csv::Writer::from_writer(file),
@@ -52,7 +49,7 @@ impl FramesWriter {
 /// Writes `rows` to `name` in `dir` through a temporary file, so it appears whole or not at all.
 fn write_whole<T: serde::Serialize>(dir: &Path, name: &str, rows: &[T]) -> Result<PathBuf> {
     let path = dir.join(name);
-    let tmp = dir.join(format!("{name}{PARTIAL_SUFFIX}"));
+    let tmp = dir.join(partial(name));
     {
         let file = File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
         let mut w = ::csv::Writer::from_writer(file);
@@ -75,7 +72,6 @@ pub fn write_transitions(dir: &Path, rows: &[TransitionRecord]) -> Result<PathBu
     write_whole(dir, TRANSITIONS_CSV, rows)
 }
 
-/// Writes rounds.csv (whole or not at all).
 /// The transitions.csv of the run folder `dir` (what `lodbench perceptual` and `lodbench clips` start from);
 /// its absence is one error naming the folder.
 pub fn read_transitions(dir: &Path) -> Result<Vec<TransitionRecord>> {
@@ -91,6 +87,7 @@ pub fn read_transitions(dir: &Path) -> Result<Vec<TransitionRecord>> {
         .collect::<std::result::Result<Vec<_>, _>>()?)
 }
 
+/// Writes rounds.csv (whole or not at all).
 pub fn write_rounds(dir: &Path, rows: &[RoundRecord]) -> Result<PathBuf> {
     write_whole(dir, ROUNDS_CSV, rows)
 }

@@ -1,5 +1,7 @@
-//! Exporters: turn measurement structs into files. Nothing here measures anything.
+//! The results folder: its format written once (`files`), and the writers and readers of its files. Nothing
+//! here measures anything.
 
 pub mod csv;
+pub mod files;
 pub mod manifest;
 pub mod png;

@@ -1,5 +1,6 @@
 //! `--dump-frames`: the method frame, the reference frame and an error heat-map as PNGs.
 
+use super::files::{DumpKind, FRAMES_DIR};
 use crate::error::{Error, Result};
 use crate::measure::metrics::difference_image;
 use std::path::{Path, PathBuf};
@@ -12,9 +13,29 @@ pub struct FrameDumper {
     dir: PathBuf,
 }
 
+/// Which frame a dump is of: scene, method label, instance count and frame number, as frames.csv names it.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameId<'a> {
+    pub scene: &'a str,
+    pub method: &'a str,
+    pub count: u32,
+    pub frame: u32,
+}
+
+/// One frame's images: the method's and the reference's frames (RGBA, `width` x `height`), and the extra images
+/// the quality pass and the method add (lodpop's counterfactuals, FSI's buffers), each named by its
+/// [`DumpKind`].
+pub struct DumpImages<'a> {
+    pub width: u32,
+    pub height: u32,
+    pub method: &'a [u8],
+    pub reference: &'a [u8],
+    pub extras: &'a [(&'a str, Vec<u8>)],
+}
+
 impl FrameDumper {
     pub fn create(out: &Path) -> Result<FrameDumper> {
-        let dir = out.join("frames");
+        let dir = out.join(FRAMES_DIR);
         std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
         Ok(FrameDumper { dir })
     }
@@ -26,7 +47,7 @@ impl FrameDumper {
 
     /// The dumps folder of the run folder `dir`; its absence is one error saying how to make it.
     pub fn dumps_of(dir: &Path) -> Result<PathBuf> {
-        let frames = dir.join("frames");
+        let frames = dir.join(FRAMES_DIR);
         if !frames.is_dir() {
             return Err(Error::results(
                 dir,
@@ -36,43 +57,34 @@ impl FrameDumper {
         Ok(frames)
     }
 
-    /// In the dumps folder `frames`, the image `kind` (`method`, `reference`, `error`, ...) of one frame.
-    pub fn path(
-        frames: &Path,
-        (scene, method, count, frame): (&str, &str, u32, u32),
-        kind: &str,
-    ) -> PathBuf {
+    /// In the dumps folder `frames`, the image `kind` of one frame.
+    pub fn path(frames: &Path, id: &FrameId<'_>, kind: DumpKind) -> PathBuf {
+        Self::path_named(frames, id, kind.name())
+    }
+
+    fn path_named(frames: &Path, id: &FrameId<'_>, kind: &str) -> PathBuf {
         frames.join(format!(
             "{}_{kind}.png",
-            Self::stem(scene, method, count, frame)
+            Self::stem(id.scene, id.method, id.count, id.frame)
         ))
     }
 
-    #[allow(
-        clippy::too_many_arguments,
-        reason = "a frame's images and their identity: grouping them would only add a struct used once"
-    )]
-    pub fn write(
-        &self,
-        scene: &str,
-        method: &str,
-        count: u32,
-        frame: u32,
-        width: u32,
-        height: u32,
-        method_rgba: &[u8],
-        reference_rgba: &[u8],
-        extras: &[(&str, Vec<u8>)],
-    ) -> Result<()> {
-        let id = (scene, method, count, frame);
-        let at = |kind: &str| Self::path(&self.dir, id, kind);
-        for (name, rgba) in extras {
-            save(&at(name), width, height, rgba)?;
+    /// Writes the images of frame `id`: the extras first, then the method's and the reference's frames and the
+    /// error heat-map.
+    pub fn write(&self, id: &FrameId<'_>, images: &DumpImages<'_>) -> Result<()> {
+        let (width, height) = (images.width, images.height);
+        for (name, rgba) in images.extras {
+            debug_assert!(
+                DumpKind::from_name(name).is_some(),
+                "dump kind {name} is not a results::files::DumpKind"
+            );
+            save(&Self::path_named(&self.dir, id, name), width, height, rgba)?;
         }
-        save(&at("method"), width, height, method_rgba)?;
-        save(&at("reference"), width, height, reference_rgba)?;
-        let heat = heatmap(&difference_image(method_rgba, reference_rgba));
-        save(&at("error"), width, height, &heat)
+        let at = |kind: DumpKind| Self::path(&self.dir, id, kind);
+        save(&at(DumpKind::Method), width, height, images.method)?;
+        save(&at(DumpKind::Reference), width, height, images.reference)?;
+        let heat = heatmap(&difference_image(images.method, images.reference));
+        save(&at(DumpKind::Error), width, height, &heat)
     }
 }
 

@@ -1,0 +1,135 @@
+//! `lodbench describe SCENE`: what a scene holds (models, LODs, switch distances, blocks, path), as text or
+//! JSON.
+
+use crate::cli::DescribeArgs;
+use crate::error::Result;
+use crate::scene::{SceneConfig, SceneDef, SceneDescription, SceneKind};
+
+/// Prints the description of the scene `args` name, with its flags.
+pub fn execute(args: &DescribeArgs) -> Result<()> {
+    let cfg = SceneConfig::from_args(&args.scene_args)?;
+    let def = SceneDef::new(SceneKind::from_name(&args.scene)?, &cfg)?;
+    let d = def.describe(&cfg);
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&d)?);
+        return Ok(());
+    }
+    outln!(
+        "{}: profile {}, {}x{}, fov {} deg, {} frames, instance counts {:?}",
+        d.scene,
+        d.profile,
+        d.width,
+        d.height,
+        d.fov_y_deg,
+        d.frames,
+        d.instance_counts
+    );
+    outln!("mesh: {}", d.mesh);
+    if d.unified.is_some() {
+        print_blocks(&d);
+    } else {
+        print_models(&d);
+    }
+    print_path(&d)
+}
+
+/// A unified scene: its blocks, seams and preprocessing.
+fn print_blocks(d: &SceneDescription) {
+    let Some(u) = &d.unified else {
+        return;
+    };
+    let lods = d.models.iter().map(|m| m.lods.len()).max().unwrap_or(0);
+    let per_lod: Vec<String> = (0..lods)
+        .map(|l| {
+            let t: usize = d
+                .models
+                .iter()
+                .filter_map(|m| m.lods.get(l))
+                .map(|x| x.info.triangles)
+                .sum();
+            format!("LOD{l} {t}")
+        })
+        .collect();
+    outln!(
+        "blocks: {} ({:?} grid of {:.3}-unit cubes, --partition {}), {} input triangles, {} in blocks; \
+         triangles of all blocks per LOD: {}",
+        u.blocks,
+        u.grid,
+        u.block_size,
+        format!("{:?}", u.partition).to_lowercase(),
+        u.input_triangles,
+        u.block_triangles,
+        per_lod.join(", ")
+    );
+    outln!(
+        "seams: {} block pairs, {} edges, {} triangles over all LOD pairs",
+        u.seam_pairs,
+        u.seam_edges,
+        u.seam_triangles_all_lod_pairs
+    );
+    outln!(
+        "preprocessing: blocks {:.0} ms (partition {:.0}, LOD chains {:.0}, seams {:.0}), {:.1} MiB; \
+         clusterlod {:.0} ms, {} clusters in {} groups, {} levels, {:.1} MiB",
+        u.blocks_ms,
+        u.partition_ms,
+        u.lod_chains_ms,
+        u.seams_ms,
+        (u.blocks_bytes + u.seams_bytes) as f64 / (1 << 20) as f64,
+        u.clusterlod_ms,
+        u.clusters,
+        u.cluster_groups,
+        u.cluster_levels,
+        u.clusterlod_bytes as f64 / (1 << 20) as f64
+    );
+    outln!("(every block's LODs and switch distances: --json)");
+}
+
+/// Each model's LODs and switch distances.
+fn print_models(d: &SceneDescription) {
+    for m in &d.models {
+        outln!(
+            "model {} (radius {:.3}, switch distances from {}):",
+            m.name,
+            m.radius,
+            m.switch_source
+        );
+        outln!(
+            "  {:>4} {:>10} {:>9} {:>14} {:>16}",
+            "lod",
+            "triangles",
+            "vertices",
+            "error_abs",
+            "switch_distance"
+        );
+        for l in &m.lods {
+            outln!(
+                "  {:>4} {:>10} {:>9} {:>14.6} {:>16}{}",
+                l.info.lod,
+                l.info.triangles,
+                l.info.vertices,
+                l.info.error_abs,
+                l.switch_distance
+                    .map_or("-".to_string(), |s| format!("{s:.3}")),
+                l.note.map_or(String::new(), |n| format!("  ({n})"))
+            );
+        }
+    }
+}
+
+/// The pixel error, the camera path, the motion and the notes.
+fn print_path(d: &SceneDescription) -> Result<()> {
+    outln!("pixel error: {}", d.pixel_error);
+    if let Some(p) = &d.path {
+        outln!(
+            "path: from {:.3} to {:.3} (the bounding sphere fits the view from {:.3})",
+            p.near,
+            p.far,
+            p.fit
+        );
+    }
+    outln!("motion: {}", serde_json::to_string(&d.motion)?);
+    for n in &d.notes {
+        outln!("note: {n}");
+    }
+    Ok(())
+}

@@ -1,0 +1,36 @@
+//! `lodbench list`: the scenes, the methods and the adapters.
+
+use crate::error::Result;
+use crate::gpu;
+use crate::methods;
+use crate::scene::SceneKind;
+
+/// Prints the scenes, the methods with what each does, and the adapters found (best first).
+pub fn execute() -> Result<()> {
+    outln!("scenes:  {}", SceneKind::names().join(", "));
+    outln!("methods:");
+    for m in methods::BUILTIN {
+        outln!("  {:<16} {}", m.name, m.about);
+    }
+    let adapters = gpu::context::enumerate_adapters();
+    if adapters.is_empty() {
+        outln!("adapters: none found");
+        outln!("  {}", gpu::context::NO_ADAPTER_HELP);
+        return Ok(());
+    }
+    outln!("adapters (best first; `--adapter SUBSTRING` picks one):");
+    for a in adapters {
+        let i = a.get_info();
+        let ts = a.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        outln!(
+            "  {}  [{:?}, {:?}, driver {} {}{}]",
+            i.name,
+            i.backend,
+            i.device_type,
+            i.driver,
+            i.driver_info,
+            if ts { ", timestamps" } else { "" }
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,199 @@
+//! The results-folder format, written once: every file and folder name of a run folder and of an experiment
+//! folder, the kinds of dumped image, and the frames of a transition's clip.
+//!
+//! A run folder (`lodbench run --out DIR`):
+//! - [`RUN_JSON`]: what was run and whether it finished (`results::manifest::RunManifest`);
+//! - [`FRAMES_CSV`] (written as `frames.csv.partial` until the run completes), [`SUMMARY_CSV`],
+//!   [`TRANSITIONS_CSV`], [`ROUNDS_CSV`] (`results::csv`);
+//! - [`FRAMES_DIR`]`/`: with `--dump-frames`, `<stem>_<kind>.png` per dumped frame ([`DumpKind`]);
+//! - [`CLIPS_DIR`]`/`: `lodbench clips`, with [`INDEX_JSON`] (built as `clips.partial/`);
+//! - [`PERCEPTUAL_CSV`]: `lodbench perceptual`.
+//!
+//! An experiment folder (`lodbench experiment`, `lodbench merge`): [`EXPERIMENT_JSON`]
+//! (`results::manifest::ExperimentRecord`), the [`RUN_CSVS`] of all its runs joined, and each run's folder under
+//! [`RUNS_DIR`]`/<variable>=<value>/` ([`run_folder_of`]).
+
+use crate::measure::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
+use std::path::{Path, PathBuf};
+
+pub const FRAMES_CSV: &str = "frames.csv";
+pub const SUMMARY_CSV: &str = "summary.csv";
+pub const TRANSITIONS_CSV: &str = "transitions.csv";
+pub const ROUNDS_CSV: &str = "rounds.csv";
+pub const PERCEPTUAL_CSV: &str = "perceptual.csv";
+pub const RUN_JSON: &str = "run.json";
+pub const EXPERIMENT_JSON: &str = "experiment.json";
+/// The frame dumps of a run folder.
+pub const FRAMES_DIR: &str = "frames";
+/// The transition clips of a run folder.
+pub const CLIPS_DIR: &str = "clips";
+/// The clips and their frames, in [`CLIPS_DIR`].
+pub const INDEX_JSON: &str = "index.json";
+/// The run folders of an experiment folder.
+pub const RUNS_DIR: &str = "runs";
+/// Under [`RUNS_DIR`] of a merged folder: the run of an experiment without a sweep.
+pub const UNSWEPT_RUN_DIR: &str = "run";
+/// What a file or folder is called while it is written; renamed to its name when whole.
+pub const PARTIAL_SUFFIX: &str = ".partial";
+/// The empty file that checks an output folder is writable (removed at once).
+pub const WRITE_PROBE: &str = ".lodbench-write-test";
+
+/// The CSV files of a run folder that an experiment, and `lodbench merge`, join across runs.
+pub const RUN_CSVS: [&str; 4] = [FRAMES_CSV, SUMMARY_CSV, TRANSITIONS_CSV, ROUNDS_CSV];
+
+/// `name` while it is written: `frames.csv.partial`, `clips.partial`.
+pub fn partial(name: &str) -> String {
+    format!("{name}{PARTIAL_SUFFIX}")
+}
+
+/// The result files of an earlier run that a new run in the same folder removes first, so nothing stale looks
+/// complete.
+pub fn stale_run_files() -> [String; 5] {
+    [
+        FRAMES_CSV.to_string(),
+        SUMMARY_CSV.to_string(),
+        TRANSITIONS_CSV.to_string(),
+        ROUNDS_CSV.to_string(),
+        partial(FRAMES_CSV),
+    ]
+}
+
+/// The folder of the run with swept `value` of `variable` under `out`: `runs/<variable>=<value>/` (a comma of a
+/// value as `x`), or `out` itself without a sweep.
+pub fn run_folder_of(out: &Path, variable: Option<&str>, value: Option<&str>) -> PathBuf {
+    match (variable, value) {
+        (Some(var), Some(v)) => out
+            .join(RUNS_DIR)
+            .join(format!("{var}={}", v.replace(',', "x"))),
+        _ => out.to_path_buf(),
+    }
+}
+
+/// The kinds of image `--dump-frames` writes per frame, `<stem>_<kind>.png` (`FrameDumper::path`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DumpKind {
+    /// The method's frame.
+    Method,
+    /// The reference's frame.
+    Reference,
+    /// The heat-map of the method's frame against the reference's.
+    Error,
+    /// lodpop's counterfactuals: the frame with this frame's schedule, and with the previous frame's.
+    LodpopNow,
+    LodpopBefore,
+    /// FSI's two LOD buffers (the method's `debug_targets`).
+    LodBuffer0,
+    LodBuffer1,
+}
+
+impl DumpKind {
+    pub const ALL: [DumpKind; 7] = [
+        DumpKind::Method,
+        DumpKind::Reference,
+        DumpKind::Error,
+        DumpKind::LodpopNow,
+        DumpKind::LodpopBefore,
+        DumpKind::LodBuffer0,
+        DumpKind::LodBuffer1,
+    ];
+
+    /// The kind as the file name ends: `..._method.png`.
+    pub fn name(self) -> &'static str {
+        match self {
+            DumpKind::Method => "method",
+            DumpKind::Reference => "reference",
+            DumpKind::Error => "error",
+            DumpKind::LodpopNow => "lodpop-now",
+            DumpKind::LodpopBefore => "lodpop-before",
+            DumpKind::LodBuffer0 => "lodbuffer0",
+            DumpKind::LodBuffer1 => "lodbuffer1",
+        }
+    }
+
+    /// The kind named `name` (as the quality pass and the methods name their extra images).
+    pub fn from_name(name: &str) -> Option<DumpKind> {
+        DumpKind::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// The frames of a transition's clip (`lodbench clips`, `lodbench perceptual`, and what `--dump-transitions`
+/// dumps around it): from [`TRANSITION_LEAD`] before its first frame to [`TRANSITION_TAIL`] after its last.
+/// scripts/plot.py mirrors it as CLIP_LEAD and CLIP_TAIL.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ClipWindow {
+    pub first: u32,
+    pub last: u32,
+}
+
+impl ClipWindow {
+    pub fn of(t: &TransitionRecord) -> ClipWindow {
+        ClipWindow {
+            first: t.first_frame.saturating_sub(TRANSITION_LEAD),
+            last: t.last_frame + TRANSITION_TAIL,
+        }
+    }
+
+    pub fn frames(&self) -> std::ops::RangeInclusive<u32> {
+        self.first..=self.last
+    }
+}
+
+/// The files of one clip in [`CLIPS_DIR`], relative to it.
+pub struct ClipFiles {
+    pub name: String,
+}
+
+impl ClipFiles {
+    /// The clip of transition `transition` of scene block `scene`, `count`: `bunny-sweep_c1_t03`.
+    pub fn new(scene: &str, count: u32, transition: u32) -> ClipFiles {
+        ClipFiles {
+            name: format!("{scene}_c{count}_t{transition:02}"),
+        }
+    }
+
+    /// The folder of its frames.
+    pub fn folder(&self) -> &str {
+        &self.name
+    }
+
+    /// Frame `f`'s grid of pictures.
+    pub fn frame_image(&self, f: u32) -> String {
+        format!("{}/frame_{f:05}.png", self.name)
+    }
+
+    /// Frame `f`'s grid of error heat-maps.
+    pub fn error_image(&self, f: u32) -> String {
+        format!("{}/error_{f:05}.png", self.name)
+    }
+
+    /// The animation, as `ext` (`png`, `gif`, `mp4`).
+    pub fn animation(&self, ext: &str) -> String {
+        format!("{}.{ext}", self.name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dump_kinds_read_back() {
+        for k in DumpKind::ALL {
+            assert_eq!(DumpKind::from_name(k.name()), Some(k));
+        }
+        assert_eq!(DumpKind::from_name("methods"), None);
+    }
+
+    #[test]
+    fn folder_names() {
+        assert_eq!(partial(FRAMES_CSV), "frames.csv.partial");
+        assert_eq!(
+            run_folder_of(Path::new("o"), Some("viewport"), Some("64,48")),
+            Path::new("o/runs/viewport=64x48")
+        );
+        assert_eq!(run_folder_of(Path::new("o"), None, None), Path::new("o"));
+        let c = ClipFiles::new("s", 2, 3);
+        assert_eq!(c.frame_image(7), "s_c2_t03/frame_00007.png");
+        assert_eq!(c.animation("gif"), "s_c2_t03.gif");
+    }
+}
