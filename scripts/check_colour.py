@@ -3,7 +3,7 @@
 
 For every frame dumped with `lodbench run --dump-frames` (results/<run>/frames/*_method.png and
 *_reference.png), recompute
-  - rmse as seed 003 section 6 steps 5-6, with numpy: per pixel the mean over R, G, B of |a - b| on the
+  - rmse as Sheliemietiev et al. 2023 section 6 steps 5-6, with numpy: per pixel the mean over R, G, B of |a - b| on the
     sRGB-encoded values in [0, 1], then the root mean square over pixels;
   - the mean CIEDE2000 with colour-science:
     colour.delta_E(XYZ_to_Lab(sRGB_to_XYZ(a)), XYZ_to_Lab(sRGB_to_XYZ(b)), method="CIE 2000"), averaged over pixels;

@@ -9,12 +9,12 @@ wrote `clips/`, a player per transition stepping through the methods' frames sid
 nothing but the folder's own files, see scripts/report_html.py):
   - sweep_<scene>.png       rmse, pop and lodpop along the path per method, and FSI's lag_rmse, discrete LOD switch
                             frames marked;
-  - fig6_<scene>.png        seed 003 Fig. 6: popping per method (mean rmse, max pop, max lodpop; bunny-sweep or any
+  - fig6_<scene>.png        Sheliemietiev et al. 2023 Fig. 6: popping per method (mean rmse, max pop, max lodpop; bunny-sweep or any
                             moving scene);
   - transitions_<scene>.png per transition of the path (up to 16), the largest lodpop and pop of each method (from
                             transitions.csv: the transition's frames and the 2 after; older folders without it: the
                             largest pop within 5 frames), also as tables in report.md;
-  - fig5_<scene>.png        seed 003 Fig. 5: median frame time against instance count per method (scenes run with
+  - fig5_<scene>.png        Sheliemietiev et al. 2023 Fig. 5: median frame time against instance count per method (scenes run with
                             several --count values, e.g. bunny-grid), with bootstrap 95 % intervals;
   - cost_<scene>.png        error against cost: mean rmse and max pop against median GPU time, per method;
   - contact_<scene>.png     three dumped frames around one transition per method with their error heat-maps, cropped
@@ -22,7 +22,7 @@ nothing but the folder's own files, see scripts/report_html.py):
                             frame where the methods' rmse differ most), `first`, or N (the N-th along the path).
   - fsi_buffers_<scene>.png FSI's two LOD buffers and the combined frame, at the dumped frame with the most instances
                             in transition (ties: the largest rmse), cropped (an fsi method run with --dump-frames).
-  - fig8_<scene>.png        seed 000 Fig. 8: median frame time against viewport size per method (experiment folders
+  - fig8_<scene>.png        Scherzer & Wimmer 2008 Fig. 8: median frame time against viewport size per method (experiment folders
                             sweeping `viewport`, e.g. `lodbench experiment` with [sweep] variable = "viewport").
   - unified_<scene>.png     unified LOD (experiment folders sweeping `pixel-error`, e.g.
                             scenes/experiments/unified-lod.toml): mean triangles, largest lodpop and mean crack pixels
@@ -95,7 +95,7 @@ def sweep_figure(scene, by_method, path):
         axes[1].plot(frames, [num(r["pop"]) for r in rows], lw=0.9, label=method)
         if has_lodpop:
             axes[2].plot(frames, [num(r["lodpop"]) for r in rows], lw=0.9, label=method)
-    axes[0].set_ylabel("rmse (seed 003 sec. 6)")
+    axes[0].set_ylabel("rmse (Sheliemietiev et al. 2023 sec. 6)")
     axes[1].set_ylabel("pop (motion included)")
     if has_lodpop:
         axes[2].set_ylabel("lodpop (pose held)")
@@ -122,7 +122,7 @@ def fig6(scene, summary, path):
     for i, (c, label) in enumerate(bars):
         ax.bar(x - 0.4 + (i + 0.5) * w, [num(r[c]) for r in summary], w, label=label)
     ax.set_xticks(x, methods, rotation=20)
-    ax.set_title(f"{scene}: popping per method (cf. seed 003 Fig. 6)")
+    ax.set_title(f"{scene}: popping per method (cf. Sheliemietiev et al. 2023 Fig. 6)")
     ax.legend()
     save(fig, path)
 
@@ -199,7 +199,7 @@ def fig5(scene, summary, path):
         ax.plot(n, med, marker="o", label=method[0])
     ax.set_xlabel("models")
     ax.set_ylabel("median GPU frame time, ms")
-    ax.set_title(f"{scene}: frame time against model count (cf. seed 003 Fig. 5)")
+    ax.set_title(f"{scene}: frame time against model count (cf. Sheliemietiev et al. 2023 Fig. 5)")
     ax.legend()
     save(fig, path)
 
@@ -214,7 +214,7 @@ def fig8(scene, summary, path):
     ax.set_xscale("log")
     ax.set_xlabel("viewport pixels")
     ax.set_ylabel("median GPU frame time, ms")
-    ax.set_title(f"{scene}: frame time against viewport size (cf. seed 000 Fig. 8)")
+    ax.set_title(f"{scene}: frame time against viewport size (cf. Scherzer & Wimmer 2008 Fig. 8)")
     ax.legend()
     save(fig, path)
 

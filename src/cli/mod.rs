@@ -193,7 +193,7 @@ pub struct SceneArgs {
     /// How k advances through a transition.
     #[arg(long, value_enum, default_value_t = FadeMode::Distance)]
     pub fade: FadeMode,
-    /// Half-width of the transition band as a fraction of the switch distance (seed 003 section 8).
+    /// Half-width of the transition band as a fraction of the switch distance (Sheliemietiev et al. 2023 section 8).
     #[arg(long, default_value_t = 0.05)]
     pub band: f32,
     /// Length of a time-based fade in frames (--fade time).

@@ -280,7 +280,7 @@ impl RunJob<'_> {
                 reference_ms,
                 cfg.dump_every,
                 &self.progress,
-                |f, (mi, r, x)| self.dump(&scene, &method, f, (mi, r, x)),
+                |f, images| self.dump(&scene, &method, f, images),
             )?;
             output.frames_csv.write_block(&out.rows)?;
             output.transitions.extend(out.transitions);
@@ -308,7 +308,7 @@ impl RunJob<'_> {
         scene: &Scene,
         method: &str,
         frame: u32,
-        (method_rgba, reference_rgba, extras): FrameImages<'_>,
+        frame_images: FrameImages<'_>,
     ) -> Result<()> {
         let Some(d) = &self.dumper else {
             return Ok(());
@@ -322,9 +322,9 @@ impl RunJob<'_> {
         let images = DumpImages {
             width: scene.width,
             height: scene.height,
-            method: method_rgba,
-            reference: reference_rgba,
-            extras,
+            method: frame_images.method,
+            reference: frame_images.reference,
+            extras: frame_images.extras,
         };
         d.write(&id, &images)
     }

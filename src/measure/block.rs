@@ -11,13 +11,19 @@ use crate::measure::metrics::Metric;
 use crate::measure::records::{
     near_transitions, transitions, BlockInfo, FrameRecord, TransitionPair,
 };
+use crate::methods::common::DumpKind;
 use crate::methods::{Build, Method, Registry};
 use crate::scene::Scene;
 use indicatif::ProgressBar;
 
-/// The images of one dumped quality-pass frame: the method's, the reference's, and the method's intermediate
-/// images (name, RGBA8).
-pub type FrameImages<'i> = (&'i [u8], &'i [u8], &'i [(&'i str, Vec<u8>)]);
+/// The images of one dumped quality-pass frame, RGBA8.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameImages<'i> {
+    pub method: &'i [u8],
+    pub reference: &'i [u8],
+    /// The intermediate images: the method's (FSI's LOD buffers) and lodpop's counterfactual frames.
+    pub extras: &'i [(DumpKind, Vec<u8>)],
+}
 
 /// Which quality-pass frames are handed to the caller's dump callback.
 #[derive(Debug, Clone, Copy)]

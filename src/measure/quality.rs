@@ -21,6 +21,7 @@ use crate::error::{Error, Result};
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::{GpuContext, RenderTarget, SceneGpu, TextureReadback};
 use crate::measure::metrics::{FrameMetrics, Metric, MetricReduction};
+use crate::methods::common::DumpKind;
 use crate::methods::{FrameInput, Method};
 use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
@@ -188,7 +189,7 @@ struct FrameReads {
     /// The frame goes to the dump callback.
     dump: bool,
     /// The method's intermediate images and the counterfactual frames (dumped frames only).
-    extras: Vec<(&'static str, TextureReadback)>,
+    extras: Vec<(DumpKind, TextureReadback)>,
 }
 
 /// What the pass carries from frame to frame.
@@ -412,7 +413,7 @@ impl BlockRunner<'_> {
             method
                 .debug_targets()
                 .into_iter()
-                .map(|(name, t)| (name, self.copy_of(encoder, name, t)))
+                .map(|(kind, t)| (kind, self.copy_of(encoder, kind, t)))
                 .collect()
         } else {
             Vec::new()
@@ -427,10 +428,10 @@ impl BlockRunner<'_> {
     fn copy_of(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        name: &str,
+        kind: DumpKind,
         t: &RenderTarget,
     ) -> TextureReadback {
-        let rb = TextureReadback::color(&self.ctx.device, name, t.width, t.height);
+        let rb = TextureReadback::color(&self.ctx.device, kind.name(), t.width, t.height);
         rb.encode_copy(encoder, t);
         rb
     }
@@ -475,13 +476,13 @@ impl BlockRunner<'_> {
         encoder: &mut wgpu::CommandEncoder,
         reads: &mut FrameReads,
     ) {
-        for (name, show, target) in [
-            ("lodpop-now", drawn.unlagged, &self.targets.now),
-            ("lodpop-before", drawn.changed, &self.targets.before),
+        for (kind, show, target) in [
+            (DumpKind::LodpopNow, drawn.unlagged, &self.targets.now),
+            (DumpKind::LodpopBefore, drawn.changed, &self.targets.before),
         ] {
             if show {
-                let rb = self.copy_of(encoder, name, target);
-                reads.extras.push((name, rb));
+                let rb = self.copy_of(encoder, kind, target);
+                reads.extras.push((kind, rb));
             }
         }
     }
@@ -512,9 +513,14 @@ impl BlockRunner<'_> {
                 let extras = reads
                     .extras
                     .iter()
-                    .map(|(name, rb)| Ok((*name, rb.read(ctx)?)))
+                    .map(|(kind, rb)| Ok((*kind, rb.read(ctx)?)))
                     .collect::<Result<Vec<_>>>()?;
-                on_frames(f, (&method_rgba, &reference_rgba, &extras))?;
+                let images = FrameImages {
+                    method: &method_rgba,
+                    reference: &reference_rgba,
+                    extras: &extras,
+                };
+                on_frames(f, images)?;
             }
             return Ok(());
         }

@@ -8,6 +8,49 @@ use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
 use glam::Mat4;
 
+/// The images of a quality-pass frame that `--dump-frames` writes, `<stem>_<kind>.png` (`results::png::FrameDumper::path`):
+/// the frames and the heat-map, and the intermediate images the quality pass and the methods hand over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DumpKind {
+    /// The method's frame.
+    Method,
+    /// The reference's frame.
+    Reference,
+    /// The heat-map of the method's frame against the reference's.
+    Error,
+    /// lodpop's counterfactuals: the frame with this frame's schedule, and with the previous frame's.
+    LodpopNow,
+    LodpopBefore,
+    /// FSI's two LOD buffers (the method's `debug_targets`).
+    LodBuffer0,
+    LodBuffer1,
+}
+
+impl DumpKind {
+    pub const ALL: [DumpKind; 7] = [
+        DumpKind::Method,
+        DumpKind::Reference,
+        DumpKind::Error,
+        DumpKind::LodpopNow,
+        DumpKind::LodpopBefore,
+        DumpKind::LodBuffer0,
+        DumpKind::LodBuffer1,
+    ];
+
+    /// The kind as the file name ends: `..._method.png`.
+    pub fn name(self) -> &'static str {
+        match self {
+            DumpKind::Method => "method",
+            DumpKind::Reference => "reference",
+            DumpKind::Error => "error",
+            DumpKind::LodpopNow => "lodpop-now",
+            DumpKind::LodpopBefore => "lodpop-before",
+            DumpKind::LodBuffer0 => "lodbuffer0",
+            DumpKind::LodBuffer1 => "lodbuffer1",
+        }
+    }
+}
+
 /// What a method gets for one frame.
 #[derive(Clone, Copy)]
 pub struct FrameInput<'a> {
@@ -46,7 +89,7 @@ pub trait Method {
     }
 
     /// Intermediate images worth seeing (`--dump-frames` writes them next to the frame): (name, target).
-    fn debug_targets(&self) -> Vec<(&'static str, &RenderTarget)> {
+    fn debug_targets(&self) -> Vec<(DumpKind, &RenderTarget)> {
         Vec::new()
     }
 

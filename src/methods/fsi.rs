@@ -46,7 +46,7 @@
 //!   `lod_to` in the other, same camera) and combines without reprojection: visibility textures without frame
 //!   sequencing.
 
-use super::common::{instance_raw_with, FrameInput, Method};
+use super::common::{instance_raw_with, DumpKind, FrameInput, Method};
 use crate::effects::shadow::Caster;
 use crate::error::Result;
 use crate::gpu::timing::GpuTimer;
@@ -1014,10 +1014,10 @@ impl Method for Fsi {
         }
     }
 
-    fn debug_targets(&self) -> Vec<(&'static str, &RenderTarget)> {
+    fn debug_targets(&self) -> Vec<(DumpKind, &RenderTarget)> {
         vec![
-            ("lodbuffer0", &self.buffers[0].target),
-            ("lodbuffer1", &self.buffers[1].target),
+            (DumpKind::LodBuffer0, &self.buffers[0].target),
+            (DumpKind::LodBuffer1, &self.buffers[1].target),
         ]
     }
 }

@@ -69,52 +69,8 @@ pub fn run_folder_of(out: &Path, variable: Option<&str>, value: Option<&str>) ->
     }
 }
 
-/// The kinds of image `--dump-frames` writes per frame, `<stem>_<kind>.png` (`FrameDumper::path`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum DumpKind {
-    /// The method's frame.
-    Method,
-    /// The reference's frame.
-    Reference,
-    /// The heat-map of the method's frame against the reference's.
-    Error,
-    /// lodpop's counterfactuals: the frame with this frame's schedule, and with the previous frame's.
-    LodpopNow,
-    LodpopBefore,
-    /// FSI's two LOD buffers (the method's `debug_targets`).
-    LodBuffer0,
-    LodBuffer1,
-}
-
-impl DumpKind {
-    pub const ALL: [DumpKind; 7] = [
-        DumpKind::Method,
-        DumpKind::Reference,
-        DumpKind::Error,
-        DumpKind::LodpopNow,
-        DumpKind::LodpopBefore,
-        DumpKind::LodBuffer0,
-        DumpKind::LodBuffer1,
-    ];
-
-    /// The kind as the file name ends: `..._method.png`.
-    pub fn name(self) -> &'static str {
-        match self {
-            DumpKind::Method => "method",
-            DumpKind::Reference => "reference",
-            DumpKind::Error => "error",
-            DumpKind::LodpopNow => "lodpop-now",
-            DumpKind::LodpopBefore => "lodpop-before",
-            DumpKind::LodBuffer0 => "lodbuffer0",
-            DumpKind::LodBuffer1 => "lodbuffer1",
-        }
-    }
-
-    /// The kind named `name` (as the quality pass and the methods name their extra images).
-    pub fn from_name(name: &str) -> Option<DumpKind> {
-        DumpKind::ALL.into_iter().find(|k| k.name() == name)
-    }
-}
+/// The kinds of image `--dump-frames` writes per frame (defined where the images are made).
+pub use crate::methods::common::DumpKind;
 
 /// The frames of a transition's clip (`lodbench clips`, `lodbench perceptual`, and what `--dump-transitions`
 /// dumps around it): from [`TRANSITION_LEAD`] before its first frame to [`TRANSITION_TAIL`] after its last.
@@ -177,11 +133,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn dump_kinds_read_back() {
-        for k in DumpKind::ALL {
-            assert_eq!(DumpKind::from_name(k.name()), Some(k));
-        }
-        assert_eq!(DumpKind::from_name("methods"), None);
+    fn dump_kinds_have_distinct_names() {
+        let mut names: Vec<&str> = DumpKind::ALL.iter().map(|k| k.name()).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), DumpKind::ALL.len());
     }
 
     #[test]

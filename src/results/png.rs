@@ -30,7 +30,7 @@ pub struct DumpImages<'a> {
     pub height: u32,
     pub method: &'a [u8],
     pub reference: &'a [u8],
-    pub extras: &'a [(&'a str, Vec<u8>)],
+    pub extras: &'a [(DumpKind, Vec<u8>)],
 }
 
 impl FrameDumper {
@@ -59,13 +59,10 @@ impl FrameDumper {
 
     /// In the dumps folder `frames`, the image `kind` of one frame.
     pub fn path(frames: &Path, id: &FrameId<'_>, kind: DumpKind) -> PathBuf {
-        Self::path_named(frames, id, kind.name())
-    }
-
-    fn path_named(frames: &Path, id: &FrameId<'_>, kind: &str) -> PathBuf {
         frames.join(format!(
-            "{}_{kind}.png",
-            Self::stem(id.scene, id.method, id.count, id.frame)
+            "{}_{}.png",
+            Self::stem(id.scene, id.method, id.count, id.frame),
+            kind.name()
         ))
     }
 
@@ -73,12 +70,8 @@ impl FrameDumper {
     /// error heat-map.
     pub fn write(&self, id: &FrameId<'_>, images: &DumpImages<'_>) -> Result<()> {
         let (width, height) = (images.width, images.height);
-        for (name, rgba) in images.extras {
-            debug_assert!(
-                DumpKind::from_name(name).is_some(),
-                "dump kind {name} is not a results::files::DumpKind"
-            );
-            save(&Self::path_named(&self.dir, id, name), width, height, rgba)?;
+        for (kind, rgba) in images.extras {
+            save(&Self::path(&self.dir, id, *kind), width, height, rgba)?;
         }
         let at = |kind: DumpKind| Self::path(&self.dir, id, kind);
         save(&at(DumpKind::Method), width, height, images.method)?;

@@ -296,18 +296,12 @@ pub fn render_frame(
     .unwrap();
     let mut out = None;
     block
-        .run_method(
-            method,
-            0,
-            1,
-            &indicatif::ProgressBar::hidden(),
-            |f, (m, _, _)| {
-                if f == frame {
-                    out = Some(m.to_vec());
-                }
-                Ok(())
-            },
-        )
+        .run_method(method, 0, 1, &indicatif::ProgressBar::hidden(), |f, img| {
+            if f == frame {
+                out = Some(img.method.to_vec());
+            }
+            Ok(())
+        })
         .unwrap();
     out.expect("the frame was rendered")
 }

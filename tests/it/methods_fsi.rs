@@ -299,8 +299,8 @@ fn a_no_transition_frames_match_discrete_bit_for_bit() {
         let mut frames = std::collections::HashMap::new();
         for method in ["discrete", "fsi"] {
             let out = block
-                .run_method(method, 0, 1, &ProgressBar::hidden(), |f, (m, _, _)| {
-                    frames.insert((method, f), m.to_vec());
+                .run_method(method, 0, 1, &ProgressBar::hidden(), |f, img| {
+                    frames.insert((method, f), img.method.to_vec());
                     Ok(())
                 })
                 .unwrap();

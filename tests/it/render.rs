@@ -187,8 +187,8 @@ fn gpu_metrics_match_cpu_oracle() {
     let mut oracle = SequenceMetrics::new();
     let mut cpu = Vec::new();
     let out = block
-        .run_method("discrete", 0, 1, &ProgressBar::hidden(), |_, (m, r, _)| {
-            cpu.push(oracle.frame(m, r));
+        .run_method("discrete", 0, 1, &ProgressBar::hidden(), |_, img| {
+            cpu.push(oracle.frame(img.method, img.reference));
             Ok(())
         })
         .unwrap();
@@ -251,9 +251,9 @@ fn snapshot_reference_frame() {
         BlockRunner::new(&ctx, &scene, Default::default(), true, &Default::default()).unwrap();
     let mut frame0 = None;
     block
-        .run_method("reference", 0, 1, &ProgressBar::hidden(), |f, (m, _, _)| {
+        .run_method("reference", 0, 1, &ProgressBar::hidden(), |f, img| {
             if f == 0 {
-                frame0 = Some(m.to_vec());
+                frame0 = Some(img.method.to_vec());
             }
             Ok(())
         })

@@ -43,8 +43,8 @@ fn bunny_halves_seam_leaves_no_crack_and_its_ablation_does() {
         let mut oracle = SequenceMetrics::new().with_cracks(scene.width, scene.height, background);
         let mut cpu = Vec::new();
         let out = block
-            .run_method(method, 0, 1, &ProgressBar::hidden(), |_, (m, r, _)| {
-                cpu.push(oracle.frame(m, r));
+            .run_method(method, 0, 1, &ProgressBar::hidden(), |_, img| {
+                cpu.push(oracle.frame(img.method, img.reference));
                 Ok(())
             })
             .unwrap();
