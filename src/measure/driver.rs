@@ -1,11 +1,25 @@
 //! A walk along a scene's path: the shared LOD schedule and the instance matrices of each frame, the same
 //! for every method.
 
+use crate::error::{Error, Result};
 use crate::measure::records::TransitionPair;
 use crate::methods::FrameInput;
 use crate::scene::schedule::{InstanceState, LodSchedule};
 use crate::scene::Scene;
 use glam::Mat4;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Set by the binary's signal handler; checked once per frame.
+pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// An error once the run was interrupted.
+pub(super) fn check_interrupt() -> Result<()> {
+    if INTERRUPTED.load(Ordering::Relaxed) {
+        Err(Error::Interrupted)
+    } else {
+        Ok(())
+    }
+}
 
 /// Walks a scene's frames in order: the shared LOD schedule and the instance matrices of each frame.
 pub struct FrameDriver<'s> {

@@ -11,6 +11,7 @@
 //!   image figure (the GPU kernels' oracle); `metric_kernel.rs`, `diff_kernel.rs`: the GPU reductions.
 
 pub mod block;
+pub mod context;
 pub mod diff_kernel;
 pub mod driver;
 pub mod effects;
@@ -21,55 +22,14 @@ pub mod records;
 pub mod stats;
 pub mod timing;
 
-pub use block::{BlockRunner, DumpPolicy, FrameImages};
+pub use block::{BlockOutput, BlockRunner};
+pub use context::{BlockGpu, MethodSetup};
 pub use driver::{FrameDriver, FrameFacts};
-pub use quality::QualityOptions;
+pub use quality::{DumpPolicy, FrameImages, QualityOptions, QualityStage};
 pub use records::{BlockRounds, Round};
 pub use timing::{
     reference_ms_per_frame, round_frames, shuffled_order, TimedMethod, Uploads, WarmUpPlan,
 };
 
-use crate::error::{Error, Result};
-use crate::measure::records::{BlockInfo, FrameRecord, TransitionRecord};
-use crate::methods::{MethodOptions, Registry};
-use std::sync::atomic::{AtomicBool, Ordering};
-
-/// Set by the binary's signal handler; checked once per frame.
-pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
-
-fn check_interrupt() -> Result<()> {
-    if INTERRUPTED.load(Ordering::Relaxed) {
-        Err(Error::Interrupted)
-    } else {
-        Ok(())
-    }
-}
-
-/// One method's measurement on one scene block.
-pub struct BlockOutput {
-    pub rows: Vec<FrameRecord>,
-    pub transitions: Vec<TransitionRecord>,
-    pub info: BlockInfo,
-}
-
-/// Which methods a block can run and what they are built with.
-#[derive(Clone)]
-pub struct MethodSetup {
-    pub registry: Registry,
-    pub options: MethodOptions,
-    /// `--seed`.
-    pub seed: u64,
-}
-
-impl Default for MethodSetup {
-    /// The built-in methods with every flag at its default (`--seed 1`).
-    fn default() -> Self {
-        MethodSetup {
-            registry: Registry::builtin(),
-            options: MethodOptions::default(),
-            seed: 1,
-        }
-    }
-}
-
 pub use crate::methods::is_reference;
+pub use driver::INTERRUPTED;

@@ -11,18 +11,18 @@
 //!
 //! The scalars of all frames are read back once at the end. FSI's combination pass is timed here.
 
-use super::block::{BlockRunner, FrameImages};
-use super::check_interrupt;
+use super::context::BlockGpu;
 use super::diff_kernel::DiffKernel;
+use super::driver::check_interrupt;
 use super::driver::FrameDriver;
-use super::effects::{Casters, ShadowRole};
+use super::effects::{Casters, ShadowRole, ShadowShare, TaaStreams};
 use super::metric_kernel::MetricKernel;
 use crate::error::{Error, Result};
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::{GpuContext, RenderTarget, SceneGpu, TextureReadback};
 use crate::measure::metrics::{FrameMetrics, Metric, MetricReduction};
 use crate::methods::common::DumpKind;
-use crate::methods::{FrameInput, Method};
+use crate::methods::{FrameInput, Method, Registry};
 use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
 use indicatif::ProgressBar;
@@ -128,6 +128,42 @@ pub struct QualityPass {
     pub metric_gpu_ms_median: Option<f64>,
 }
 
+/// The images of one dumped quality-pass frame, RGBA8.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameImages<'i> {
+    pub method: &'i [u8],
+    pub reference: &'i [u8],
+    /// The intermediate images: the method's (FSI's LOD buffers) and lodpop's counterfactual frames.
+    pub extras: &'i [(DumpKind, Vec<u8>)],
+}
+
+/// Which quality-pass frames are handed to the caller's dump callback.
+#[derive(Debug, Clone, Copy)]
+pub struct DumpPolicy {
+    /// Dump at all (the stage was built with read-back for it).
+    pub dump: bool,
+    /// Only frames with an instance in transition (`--dump-transitions`).
+    pub transitions_only: bool,
+}
+
+/// The quality pass's own GPU objects on a block, reused by every method measured on it.
+pub struct QualityStage {
+    targets: QualityTargets,
+    kernels: QualityKernels,
+    reference: Box<dyn Method>,
+    /// `--metrics de2000`: the kernel computes CIEDE2000 (else de2000_mean is empty).
+    pub de2000: bool,
+    /// Read back every quality-pass frame and compute FLIP on it.
+    flip: bool,
+    /// The method's and the reference's read-back, with `--metrics flip` or dumps.
+    readback: Option<[TextureReadback; 2]>,
+    pub dumps: DumpPolicy,
+    /// `--taa on`: the resolve and the two image streams.
+    taa: Option<TaaStreams>,
+    /// `--shadows on`: the shadow's own share of the error.
+    shadow_share: Option<ShadowShare>,
+}
+
 /// Keep at most this many quality-pass frames queued on the GPU.
 const QUALITY_IN_FLIGHT: usize = 2;
 
@@ -193,66 +229,97 @@ struct FrameReads {
 }
 
 /// What the pass carries from frame to frame.
-struct Walk {
+struct Walk<'d> {
+    /// Per frame, whether it goes to the dump callback.
+    dump_frames: &'d [bool],
     history: StateHistory,
     in_flight: VecDeque<wgpu::SubmissionIndex>,
     flip: Vec<Option<f64>>,
     has_lag: bool,
 }
 
-impl BlockRunner<'_> {
+impl QualityStage {
+    /// `dump`: hand frames to the pass's callback.
+    pub fn new(base: &BlockGpu<'_>, dump: bool, quality: &QualityOptions) -> Result<QualityStage> {
+        let (ctx, scene) = (base.ctx, base.scene);
+        let flip = quality.metrics.contains(&Metric::Flip);
+        let (w, h) = (scene.width, scene.height);
+        let targets = QualityTargets::new(ctx, w, h);
+        let kernels = QualityKernels::new(ctx, &base.gpu, scene, &targets, quality)?;
+        let reference = Registry::builtin().create("reference", &base.build())?;
+        let readback = (dump || flip).then(|| {
+            [
+                TextureReadback::color(&ctx.device, "method read-back", w, h),
+                TextureReadback::color(&ctx.device, "reference read-back", w, h),
+            ]
+        });
+        let shadow_share = match scene.shadows {
+            None => None,
+            Some(_) => Some(ShadowShare::new(ctx, scene, &targets.reference)?),
+        };
+        Ok(QualityStage {
+            taa: TaaStreams::new(ctx, scene),
+            shadow_share,
+            targets,
+            kernels,
+            reference,
+            de2000: quality.metrics.contains(&Metric::De2000),
+            flip,
+            readback,
+            dumps: DumpPolicy {
+                dump,
+                transitions_only: false,
+            },
+        })
+    }
+
     /// The quality pass of `method` walking `driver`; `dump_frames`: per frame, whether it goes to `on_frames`.
-    pub(super) fn quality_pass(
+    pub(super) fn pass(
         &mut self,
+        base: &BlockGpu<'_>,
         method: &mut dyn Method,
         driver: &mut FrameDriver<'_>,
         dump_frames: &[bool],
         progress: &ProgressBar,
         on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<QualityPass> {
-        let frames = self.scene.frames;
+        let frames = base.scene.frames;
         driver.reset();
         let mut walk = Walk {
+            dump_frames,
             history: StateHistory::new(method.lodpop_history().max(1)),
             in_flight: VecDeque::new(),
             flip: vec![None; frames as usize],
             has_lag: false,
         };
         let pass_start = Instant::now();
-        if let Some(taa) = &mut self.effects.taa {
+        if let Some(taa) = &mut self.taa {
             taa.reset();
         }
         for f in 0..frames {
             check_interrupt()?;
             driver.advance(f);
-            self.quality_frame(
-                method,
-                driver,
-                f,
-                dump_frames[f as usize],
-                &mut walk,
-                on_frames,
-            )?;
+            self.quality_frame(base, method, driver, f, &mut walk, on_frames)?;
             progress.inc(1);
         }
-        self.ctx.wait_idle()?;
+        base.ctx.wait_idle()?;
         let ms_per_frame = pass_start.elapsed().as_secs_f64() * 1e3 / frames as f64;
-        self.read_figures(method, walk, ms_per_frame)
+        self.read_figures(base, method, walk, ms_per_frame)
     }
 
     /// One frame of the quality pass, through every stage.
     fn quality_frame(
         &mut self,
+        base: &BlockGpu<'_>,
         method: &mut dyn Method,
         driver: &FrameDriver<'_>,
         f: u32,
-        dump: bool,
-        walk: &mut Walk,
+        walk: &mut Walk<'_>,
         on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<()> {
-        let ctx = self.ctx;
-        self.write_frame(f);
-        if let Some(taa) = &self.effects.taa {
+        let (ctx, dump) = (base.ctx, walk.dump_frames[f as usize]);
+        base.write_frame(f);
+        if let Some(taa) = &self.taa {
             taa.begin_frame(ctx);
         }
         let input = driver.input(f);
@@ -260,35 +327,35 @@ impl BlockRunner<'_> {
         if f == 0 {
             self.clear_kernels(&mut encoder);
         }
-        self.render_frames(method, &input, &mut encoder);
-        let shadows = self.shadow_maps(method, &input, walk.history.previous());
-        self.apply_effects(&input, &mut encoder, f);
-        self.encode_metrics(&mut encoder, f);
-        let mut reads = self.request_reads(method, &mut encoder, dump);
+        self.render_frames(base, method, &input, &mut encoder);
+        let shadows = self.shadow_maps(base, method, &input, walk.history.previous());
+        self.apply_effects(base, &input, &mut encoder, f);
+        self.encode_metrics(base, &mut encoder, f);
+        let mut reads = self.request_reads(base, method, &mut encoder, dump);
         let mut index = ctx
             .queue
             .submit(shadows.into_iter().chain([encoder.finish()]));
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         walk.history.push(&driver.states);
-        let drawn = self.counterfactuals(method, &input, &walk.history, &mut encoder, f);
+        let drawn = self.counterfactuals(base, method, &input, &walk.history, &mut encoder, f);
         walk.has_lag |= drawn.unlagged;
         if reads.dump {
-            self.request_counterfactual_reads(drawn, &mut encoder, &mut reads);
+            self.request_counterfactual_reads(base, drawn, &mut encoder, &mut reads);
         }
         if drawn.unlagged || drawn.changed {
             index = ctx.queue.submit([encoder.finish()]);
         }
-        if let Some(taa) = &mut self.effects.taa {
+        if let Some(taa) = &mut self.taa {
             taa.advance();
         }
-        self.collect_frame(f, reads, index, walk, on_frames)
+        self.collect_frame(base, f, reads, index, walk, on_frames)
     }
 
     /// lodpop's, the lag's and the shadow share's accumulators, before the first frame.
     fn clear_kernels(&self, encoder: &mut wgpu::CommandEncoder) {
         self.kernels.lodpop.clear(encoder);
         self.kernels.lag.clear(encoder);
-        if let Some(share) = &self.effects.shadow_share {
+        if let Some(share) = &self.shadow_share {
             share.rmse.clear(encoder);
             share.lodpop.clear(encoder);
         }
@@ -297,11 +364,12 @@ impl BlockRunner<'_> {
     /// Stage 1: the reference and the method, each lit by its own shadow map.
     fn render_frames(
         &mut self,
+        base: &BlockGpu<'_>,
         method: &mut dyn Method,
         input: &FrameInput<'_>,
         encoder: &mut wgpu::CommandEncoder,
     ) {
-        let (gpu, t, reference) = (&self.gpu, &self.targets, &mut self.reference);
+        let (gpu, t, reference) = (&base.gpu, &self.targets, &mut self.reference);
         gpu.lit_by(ShadowRole::Reference.map(), || {
             reference.encode(gpu, input, encoder, &t.reference)
         });
@@ -314,14 +382,15 @@ impl BlockRunner<'_> {
     /// lodpop's counterfactual, what the method cast with the `previous` frame's states.
     fn shadow_maps(
         &self,
+        base: &BlockGpu<'_>,
         method: &dyn Method,
         input: &FrameInput<'_>,
         previous: Option<&[InstanceState]>,
     ) -> Vec<wgpu::CommandBuffer> {
-        let Some(shadows) = &self.effects.shadows else {
+        let Some(shadows) = &base.shadows else {
             return Vec::new();
         };
-        let gpu = &self.gpu;
+        let gpu = &base.gpu;
         let mut out = vec![
             shadows.commands(
                 gpu,
@@ -355,15 +424,16 @@ impl BlockRunner<'_> {
     /// (resolved against the reference's history under TAA, which they leave as it is).
     fn apply_effects(
         &mut self,
+        base: &BlockGpu<'_>,
         input: &FrameInput<'_>,
         encoder: &mut wgpu::CommandEncoder,
         f: u32,
     ) {
-        let (ctx, gpu, t, reference) = (self.ctx, &self.gpu, &self.targets, &mut self.reference);
-        if let Some(taa) = &self.effects.taa {
+        let (ctx, gpu, t, reference) = (base.ctx, &base.gpu, &self.targets, &mut self.reference);
+        if let Some(taa) = &self.taa {
             taa.resolve_frames(ctx, encoder, &t.method, &t.reference);
         }
-        let Some(share) = &self.effects.shadow_share else {
+        let Some(share) = &self.shadow_share else {
             return;
         };
         for (role, target) in [
@@ -371,7 +441,7 @@ impl BlockRunner<'_> {
             (ShadowRole::Before, &share.before),
         ] {
             gpu.lit_by(role.map(), || reference.encode(gpu, input, encoder, target));
-            if let Some(taa) = &self.effects.taa {
+            if let Some(taa) = &self.taa {
                 taa.resolve_reference_counterfactual(ctx, encoder, target);
             }
         }
@@ -382,12 +452,12 @@ impl BlockRunner<'_> {
     }
 
     /// Stage 4: the metric kernel on (method, reference), timed on its own.
-    fn encode_metrics(&self, encoder: &mut wgpu::CommandEncoder, f: u32) {
+    fn encode_metrics(&self, base: &BlockGpu<'_>, encoder: &mut wgpu::CommandEncoder, f: u32) {
         let k = &self.kernels;
         if let Some(t) = &k.metric_timer {
             t.begin(encoder, f);
         }
-        k.metric.encode(&self.ctx.queue, encoder, f);
+        k.metric.encode(&base.ctx.queue, encoder, f);
         if let Some(t) = &k.metric_timer {
             t.end(encoder, f);
         }
@@ -397,6 +467,7 @@ impl BlockRunner<'_> {
     /// buffers) for a dump.
     fn request_reads(
         &self,
+        base: &BlockGpu<'_>,
         method: &dyn Method,
         encoder: &mut wgpu::CommandEncoder,
         dump: bool,
@@ -413,7 +484,7 @@ impl BlockRunner<'_> {
             method
                 .debug_targets()
                 .into_iter()
-                .map(|(kind, t)| (kind, self.copy_of(encoder, kind, t)))
+                .map(|(kind, t)| (kind, self.copy_of(base, encoder, kind, t)))
                 .collect()
         } else {
             Vec::new()
@@ -427,11 +498,12 @@ impl BlockRunner<'_> {
 
     fn copy_of(
         &self,
+        base: &BlockGpu<'_>,
         encoder: &mut wgpu::CommandEncoder,
         kind: DumpKind,
         t: &RenderTarget,
     ) -> TextureReadback {
-        let rb = TextureReadback::color(&self.ctx.device, kind.name(), t.width, t.height);
+        let rb = TextureReadback::color(&base.ctx.device, kind.name(), t.width, t.height);
         rb.encode_copy(encoder, t);
         rb
     }
@@ -440,14 +512,15 @@ impl BlockRunner<'_> {
     /// writes its instance data again through the queue, so this goes in a submission of its own).
     fn counterfactuals(
         &self,
+        base: &BlockGpu<'_>,
         method: &mut dyn Method,
         input: &FrameInput<'_>,
         history: &StateHistory,
         encoder: &mut wgpu::CommandEncoder,
         f: u32,
     ) -> Counterfactuals {
-        let (ctx, gpu, t, k) = (self.ctx, &self.gpu, &self.targets, &self.kernels);
-        let taa = self.effects.taa.as_ref();
+        let (ctx, gpu, t, k) = (base.ctx, &base.gpu, &self.targets, &self.kernels);
+        let taa = self.taa.as_ref();
         let unlagged = method.encode_unlagged(gpu, input, encoder, &t.now);
         if unlagged {
             if let Some(taa) = taa {
@@ -472,6 +545,7 @@ impl BlockRunner<'_> {
     /// With a dump: the counterfactual frames drawn this frame, for read-back.
     fn request_counterfactual_reads(
         &self,
+        base: &BlockGpu<'_>,
         drawn: Counterfactuals,
         encoder: &mut wgpu::CommandEncoder,
         reads: &mut FrameReads,
@@ -481,7 +555,7 @@ impl BlockRunner<'_> {
             (DumpKind::LodpopBefore, drawn.changed, &self.targets.before),
         ] {
             if show {
-                let rb = self.copy_of(encoder, kind, target);
+                let rb = self.copy_of(base, encoder, kind, target);
                 reads.extras.push((kind, rb));
             }
         }
@@ -491,13 +565,14 @@ impl BlockRunner<'_> {
     /// bound on the frames queued on the GPU.
     fn collect_frame(
         &self,
+        base: &BlockGpu<'_>,
         f: u32,
         reads: FrameReads,
         index: wgpu::SubmissionIndex,
-        walk: &mut Walk,
+        walk: &mut Walk<'_>,
         on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<()> {
-        let ctx = self.ctx;
+        let ctx = base.ctx;
         if let (true, Some([m, r])) = (reads.frames, &self.readback) {
             let method_rgba = m.read(ctx)?;
             let reference_rgba = r.read(ctx)?;
@@ -505,8 +580,8 @@ impl BlockRunner<'_> {
                 walk.flip[f as usize] = Some(crate::measure::metrics::flip_mean(
                     &method_rgba,
                     &reference_rgba,
-                    self.scene.width,
-                    self.scene.height,
+                    base.scene.width,
+                    base.scene.height,
                 ));
             }
             if reads.dump {
@@ -541,12 +616,13 @@ impl BlockRunner<'_> {
     /// After the last frame: every kernel's per-frame figures, read back once.
     fn read_figures(
         &self,
+        base: &BlockGpu<'_>,
         method: &dyn Method,
         walk: Walk,
         ms_per_frame: f64,
     ) -> Result<QualityPass> {
-        let (ctx, k, frames) = (self.ctx, &self.kernels, self.scene.frames);
-        let shadow = match &self.effects.shadow_share {
+        let (ctx, k, frames) = (base.ctx, &self.kernels, base.scene.frames);
+        let shadow = match &self.shadow_share {
             Some(share) => Some(ShadowFigures {
                 rmse: share.rmse.read(ctx, frames)?,
                 lodpop: share.lodpop.read(ctx, frames)?,

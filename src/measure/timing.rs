@@ -9,14 +9,15 @@
 //!   frame is submitted and waited for, so `cpu_ms` is a true encode-to-completion time and frames never
 //!   overlap; GPU timestamps are resolved into one buffer per method and read once after the rounds.
 
-use super::block::BlockRunner;
+use super::context::BlockGpu;
+use super::driver::check_interrupt;
 use super::driver::{FrameDriver, FrameFacts};
 use super::effects::{Casters, ShadowRole};
-use super::{check_interrupt, is_reference};
 use crate::error::Result;
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::DrawStats;
 use crate::measure::records::{BlockRounds, Round, TransitionPair};
+use crate::methods::is_reference;
 use crate::methods::{FrameInput, Method, MethodEntry};
 use crate::rng::SplitMix64;
 use crate::scene::Scene;
@@ -117,7 +118,7 @@ pub fn shuffled_order(n: usize, rng: &mut SplitMix64) -> Vec<usize> {
     order
 }
 
-impl<'a> BlockRunner<'a> {
+impl<'a> BlockGpu<'a> {
     /// Creates the methods `labels` (a label `NAME#k` is another instance of NAME), warms each up
     /// ([`WarmUpPlan`]), then times them in `rounds` interleaved rounds: round r times every method over the
     /// frames [`round_frames`]`(r)`, in an order shuffled from `seed`, each method continuing its own walk along
@@ -240,7 +241,7 @@ impl<'a> BlockRunner<'a> {
         } else {
             Casters::Method
         };
-        let shadows = self.effects.shadows.as_ref()?;
+        let shadows = self.shadows.as_ref()?;
         Some(shadows.commands(
             &self.gpu,
             m.method.as_ref(),

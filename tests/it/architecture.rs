@@ -173,6 +173,8 @@ impl<'ast> Visit<'ast> for Refs<'_> {
     fn visit_item_use(&mut self, u: &'ast syn::ItemUse) {
         self.use_tree(Vec::new(), &u.tree);
     }
+    // `pub(super)` and `pub(in path)` name who may see an item, not what it uses.
+    fn visit_visibility(&mut self, _: &'ast syn::Visibility) {}
     fn visit_path(&mut self, p: &'ast syn::Path) {
         self.add(p.segments.iter().map(|s| s.ident.to_string()).collect());
         syn::visit::visit_path(self, p);
