@@ -11,16 +11,18 @@ ROOT = Path(__file__).resolve().parents[2]
 
 @functools.lru_cache(maxsize=1)
 def lodbench_binary() -> Path:
-    """LODBENCH_BIN, or the binary `cargo test` builds (target/debug/lodbench, the README's test command builds it
-    just before pytest), brought up to date with `cargo test --no-run` (the same build, a no-op when fresh), so the
-    scripts are never tested against an older or a release binary."""
+    """LODBENCH_BIN, or the binary `cargo test --release` builds (target/release/lodbench, the README's test command
+    builds it just before pytest), brought up to date with `cargo test --release --no-run` (the same build, a no-op
+    when fresh), so the scripts are never tested against an older binary."""
     if os.environ.get("LODBENCH_BIN"):
         return Path(os.environ["LODBENCH_BIN"])
     target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
     if not target.is_absolute():
         target = ROOT / target
-    subprocess.run(["cargo", "test", "--no-run", "--quiet"], cwd=ROOT, check=True, capture_output=True)
-    return target / "debug" / "lodbench"
+    subprocess.run(
+        ["cargo", "test", "--release", "--no-run", "--quiet"], cwd=ROOT, check=True, capture_output=True
+    )
+    return target / "release" / "lodbench"
 
 
 def lodbench(*args: str) -> None:
