@@ -69,6 +69,7 @@ write_conf() {
     local cpus gpus port
     cpus=$(nproc)
     gpus=${LOCAL_SLURM_GPUS:-$cpus}
+    [[ $gpus =~ ^[1-9][0-9]*$ ]] || { say "LOCAL_SLURM_GPUS must be a count of at least 1, not '$gpus'"; exit 2; }
     port=${LOCAL_SLURM_PORT:-16817}
     while ! port_free "$port" || ! port_free $((port + 1)); do
         port=$((port + 2))
