@@ -18,8 +18,8 @@ if [[ -z $lodbench ]]; then
     cargo build --release --quiet
     lodbench=target/release/lodbench
 fi
-# The first adapter `lodbench list` prints is the one the runs use.
-best=$("$lodbench" list | sed -n '/^adapters/{n;p;q;}')
+# The first adapter `lodbench list` prints (index 0) is the one the runs use; the index is left out of the line.
+best=$("$lodbench" list | sed -n '/^adapters/{n;s/^ *[0-9][0-9]*  //;p;q;}')
 case $best in
     '' | *", Cpu,"*)
         echo "error: the best adapter is a software one (${best:-none found}): the GPU suite needs a GPU" >&2

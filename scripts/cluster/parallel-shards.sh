@@ -2,8 +2,9 @@
 # One machine, several GPUs: one shard of a lodbench experiment per adapter with GNU parallel, then the merge
 # (docs/cluster.md).
 #   scripts/cluster/parallel-shards.sh EXPERIMENT OUT ADAPTER [ADAPTER ...]
-# ADAPTER is a part of an adapter's name as `lodbench list` prints it; give one per shard (the same name twice
-# runs two shards on one adapter). LODBENCH names the binary (default target/release/lodbench).
+# ADAPTER is an adapter's index (0-based, as `lodbench list` prints them; it tells identical GPUs apart) or a
+# part of its name; give one per shard (`0 1 2 3` on a node of four GPUs; the same one twice runs two shards on
+# one adapter). LODBENCH names the binary (default target/release/lodbench).
 set -euo pipefail
 if (($# < 3)); then
     echo "usage: $0 EXPERIMENT OUT ADAPTER [ADAPTER ...]" >&2

@@ -117,6 +117,8 @@ pub struct RunConfig {
     pub metrics: Vec<Metric>,
     pub metric_reduction: MetricReduction,
     pub out: Option<PathBuf>,
+    /// `--adapter`: an index into `lodbench list`'s adapters or a part of a name (run.json's `adapter` records
+    /// the one chosen, with its `index`).
     pub adapter: Option<String>,
     pub dump_frames: bool,
     pub dump_every: u32,

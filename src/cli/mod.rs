@@ -119,9 +119,9 @@ pub struct ExperimentArgs {
     /// (an interrupted or failed experiment, rerun).
     #[arg(long)]
     pub resume: bool,
-    /// Run every run on the adapter whose name contains this (overrides the file's `adapter`): one GPU per
-    /// shard on a machine with several.
-    #[arg(long)]
+    /// Run every run on this adapter (overrides the file's `adapter`): an index, 0-based in the order `lodbench
+    /// list` prints, or a part of its name (case-insensitive); one GPU per shard on a machine with several.
+    #[arg(long, value_name = "INDEX|NAME")]
     pub adapter: Option<String>,
     /// Override a `[run]` key of the file in every run: `--set frames=300` (VALUE in TOML syntax; repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -264,8 +264,10 @@ pub struct RunArgs {
     /// Output folder (default results/<scene>-<time>/).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Use the adapter whose name contains this (case-insensitive).
-    #[arg(long)]
+    /// The adapter to run on: an index (0-based, in the order `lodbench list` prints them, best first), which
+    /// tells identical GPUs apart, or a part of its name (case-insensitive); the best one when absent.
+    #[arg(long, value_name = "INDEX|NAME")]
+    #[serde(deserialize_with = "name_or_index")]
     pub adapter: Option<String>,
     /// Write PNGs of the method frame, the reference frame and an error heat-map.
     #[arg(long)]
@@ -283,6 +285,23 @@ impl Default for RunArgs {
     fn default() -> Self {
         crate::defaults::clap_defaults()
     }
+}
+
+/// `adapter` in a file: a name (`adapter = "H100"`) or an index (`adapter = 1`), as `--adapter` takes either.
+fn name_or_index<'de, D>(d: D) -> Result<Option<String>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum NameOrIndex {
+        Index(u64),
+        Name(String),
+    }
+    Ok(Some(match NameOrIndex::deserialize(d)? {
+        NameOrIndex::Index(i) => i.to_string(),
+        NameOrIndex::Name(n) => n,
+    }))
 }
 
 /// A list flag in a file: a single value or an array (`count = 50` or `count = [50, 250]`), as on the command
@@ -358,6 +377,11 @@ mod tests {
             set.method_options.fsi.fsi_check,
             crate::methods::fsi::FsiCheck::Forward
         );
+        // `adapter` takes an index or a name, as --adapter does.
+        let set: RunArgs = toml::from_str("adapter = 1").unwrap();
+        assert_eq!(set.adapter.as_deref(), Some("1"));
+        let set: RunArgs = toml::from_str("adapter = \"H100\"").unwrap();
+        assert_eq!(set.adapter.as_deref(), Some("H100"));
     }
 
     #[test]

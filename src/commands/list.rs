@@ -5,7 +5,8 @@ use crate::gpu;
 use crate::methods;
 use crate::scene::SceneKind;
 
-/// Prints the scenes, the methods with what each does, and the adapters found (best first).
+/// Prints the scenes, the methods with what each does, and the adapters found (best first), each after its
+/// index (what `--adapter INDEX` names).
 pub fn execute() -> Result<()> {
     outln!("scenes:  {}", SceneKind::names().join(", "));
     outln!("methods:");
@@ -18,12 +19,12 @@ pub fn execute() -> Result<()> {
         outln!("  {}", gpu::context::NO_ADAPTER_HELP);
         return Ok(());
     }
-    outln!("adapters (best first; `--adapter SUBSTRING` picks one):");
-    for a in adapters {
+    outln!("adapters (best first; `--adapter INDEX` or `--adapter SUBSTRING` picks one):");
+    for (index, a) in adapters.iter().enumerate() {
         let i = a.get_info();
         let ts = a.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         outln!(
-            "  {}  [{:?}, {:?}, driver {} {}{}]",
+            "  {index}  {}  [{:?}, {:?}, driver {} {}{}]",
             i.name,
             i.backend,
             i.device_type,

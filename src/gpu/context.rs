@@ -7,6 +7,9 @@ use std::sync::{Arc, Mutex};
 /// The adapter facts recorded in run.json and printed by `lodbench list`.
 #[derive(Debug, Clone, Serialize)]
 pub struct AdapterSummary {
+    /// The adapter's place (0-based) in the list [`enumerate_adapters`] returns and `lodbench list` prints:
+    /// what `--adapter INDEX` names.
+    pub index: usize,
     pub name: String,
     pub backend: String,
     pub device_type: String,
@@ -14,9 +17,11 @@ pub struct AdapterSummary {
     pub driver_info: String,
 }
 
-impl From<&wgpu::AdapterInfo> for AdapterSummary {
-    fn from(i: &wgpu::AdapterInfo) -> Self {
+impl AdapterSummary {
+    /// The facts of the `index`-th adapter of [`enumerate_adapters`].
+    pub fn new(index: usize, i: &wgpu::AdapterInfo) -> Self {
         AdapterSummary {
+            index,
             name: i.name.clone(),
             backend: format!("{:?}", i.backend).to_lowercase(),
             device_type: format!("{:?}", i.device_type),
@@ -75,31 +80,59 @@ pub fn enumerate_adapters() -> Vec<wgpu::Adapter> {
     adapters
 }
 
+/// The adapter `--adapter` names among `found` (as [`enumerate_adapters`] lists them, best first): an index
+/// (a whole number, 0-based, the order `lodbench list` prints), or else the first whose name contains the text
+/// (case-insensitive); the best one (index 0) without the flag. `found` must not be empty.
+pub fn choose_adapter(found: &[AdapterSummary], spec: Option<&str>) -> Result<usize> {
+    let listing = || {
+        found
+            .iter()
+            .enumerate()
+            .map(|(i, a)| format!("{i} {}", a.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let Some(spec) = spec.map(str::trim) else {
+        return Ok(0);
+    };
+    if let Ok(index) = spec.parse::<usize>() {
+        return if index < found.len() {
+            Ok(index)
+        } else {
+            Err(Error::NoAdapter(format!(
+                "--adapter {index}: no adapter has index {index}; found {} (0-based, as `lodbench list` \
+                 prints them): {}",
+                found.len(),
+                listing()
+            )))
+        };
+    }
+    let needle = spec.to_lowercase();
+    found
+        .iter()
+        .position(|a| a.name.to_lowercase().contains(&needle))
+        .ok_or_else(|| {
+            Error::NoAdapter(format!(
+                "--adapter {spec}: no adapter name contains '{spec}'; found: {}",
+                listing()
+            ))
+        })
+}
+
 impl GpuContext {
-    /// Opens the best adapter, or the first whose name contains `filter` (case-insensitive).
-    pub fn new(filter: Option<&str>) -> Result<GpuContext> {
+    /// Opens the adapter `--adapter` names ([`choose_adapter`]: an index or a part of a name), or the best.
+    pub fn new(spec: Option<&str>) -> Result<GpuContext> {
         let adapters = enumerate_adapters();
         if adapters.is_empty() {
             return Err(Error::NoAdapter(NO_ADAPTER_HELP.into()));
         }
-        let adapter = match filter {
-            Some(f) => {
-                let needle = f.to_lowercase();
-                adapters
-                    .iter()
-                    .find(|a| a.get_info().name.to_lowercase().contains(&needle))
-                    .cloned()
-                    .ok_or_else(|| {
-                        let names: Vec<String> =
-                            adapters.iter().map(|a| a.get_info().name).collect();
-                        Error::NoAdapter(format!(
-                            "no adapter name contains '{f}'; found: {}",
-                            names.join(", ")
-                        ))
-                    })?
-            }
-            None => adapters[0].clone(),
-        };
+        let found: Vec<AdapterSummary> = adapters
+            .iter()
+            .enumerate()
+            .map(|(i, a)| AdapterSummary::new(i, &a.get_info()))
+            .collect();
+        let index = choose_adapter(&found, spec)?;
+        let adapter = adapters[index].clone();
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let required_features = if timestamps {
@@ -127,7 +160,7 @@ impl GpuContext {
         }));
         let timestamp_period_ns = queue.get_timestamp_period();
         Ok(GpuContext {
-            info: AdapterSummary::from(&info),
+            info: found[index].clone(),
             adapter,
             device,
             queue,
@@ -219,5 +252,58 @@ impl GpuContext {
         };
         buffer.unmap();
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn found(names: &[&str]) -> Vec<AdapterSummary> {
+        names
+            .iter()
+            .enumerate()
+            .map(|(index, n)| AdapterSummary {
+                index,
+                name: n.to_string(),
+                backend: "vulkan".into(),
+                device_type: "DiscreteGpu".into(),
+                driver: String::new(),
+                driver_info: String::new(),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn an_index_or_a_name_chooses_the_adapter() {
+        // A node of identical GPUs: names cannot tell them apart, indices can.
+        let f = found(&["NVIDIA H100", "NVIDIA H100", "llvmpipe (LLVM 19)"]);
+        assert_eq!(choose_adapter(&f, None).unwrap(), 0);
+        assert_eq!(choose_adapter(&f, Some("1")).unwrap(), 1);
+        assert_eq!(choose_adapter(&f, Some(" 2 ")).unwrap(), 2);
+        assert_eq!(choose_adapter(&f, Some("h100")).unwrap(), 0);
+        assert_eq!(choose_adapter(&f, Some("LLVMpipe")).unwrap(), 2);
+    }
+
+    #[test]
+    fn an_index_out_of_range_names_the_flag_the_index_and_the_adapters() {
+        let f = found(&["NVIDIA H100", "NVIDIA H100"]);
+        let e = choose_adapter(&f, Some("2")).unwrap_err().to_string();
+        for needle in [
+            "--adapter 2",
+            "index 2",
+            "found 2",
+            "0 NVIDIA H100",
+            "1 NVIDIA H100",
+        ] {
+            assert!(e.contains(needle), "'{needle}' not in: {e}");
+        }
+        let e = choose_adapter(&f, Some("radeon")).unwrap_err().to_string();
+        assert!(
+            e.contains("--adapter radeon") && e.contains("0 NVIDIA H100"),
+            "{e}"
+        );
+        // A negative number is no index: it is looked for in the names.
+        assert!(choose_adapter(&f, Some("-1")).is_err());
     }
 }

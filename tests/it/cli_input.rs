@@ -431,3 +431,61 @@ fn unified_scenes_and_methods_reject_what_does_not_fit() {
     let out = lodbench(&["describe", "--scene", "terrain", "--mesh", &flat], &[]);
     fails_with(&out, &["flat.obj"]);
 }
+
+/// `--adapter` takes an index, 0-based in the order `lodbench list` prints the adapters (identical GPUs differ
+/// only in it), as well as a part of a name; run.json records the adapter chosen with its index. An index out
+/// of range is one error naming the flag, the index and the adapters found.
+#[test]
+fn adapter_by_index() {
+    let list = lodbench(&["list"], &[]);
+    let text = String::from_utf8_lossy(&list.stdout).to_string();
+    let adapters: Vec<&str> = text
+        .lines()
+        .skip_while(|l| !l.starts_with("adapters"))
+        .skip(1)
+        .collect();
+    assert!(adapters[0].starts_with("  0  "), "{text}");
+    let first = adapters[0]["  0  ".len()..].split("  [").next().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let run = |adapter: &str, out: &str| {
+        let out = dir.path().join(out);
+        let o = lodbench(
+            &[
+                "run",
+                "--scene",
+                "bunny-sweep",
+                "--method",
+                "discrete",
+                "--frames",
+                "2",
+                "--width",
+                "32",
+                "--height",
+                "24",
+                "--adapter",
+                adapter,
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        (o, out)
+    };
+    let (o, out) = run("0", "zero");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(manifest["adapter"]["index"], 0);
+    assert_eq!(manifest["adapter"]["name"], first);
+    assert_eq!(manifest["config"]["adapter"], "0");
+    let beyond = adapters.len().to_string();
+    let (o, _) = run(&beyond, "beyond");
+    fails_with(
+        &o,
+        &[
+            &format!("--adapter {beyond}"),
+            &format!("index {beyond}"),
+            &format!("0 {first}"),
+        ],
+    );
+}
