@@ -493,7 +493,8 @@ def report(folder: Path, transition: str = "worst") -> list:
         if len(counts) > 1:
             fig5(scene, scene_summary, figs / f"fig5_{scene}.png")
             made.append((f"fig5_{scene}.png", f"{scene}: median GPU frame time against model count"))
-        moving = any(float(r["pop"]) > 0 for r in scene_frames)
+        # A run without the quality pass (--quality off) has empty image figures: no popping figures, no cost one.
+        moving = any(num(r["pop"]) > 0 for r in scene_frames)
         if moving:
             first_count = counts[0]
             by_method = group([r for r in scene_frames if r["count"] == first_count], "method")
@@ -518,8 +519,9 @@ def report(folder: Path, transition: str = "worst") -> list:
                     made.append((f"contact_{scene}.png", f"{scene}: frames around transition {episode} of the path"))
                 if fsi_buffers(scene, folder / "frames", by_method, figs / f"fsi_buffers_{scene}.png") is not None:
                     made.append((f"fsi_buffers_{scene}.png", f"{scene}: FSI's two LOD buffers and the combined frame"))
-        cost(scene, scene_summary, figs / f"cost_{scene}.png")
-        made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
+        if any(r["rmse_mean"] != "" for r in scene_summary):
+            cost(scene, scene_summary, figs / f"cost_{scene}.png")
+            made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
     columns = ([variable] if variable else []) + ["scene", "method", "count", "frames", "gpu_ms_median",
                "gpu_ms_median_transition", "ratio_to_baseline", "ratio_to_baseline_ci95_lo", "ratio_to_baseline_ci95_hi",
                "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",

@@ -6,6 +6,8 @@ from pathlib import Path
 
 from PIL import Image
 
+from conftest import lodbench
+
 SCRIPT = Path(__file__).resolve().parents[1] / "plot.py"
 
 
@@ -35,6 +37,19 @@ def test_sweep_folder(dump, tmp_path):
     assert "| bunny-sweep | fsi |" in report
     assert "## bunny-sweep: max lodpop (pose held) of each transition (its frames and the 2 after)" in report
     assert "## bunny-sweep: max pop (motion included) of each transition (its frames and the 2 after)" in report
+
+
+def test_a_timing_only_run_gets_no_quality_figures(tmp_path):
+    """--quality off leaves every image figure empty: no popping or cost figure, the tables' cells empty."""
+    folder = tmp_path / "timing"
+    lodbench("run", "--scene", "bunny-sweep", "--method", "discrete,alpha", "--width", "64", "--height", "48",
+             "--frames", "24", "--warmup", "0", "--rounds", "4", "--quality", "off", "--out", str(folder))
+    r = plot(folder)
+    assert r.returncode == 0, r.stderr
+    assert figures(folder) == []
+    report = (folder / "report.md").read_text()
+    row = next(line for line in report.splitlines() if line.startswith("| bunny-sweep | alpha |"))
+    assert "|  |" in row and "| 0.0 |" not in row, row
 
 
 def test_contact_sheet_transition_choice(dump, tmp_path):

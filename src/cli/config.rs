@@ -3,6 +3,7 @@
 //! the flags here.
 
 use crate::cli::{RunArgs, SceneArgs};
+use crate::effects::OnOff;
 use crate::error::{Error, Result};
 use crate::formats::{COLOR_FORMAT, DEPTH_FORMAT, MAX_SIDE, MSAA_SAMPLES};
 use crate::measure::metrics::{Metric, MetricReduction};
@@ -120,6 +121,8 @@ pub struct RunConfig {
     /// `--adapter`: an index into `lodbench list`'s adapters or a part of a name (run.json's `adapter` records
     /// the one chosen, with its `index`).
     pub adapter: Option<String>,
+    /// `--quality off`: the timing rounds only, no quality pass (its figures empty).
+    pub quality: OnOff,
     pub dump_frames: bool,
     pub dump_every: u32,
     /// With `dump_frames`: only frames with an instance in transition.
@@ -146,7 +149,7 @@ impl RunConfig {
             return Err(Error::Config("--rounds must be at least 1".into()));
         }
         let methods_given = !a.method.is_empty();
-        if a.scene_args.shadow.shadows == crate::effects::OnOff::On {
+        if a.scene_args.shadow.shadows == OnOff::On {
             if let Some(scene) = scenes.iter().find(|k| k.is_unified()) {
                 return Err(Error::Config(format!(
                     "--shadows on: not built for the unified scenes yet (scene {}: its blocks and seams, and \
@@ -185,6 +188,22 @@ impl RunConfig {
                     .into(),
             ));
         }
+        if a.quality == OnOff::Off {
+            let needs = if a.dump_frames {
+                Some(("--dump-frames", "it writes the quality pass's frames"))
+            } else if a.metrics.contains(&Metric::De2000) {
+                Some(("--metrics de2000", "CIEDE2000 is measured in it"))
+            } else if a.metrics.contains(&Metric::Flip) {
+                Some(("--metrics flip", "FLIP is measured in it"))
+            } else {
+                None
+            };
+            if let Some((flag, why)) = needs {
+                return Err(Error::Config(format!(
+                    "--quality off skips the quality pass, and {flag} needs it ({why}): drop one of the two"
+                )));
+            }
+        }
         Ok(RunConfig {
             scenes,
             methods,
@@ -199,6 +218,7 @@ impl RunConfig {
             metric_reduction: a.metric_reduction,
             out: a.out.clone(),
             adapter: a.adapter.clone(),
+            quality: a.quality,
             dump_frames: a.dump_frames,
             dump_every: a.dump_every,
             dump_transitions: a.dump_transitions,
@@ -237,6 +257,11 @@ impl RunConfig {
                 .find(|b| has(b))
                 .map(String::from),
         }
+    }
+
+    /// Whether the quality pass runs (`--quality on`, the default).
+    pub fn quality_pass(&self) -> bool {
+        self.quality == OnOff::On
     }
 
     pub fn resolved(&self, scene: SceneKind) -> ProfileValues {

@@ -7,6 +7,7 @@
 pub mod config;
 pub mod experiment_file;
 
+use crate::effects::OnOff;
 use crate::geometry::blocks::PartitionMode;
 use crate::measure::metrics::{Metric, MetricReduction};
 use crate::methods::MethodOptions;
@@ -269,6 +270,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "INDEX|NAME")]
     #[serde(deserialize_with = "name_or_index")]
     pub adapter: Option<String>,
+    /// The quality pass: `off` runs the warm-up and the timing rounds only, for runs that only time (an A/A
+    /// check, cost figures); every image figure of the CSVs (rmse, pop, lodpop, de2000, FLIP, uncovered and
+    /// crack pixels, lag, shadow, FSI's combine time) is then empty, never 0, and run.json's quality-pass
+    /// times null. Refused with --dump-frames and --metrics de2000/flip, which need the pass.
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    pub quality: OnOff,
     /// Write PNGs of the method frame, the reference frame and an error heat-map.
     #[arg(long)]
     pub dump_frames: bool,
@@ -377,11 +384,17 @@ mod tests {
             set.method_options.fsi.fsi_check,
             crate::methods::fsi::FsiCheck::Forward
         );
-        // `adapter` takes an index or a name, as --adapter does.
-        let set: RunArgs = toml::from_str("adapter = 1").unwrap();
-        assert_eq!(set.adapter.as_deref(), Some("1"));
+        // `adapter` takes an index or a name, as --adapter does; `quality` is on or off.
+        let set: RunArgs = toml::from_str("adapter = 1\nquality = \"off\"").unwrap();
+        assert_eq!(
+            (set.adapter.as_deref(), set.quality),
+            (Some("1"), OnOff::Off)
+        );
         let set: RunArgs = toml::from_str("adapter = \"H100\"").unwrap();
-        assert_eq!(set.adapter.as_deref(), Some("H100"));
+        assert_eq!(
+            (set.adapter.as_deref(), set.quality),
+            (Some("H100"), OnOff::On)
+        );
     }
 
     #[test]

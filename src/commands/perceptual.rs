@@ -170,6 +170,12 @@ pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<Perceptual
     let metric = metric(settings)?;
     let mut out = Vec::new();
     for t in transitions.iter().filter(|t| !is_reference(&t.method)) {
+        let (Some(lodpop_max), Some(pop_max)) = (t.lodpop_max, t.pop_max) else {
+            return Err(Error::results(
+                dir,
+                "transitions.csv has no lodpop and pop: a run without the quality pass (--quality off)",
+            ));
+        };
         let window = clips.window(t);
         let clip = clips.load(t, window)?;
         let p = metric
@@ -183,8 +189,8 @@ pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<Perceptual
             clip_first: window.first,
             clip_last: window.last,
             jod: p.jod as f64,
-            lodpop_max: t.lodpop_max,
-            pop_max: t.pop_max,
+            lodpop_max,
+            pop_max,
         });
     }
     let path = dir.join(PERCEPTUAL_CSV);

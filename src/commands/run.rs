@@ -205,16 +205,18 @@ fn run_blocks(
 }
 
 /// The frames the progress bar counts: per block, every method's warm-up, timed and quality frames, and the
-/// reference's warm-up and timed frames when it is timed without being reported.
+/// reference's warm-up and timed frames when it is timed without being reported (with the quality pass only).
 fn total_frames(cfg: &RunConfig, defs: &[SceneDef]) -> u64 {
+    let quality = cfg.quality_pass() as u64;
     defs.iter()
         .map(|d| {
             let pv = cfg.resolved(d.kind);
             let methods = cfg.methods_for(d.kind);
-            let timed_only = !methods.iter().any(|m| is_reference(m)) as u64;
+            let timed_only = quality * !methods.iter().any(|m| is_reference(m)) as u64;
             let (warmup, frames) = (pv.warmup as u64, pv.frames as u64);
             d.counts.len() as u64
-                * (methods.len() as u64 * (warmup + 2 * frames) + timed_only * (warmup + frames))
+                * (methods.len() as u64 * (warmup + (1 + quality) * frames)
+                    + timed_only * (warmup + frames))
         })
         .sum()
 }
@@ -254,6 +256,7 @@ impl RunJob<'_> {
         let quality = QualityOptions {
             metrics: cfg.metrics.clone(),
             reduction: cfg.metric_reduction,
+            timing_only: !cfg.quality_pass(),
         };
         let mut block =
             BlockRunner::new(&self.ctx, &scene, setup, self.dumper.is_some(), &quality)?;
@@ -273,8 +276,13 @@ impl RunJob<'_> {
                 continue;
             }
             let method = m.label.clone();
+            let stage = if cfg.quality_pass() {
+                "quality"
+            } else {
+                "records"
+            };
             self.progress
-                .set_message(format!("{} n={} {} quality", def.name(), count, method));
+                .set_message(format!("{} n={} {method} {stage}", def.name(), count));
             let out = block.measure_quality(
                 m,
                 reference_ms,
@@ -373,14 +381,15 @@ pub fn summary_table(s: &RunSummary) -> String {
         "q/r",
         "ratio [95% CI]"
     );
-    let fmt_opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.3}"));
+    // A figure at `digits` decimals, or '-' where the run has none (no timestamps, `--quality off`).
+    let fig =
+        |v: Option<f64>, digits: usize| v.map_or("-".to_string(), |x| format!("{x:.digits$}"));
     for r in &s.summaries {
         let ratio = s
             .blocks
             .iter()
             .find(|b| b.scene == r.scene && b.method == r.method && b.count == r.count)
-            .and_then(|b| b.quality_to_renders_ratio)
-            .unwrap_or(f64::NAN);
+            .and_then(|b| b.quality_to_renders_ratio);
         let paired = match (
             r.ratio_to_baseline,
             r.ratio_to_baseline_ci95_lo,
@@ -391,26 +400,27 @@ pub fn summary_table(s: &RunSummary) -> String {
             _ => "-".into(),
         };
         out.push_str(&format!(
-            "{:<12} {:<15} {:>5} {:>6} {:>9} {:>9.3} {:>10.0} {:>9.5} {:>9.5} {:>9.5} {:>10.5} {:>5.2} {}\n",
+            "{:<12} {:<15} {:>5} {:>6} {:>9} {:>9.3} {:>10.0} {:>9} {:>9} {:>9} {:>10} {:>5} {}\n",
             r.scene,
             r.method,
             r.count,
             r.frames,
-            fmt_opt(r.gpu_ms_median),
+            fig(r.gpu_ms_median, 3),
             r.cpu_ms_median,
             r.triangles_mean,
-            r.rmse_mean,
-            r.rmse_max,
-            r.pop_max,
-            r.lodpop_max,
-            ratio,
+            fig(r.rmse_mean, 5),
+            fig(r.rmse_max, 5),
+            fig(r.pop_max, 5),
+            fig(r.lodpop_max, 5),
+            fig(ratio, 2),
             paired
         ));
     }
     let baseline = s.summaries.iter().find_map(|r| r.baseline.clone());
     out.push_str(&format!(
         "gpu_ms and cpu_ms are medians; q/r = quality-pass time per frame / (method's + reference's timing-pass time \
-         per frame); ratio = time over {}'s, paired by timing round, geometric mean and 95 % t interval over rounds\n",
+         per frame); ratio = time over {}'s, paired by timing round, geometric mean and 95 % t interval over rounds; \
+         '-' = not measured (no timestamps; --quality off: no image figures)\n",
         baseline.as_deref().unwrap_or("the baseline (none run)")
     ));
     out

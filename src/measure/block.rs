@@ -1,6 +1,7 @@
 //! One scene block: the GPU objects both passes share ([`BlockGpu`]) and the quality pass's own
-//! ([`QualityStage`]), and what a method's measurement on it returns: one frame record per frame, built once
-//! every figure of the frame is known.
+//! ([`QualityStage`]; none with `--quality off`), and what a method's measurement on it returns: one frame
+//! record per frame, built once every figure of the frame is known (without the quality pass, from the
+//! timing rounds alone, its figures empty).
 
 use super::context::{BlockGpu, MethodSetup};
 use super::quality::{FrameImages, QualityOptions, QualityPass, QualityStage};
@@ -24,11 +25,12 @@ pub struct BlockOutput {
 /// The GPU objects of one scene block, shared by all methods run on it.
 pub struct BlockRunner<'a> {
     base: BlockGpu<'a>,
-    quality: QualityStage,
+    /// None with [`QualityOptions::timing_only`] (`--quality off`).
+    quality: Option<QualityStage>,
 }
 
 impl<'a> BlockRunner<'a> {
-    /// `dump`: hand frames to the quality pass's callback.
+    /// `dump`: hand frames to the quality pass's callback; `quality.timing_only`: build no quality stage.
     pub fn new(
         ctx: &'a GpuContext,
         scene: &'a Scene,
@@ -37,14 +39,20 @@ impl<'a> BlockRunner<'a> {
         quality: &QualityOptions,
     ) -> Result<Self> {
         let base = BlockGpu::new(ctx, scene, setup)?;
-        let quality = QualityStage::new(&base, dump, quality)?;
+        let quality = if quality.timing_only {
+            None
+        } else {
+            Some(QualityStage::new(&base, dump, quality)?)
+        };
         ctx.check_errors()?;
         Ok(BlockRunner { base, quality })
     }
 
     /// Dump only frames with an instance in transition (of those, still every `dump_every`-th frame).
     pub fn dump_transitions_only(&mut self, on: bool) {
-        self.quality.dumps.transitions_only = on;
+        if let Some(q) = self.quality.as_mut() {
+            q.dumps.transitions_only = on;
+        }
     }
 
     /// Warm-up, timing and quality pass of one method alone (one round): what a run of `--method NAME
@@ -67,7 +75,8 @@ impl<'a> BlockRunner<'a> {
         self.measure_quality(method, reference_ms, dump_every, progress, on_frames)
     }
 
-    /// The warm-up and timing rounds of the methods `labels` ([`BlockGpu::time_methods`]).
+    /// The warm-up and timing rounds of the methods `labels` ([`BlockGpu::time_methods`]; the reference is timed
+    /// too, for `quality_to_renders_ratio`, only where the quality pass runs).
     pub fn time_methods(
         &self,
         labels: &[String],
@@ -76,12 +85,14 @@ impl<'a> BlockRunner<'a> {
         seed: u64,
         progress: &ProgressBar,
     ) -> Result<(Vec<TimedMethod<'a>>, BlockRounds)> {
+        let time_reference = self.quality.is_some();
         self.base
-            .time_methods(labels, warmup, rounds, seed, progress)
+            .time_methods(labels, warmup, rounds, seed, time_reference, progress)
     }
 
     /// The quality pass of a timed method, then its frame records. `reference_ms`: the reference's timing-pass
-    /// time per frame (for `quality_to_renders_ratio`).
+    /// time per frame (for `quality_to_renders_ratio`). Without a quality stage (`--quality off`) the records
+    /// are the timing rounds' alone, every quality figure empty, and `on_frames` is never called.
     pub fn measure_quality(
         &mut self,
         mut timed: TimedMethod<'a>,
@@ -92,28 +103,33 @@ impl<'a> BlockRunner<'a> {
     ) -> Result<BlockOutput> {
         let t_instances: Vec<u32> = timed.facts.iter().map(|f| f.t_instances).collect();
         let dump_frames = self.dump_frames(dump_every, &near_transitions(&t_instances));
-        let quality = self.quality.pass(
-            &self.base,
-            timed.method.as_mut(),
-            &mut timed.driver,
-            &dump_frames,
-            progress,
-            &mut on_frames,
-        )?;
+        let quality = match self.quality.as_mut() {
+            Some(stage) => Some(stage.pass(
+                &self.base,
+                timed.method.as_mut(),
+                &mut timed.driver,
+                &dump_frames,
+                progress,
+                &mut on_frames,
+            )?),
+            None => None,
+        };
         self.base.ctx.check_errors()?;
-        let rows = self.frame_records(&timed, &quality);
+        let rows = self.frame_records(&timed, quality.as_ref());
         let pairs: Vec<TransitionPair> = timed.facts.iter().map(|f| f.pair).collect();
         Ok(BlockOutput {
             transitions: transitions(&rows, &pairs),
             rows,
-            info: self.block_info(&timed, &quality, reference_ms),
+            info: self.block_info(&timed, quality.as_ref(), reference_ms),
         })
     }
 
     /// Per frame, whether the quality pass hands it to the dump callback: every `dump_every`-th frame, of those
     /// only the ones near a transition with `--dump-transitions`.
     fn dump_frames(&self, dump_every: u32, near_transition: &[bool]) -> Vec<bool> {
-        let dumps = self.quality.dumps;
+        let Some(dumps) = self.quality.as_ref().map(|q| q.dumps) else {
+            return vec![false; self.base.scene.frames as usize];
+        };
         (0..self.base.scene.frames)
             .map(|f| {
                 dumps.dump
@@ -123,9 +139,15 @@ impl<'a> BlockRunner<'a> {
             .collect()
     }
 
-    /// One record per frame from the method's timed frames and its quality pass.
-    fn frame_records(&self, timed: &TimedMethod<'_>, quality: &QualityPass) -> Vec<FrameRecord> {
+    /// One record per frame from the method's timed frames and its quality pass (None: every figure of the
+    /// quality pass empty).
+    fn frame_records(
+        &self,
+        timed: &TimedMethod<'_>,
+        quality: Option<&QualityPass>,
+    ) -> Vec<FrameRecord> {
         let scene = self.base.scene;
+        let de2000 = self.quality.as_ref().is_some_and(|q| q.de2000);
         (0..scene.frames as usize)
             .map(|f| FrameRecord {
                 scene: scene.name().to_string(),
@@ -142,20 +164,19 @@ impl<'a> BlockRunner<'a> {
                 t_instances: timed.facts[f].t_instances,
                 lod_mean: timed.facts[f].lod_mean,
                 k_mean: timed.facts[f].k_mean,
-                rmse: quality.metrics[f].rmse,
-                pop: quality.metrics[f].pop,
-                lodpop: quality.lodpop[f],
-                de2000_mean: self.quality.de2000.then_some(quality.metrics[f].de2000),
-                uncovered_px: quality.metrics[f].uncovered_px,
-                crack_px: quality.metrics[f].crack_px,
-                flip_mean: quality.flip[f],
+                rmse: quality.map(|q| q.metrics[f].rmse),
+                pop: quality.map(|q| q.metrics[f].pop),
+                lodpop: quality.map(|q| q.lodpop[f]),
+                de2000_mean: quality.and_then(|q| de2000.then_some(q.metrics[f].de2000)),
+                uncovered_px: quality.map(|q| q.metrics[f].uncovered_px),
+                crack_px: quality.map(|q| q.metrics[f].crack_px),
+                flip_mean: quality.and_then(|q| q.flip[f]),
                 combine_gpu_ms: quality
-                    .stage_ms
-                    .as_ref()
+                    .and_then(|q| q.stage_ms.as_ref())
                     .and_then(|s| s.get(f).copied().flatten()),
-                lag_rmse: quality.lag.as_ref().map(|l| l[f]),
-                shadow_rmse: quality.shadow.as_ref().map(|s| s.rmse[f]),
-                shadow_lodpop: quality.shadow.as_ref().map(|s| s.lodpop[f]),
+                lag_rmse: quality.and_then(|q| q.lag.as_ref().map(|l| l[f])),
+                shadow_rmse: quality.and_then(|q| q.shadow.as_ref().map(|s| s.rmse[f])),
+                shadow_lodpop: quality.and_then(|q| q.shadow.as_ref().map(|s| s.lodpop[f])),
                 round: timed.round[f],
             })
             .collect()
@@ -165,7 +186,7 @@ impl<'a> BlockRunner<'a> {
     fn block_info(
         &self,
         timed: &TimedMethod<'_>,
-        quality: &QualityPass,
+        quality: Option<&QualityPass>,
         reference_ms: Option<f64>,
     ) -> BlockInfo {
         let scene = self.base.scene;
@@ -181,10 +202,11 @@ impl<'a> BlockRunner<'a> {
             frames: scene.frames,
             warmup: timed.warmup,
             timing_pass_ms_per_frame: timing_ms,
-            quality_pass_ms_per_frame: quality.ms_per_frame,
-            quality_to_timing_ratio: quality.ms_per_frame / timing_ms,
-            quality_to_renders_ratio: reference_ms.map(|r| quality.ms_per_frame / (timing_ms + r)),
-            metric_gpu_ms_median: quality.metric_gpu_ms_median,
+            quality_pass_ms_per_frame: quality.map(|q| q.ms_per_frame),
+            quality_to_timing_ratio: quality.map(|q| q.ms_per_frame / timing_ms),
+            quality_to_renders_ratio: quality
+                .and_then(|q| reference_ms.map(|r| q.ms_per_frame / (timing_ms + r))),
+            metric_gpu_ms_median: quality.and_then(|q| q.metric_gpu_ms_median),
             extra_target_bytes: timed.method.extra_target_bytes(),
             instance_bytes_listed_per_frame: timed.uploads.listed as f64 / frames,
             instance_bytes_written_per_frame: timed.uploads.written as f64 / frames,

@@ -36,6 +36,8 @@ pub struct QualityOptions {
     pub metrics: Vec<Metric>,
     /// `--metric-reduction`.
     pub reduction: MetricReduction,
+    /// `--quality off`: no quality pass at all (the block builds no stage; its figures are empty).
+    pub timing_only: bool,
 }
 
 impl QualityOptions {

@@ -1,6 +1,8 @@
 //! The records lodbench writes: a row per frame (frames.csv) and a row per block (summary.csv). A frame record
 //! is built once, by the runner, when every figure of its frame is known; a summary record is computed here
 //! from a block's frame records with `crate::measure::stats`. The exporters only serialise them.
+//!
+//! Every figure of the quality pass is an `Option`: empty (never 0) in a run without it (`--quality off`).
 
 use crate::measure::stats::{bootstrap_ci, mean, percentile};
 use serde::Serialize;
@@ -28,20 +30,22 @@ pub struct FrameRecord {
     pub lod_mean: f64,
     /// Mean over the instances in transition of their blend factor k in [0, 1] (empty when none is).
     pub k_mean: Option<f64>,
-    pub rmse: f64,
-    pub pop: f64,
+    /// RMS over pixels and channels of the method's frame minus the reference's (empty with `--quality off`,
+    /// as every figure of the quality pass below).
+    pub rmse: Option<f64>,
+    pub pop: Option<f64>,
     /// RMS over pixels and channels of the method's frame minus the same frame rendered with the previous
     /// frame's LOD schedule at this frame's pose (docs/measurement.md, "lodpop"); 0 where the schedule did not
     /// change.
-    pub lodpop: f64,
+    pub lodpop: Option<f64>,
     /// Mean CIEDE2000 over pixels between method and reference frame (sRGB D65 -> XYZ -> CIELAB), with
     /// `--metrics de2000` (empty otherwise).
     pub de2000_mean: Option<f64>,
     /// Pixels where the method shows the background and the reference shows surface.
-    pub uncovered_px: u64,
+    pub uncovered_px: Option<u64>,
     /// The uncovered pixels with the method's own surface within 4 pixels on both sides along the row or the
     /// column: cracks and holes (`metrics::crack_pixels`).
-    pub crack_px: u64,
+    pub crack_px: Option<u64>,
     /// Mean FLIP error, with `--metrics ...,flip` (empty otherwise).
     pub flip_mean: Option<f64>,
     /// GPU time of FSI's combination pass and its copy into the frame's target, measured in the quality pass
@@ -77,16 +81,18 @@ pub struct SummaryRecord {
     pub triangles_mean: f64,
     pub draw_calls_mean: f64,
     pub t_instances_mean: f64,
-    pub rmse_mean: f64,
-    pub rmse_mean_ci95_lo: f64,
-    pub rmse_mean_ci95_hi: f64,
-    pub rmse_max: f64,
-    pub pop_max: f64,
-    pub pop_p95: f64,
+    /// The quality pass's figures, empty with `--quality off`: mean rmse with its bootstrap interval, largest
+    /// rmse, largest and 95th percentile pop.
+    pub rmse_mean: Option<f64>,
+    pub rmse_mean_ci95_lo: Option<f64>,
+    pub rmse_mean_ci95_hi: Option<f64>,
+    pub rmse_max: Option<f64>,
+    pub pop_max: Option<f64>,
+    pub pop_p95: Option<f64>,
     /// Largest, 95th percentile and sum over frames of lodpop.
-    pub lodpop_max: f64,
-    pub lodpop_p95: f64,
-    pub lodpop_sum: f64,
+    pub lodpop_max: Option<f64>,
+    pub lodpop_p95: Option<f64>,
+    pub lodpop_sum: Option<f64>,
     /// Mean over frames of de2000_mean, and its largest frame (empty without `--metrics de2000`).
     pub de2000_mean: Option<f64>,
     pub de2000_max: Option<f64>,
@@ -95,9 +101,9 @@ pub struct SummaryRecord {
     /// Mean over frames of units_drawn (clusters for clusterlod, instances otherwise).
     pub units_drawn_mean: f64,
     /// Mean over frames of uncovered_px; mean and largest crack_px.
-    pub uncovered_px_mean: f64,
-    pub crack_px_mean: f64,
-    pub crack_px_max: u64,
+    pub uncovered_px_mean: Option<f64>,
+    pub crack_px_mean: Option<f64>,
+    pub crack_px_max: Option<u64>,
     pub extra_target_bytes: u64,
     /// Largest relative change of the triangle count between consecutive frames,
     /// max |t_f - t_(f-1)| / t_(f-1) (Scherzer & Wimmer 2008 section 4 saw at most 2 % with FSI).
@@ -137,8 +143,14 @@ impl SummaryRecord {
         let shadow_lodpop: Option<Vec<f64>> = rows.iter().map(|r| r.shadow_lodpop).collect();
         let gpu: Vec<f64> = rows.iter().filter_map(|r| r.gpu_ms).collect();
         let cpu: Vec<f64> = rows.iter().map(|r| r.cpu_ms).collect();
-        let pop: Vec<f64> = rows.iter().map(|r| r.pop).collect();
-        let rmse: Vec<f64> = rows.iter().map(|r| r.rmse).collect();
+        // The quality pass's figures: None when a frame has none (`--quality off`).
+        let pop: Option<Vec<f64>> = rows.iter().map(|r| r.pop).collect();
+        let rmse: Option<Vec<f64>> = rows.iter().map(|r| r.rmse).collect();
+        let lodpop: Option<Vec<f64>> = rows.iter().map(|r| r.lodpop).collect();
+        let uncovered: Option<Vec<u64>> = rows.iter().map(|r| r.uncovered_px).collect();
+        let crack: Option<Vec<u64>> = rows.iter().map(|r| r.crack_px).collect();
+        let max = |v: &Vec<f64>| v.iter().copied().fold(0.0, f64::max);
+        let mean_of = |v: &Vec<u64>| mean(v.iter().map(|&x| x as f64));
         let gpu_where = |transition: bool| {
             rows.iter()
                 .filter(|r| (r.t_instances > 0) == transition)
@@ -146,8 +158,10 @@ impl SummaryRecord {
                 .collect::<Vec<_>>()
         };
         let de2000: Option<Vec<f64>> = rows.iter().map(|r| r.de2000_mean).collect();
-        let rmse_ci = bootstrap_ci(&rmse, seed ^ 0x524D_5345, |v| Some(mean(v.iter().copied())))
-            .unwrap_or((0.0, 0.0));
+        let rmse_ci = rmse.as_ref().map(|rmse| {
+            bootstrap_ci(rmse, seed ^ 0x524D_5345, |v| Some(mean(v.iter().copied())))
+                .unwrap_or((0.0, 0.0))
+        });
         Some(SummaryRecord {
             scene: first.scene.clone(),
             method: first.method.clone(),
@@ -162,16 +176,15 @@ impl SummaryRecord {
             triangles_mean: mean(rows.iter().map(|r| r.triangles as f64)),
             draw_calls_mean: mean(rows.iter().map(|r| r.draw_calls as f64)),
             t_instances_mean: mean(rows.iter().map(|r| r.t_instances as f64)),
-            rmse_mean: mean(rows.iter().map(|r| r.rmse)),
-            rmse_mean_ci95_lo: rmse_ci.0,
-            rmse_mean_ci95_hi: rmse_ci.1,
-            rmse_max: rows.iter().map(|r| r.rmse).fold(0.0, f64::max),
-            pop_max: pop.iter().copied().fold(0.0, f64::max),
-            pop_p95: percentile(&pop, 95.0).unwrap_or(0.0),
-            lodpop_max: rows.iter().map(|r| r.lodpop).fold(0.0, f64::max),
-            lodpop_p95: percentile(&rows.iter().map(|r| r.lodpop).collect::<Vec<_>>(), 95.0)
-                .unwrap_or(0.0),
-            lodpop_sum: rows.iter().map(|r| r.lodpop).sum(),
+            rmse_mean: rmse.as_ref().map(|v| mean(v.iter().copied())),
+            rmse_mean_ci95_lo: rmse_ci.map(|c| c.0),
+            rmse_mean_ci95_hi: rmse_ci.map(|c| c.1),
+            rmse_max: rmse.as_ref().map(max),
+            pop_max: pop.as_ref().map(max),
+            pop_p95: pop.as_ref().map(|v| percentile(v, 95.0).unwrap_or(0.0)),
+            lodpop_max: lodpop.as_ref().map(max),
+            lodpop_p95: lodpop.as_ref().map(|v| percentile(v, 95.0).unwrap_or(0.0)),
+            lodpop_sum: lodpop.as_ref().map(|v| v.iter().sum()),
             de2000_mean: de2000.as_ref().map(|v| mean(v.iter().copied())),
             de2000_max: de2000.map(|v| v.into_iter().fold(0.0, f64::max)),
             flip_mean: rows
@@ -180,9 +193,9 @@ impl SummaryRecord {
                 .collect::<Option<Vec<f64>>>()
                 .map(|v| mean(v.into_iter())),
             units_drawn_mean: mean(rows.iter().map(|r| r.units_drawn as f64)),
-            uncovered_px_mean: mean(rows.iter().map(|r| r.uncovered_px as f64)),
-            crack_px_mean: mean(rows.iter().map(|r| r.crack_px as f64)),
-            crack_px_max: rows.iter().map(|r| r.crack_px).max().unwrap_or(0),
+            uncovered_px_mean: uncovered.as_ref().map(mean_of),
+            crack_px_mean: crack.as_ref().map(mean_of),
+            crack_px_max: crack.map(|v| v.into_iter().max().unwrap_or(0)),
             extra_target_bytes,
             tri_alternation_max: tri_alternation_max(rows),
             combine_gpu_ms_median: percentile(
@@ -416,11 +429,13 @@ pub struct TransitionRecord {
     pub last_frame: u32,
     /// `lod_from->lod_to` of the t-instances (of the first frame's), or `mixed`.
     pub lods: String,
-    pub lodpop_max: f64,
-    pub lodpop_max_frame: u32,
-    pub pop_max: f64,
-    pub pop_max_frame: u32,
-    pub rmse_max: f64,
+    /// The largest lodpop, pop and rmse over the transition's frames and the frame of each (empty, as the
+    /// frame, with `--quality off`).
+    pub lodpop_max: Option<f64>,
+    pub lodpop_max_frame: Option<u32>,
+    pub pop_max: Option<f64>,
+    pub pop_max_frame: Option<u32>,
+    pub rmse_max: Option<f64>,
     /// `--shadows on`: the largest shadow_lodpop over the same frames (empty without shadows).
     #[serde(default)]
     pub shadow_lodpop_max: Option<f64>,
@@ -441,16 +456,15 @@ pub fn transitions(rows: &[FrameRecord], pairs: &[TransitionPair]) -> Vec<Transi
         }
         let last = f - 1;
         let window = &rows[first..(last + 1 + TRANSITION_TAIL as usize).min(rows.len())];
-        let argmax = |value: fn(&FrameRecord) -> f64| {
+        // The largest value over the window and its frame; None when a frame has no value.
+        let argmax = |value: fn(&FrameRecord) -> Option<f64>| {
             window
                 .iter()
-                .fold((0.0f64, window[0].frame), |(best, at), r| {
-                    if value(r) > best {
-                        (value(r), r.frame)
-                    } else {
-                        (best, at)
-                    }
+                .try_fold((0.0f64, window[0].frame), |(best, at), r| {
+                    let v = value(r)?;
+                    Some(if v > best { (v, r.frame) } else { (best, at) })
                 })
+                .unzip()
         };
         let (lodpop_max, lodpop_max_frame) = argmax(|r| r.lodpop);
         let (pop_max, pop_max_frame) = argmax(|r| r.pop);
@@ -493,10 +507,11 @@ pub struct BlockInfo {
     pub warmup: u32,
     /// Wall time per frame of the timing pass (render + wait), milliseconds.
     pub timing_pass_ms_per_frame: f64,
-    /// Wall time per frame of the quality pass (reference + method + metric kernel), milliseconds.
-    pub quality_pass_ms_per_frame: f64,
+    /// Wall time per frame of the quality pass (reference + method + metric kernel), milliseconds (null with
+    /// `--quality off`, as the two ratios).
+    pub quality_pass_ms_per_frame: Option<f64>,
     /// quality_pass_ms_per_frame / timing_pass_ms_per_frame (2.0 is the floor: the reference doubles the work).
-    pub quality_to_timing_ratio: f64,
+    pub quality_to_timing_ratio: Option<f64>,
     /// quality_pass_ms_per_frame / (this method's + the reference's timing_pass_ms_per_frame): what the
     /// quality pass costs over its two renders (1.0 would be a free metric).
     pub quality_to_renders_ratio: Option<f64>,
@@ -621,12 +636,12 @@ pub(crate) mod tests {
             t_instances: 0,
             lod_mean: 0.0,
             k_mean: None,
-            rmse,
-            pop,
-            lodpop: 0.0,
+            rmse: Some(rmse),
+            pop: Some(pop),
+            lodpop: Some(0.0),
             de2000_mean: Some(rmse / 2.0),
-            uncovered_px: 0,
-            crack_px: 0,
+            uncovered_px: Some(0),
+            crack_px: Some(0),
             flip_mean: None,
             combine_gpu_ms: None,
             lag_rmse: None,
@@ -739,9 +754,9 @@ pub(crate) mod tests {
         let s = SummaryRecord::from_frames(&rows, 0, 7).unwrap();
         assert_eq!(s.frames, 3);
         assert_eq!(s.gpu_ms_median, Some(2.0));
-        assert!((s.rmse_mean - 0.1).abs() < 1e-12);
-        assert_eq!(s.rmse_max, 0.2);
-        assert_eq!(s.pop_max, 0.5);
+        assert!((s.rmse_mean.unwrap() - 0.1).abs() < 1e-12);
+        assert_eq!(s.rmse_max, Some(0.2));
+        assert_eq!(s.pop_max, Some(0.5));
         assert_eq!(s.triangles_mean, 101.0);
         let no_gpu: Vec<_> = rows
             .iter()
@@ -754,7 +769,12 @@ pub(crate) mod tests {
         assert_eq!(s_no_gpu.gpu_ms_median, None);
         assert_eq!(s_no_gpu.gpu_ms_median_steady, None);
         // The intervals hold the statistic, and are the same for the same seed.
-        assert!(s.rmse_mean_ci95_lo <= s.rmse_mean && s.rmse_mean <= s.rmse_mean_ci95_hi);
+        let (lo, m, hi) = (
+            s.rmse_mean_ci95_lo.unwrap(),
+            s.rmse_mean.unwrap(),
+            s.rmse_mean_ci95_hi.unwrap(),
+        );
+        assert!(lo <= m && m <= hi);
         assert_eq!(s, SummaryRecord::from_frames(&rows, 0, 7).unwrap());
     }
 
@@ -766,7 +786,7 @@ pub(crate) mod tests {
             .enumerate()
             .map(|(f, &n)| FrameRecord {
                 t_instances: n,
-                lodpop: [0.0, 0.1, 0.3, 0.2, 0.0, 0.05, 0.4, 0.0][f],
+                lodpop: Some([0.0, 0.1, 0.3, 0.2, 0.0, 0.05, 0.4, 0.0][f]),
                 ..row(f as u32, None, 0.01 * f as f64, 0.0)
             })
             .collect();
@@ -783,12 +803,67 @@ pub(crate) mod tests {
         assert_eq!((tr[0].first_frame, tr[0].last_frame), (1, 2));
         assert_eq!(tr[0].lods, "0->1");
         // Frames 1-4 (two after the last): the largest lodpop 0.3 at frame 2, rmse at frame 4.
-        assert_eq!((tr[0].lodpop_max, tr[0].lodpop_max_frame), (0.3, 2));
-        assert!((tr[0].rmse_max - 0.04).abs() < 1e-12);
+        assert_eq!(
+            (tr[0].lodpop_max, tr[0].lodpop_max_frame),
+            (Some(0.3), Some(2))
+        );
+        assert!((tr[0].rmse_max.unwrap() - 0.04).abs() < 1e-12);
         assert_eq!((tr[1].first_frame, tr[1].lods.as_str()), (6, "mixed"));
         // The tail is cut at the end of the path.
-        assert!((tr[1].rmse_max - 0.07).abs() < 1e-12);
+        assert!((tr[1].rmse_max.unwrap() - 0.07).abs() < 1e-12);
         assert!(transitions(&rows[..1], &pairs[..1]).is_empty());
+    }
+
+    #[test]
+    fn without_the_quality_pass_its_figures_are_empty_not_zero() {
+        let rows: Vec<FrameRecord> = (0..4)
+            .map(|f| FrameRecord {
+                t_instances: (f == 1) as u32,
+                rmse: None,
+                pop: None,
+                lodpop: None,
+                de2000_mean: None,
+                uncovered_px: None,
+                crack_px: None,
+                ..row(f, Some(1.0 + f as f64), 0.0, 0.0)
+            })
+            .collect();
+        let s = SummaryRecord::from_frames(&rows, 0, 1).unwrap();
+        assert_eq!(s.gpu_ms_median, Some(2.5));
+        assert_eq!(
+            (
+                s.rmse_mean,
+                s.rmse_mean_ci95_lo,
+                s.rmse_max,
+                s.pop_max,
+                s.pop_p95
+            ),
+            (None, None, None, None, None)
+        );
+        assert_eq!(
+            (s.lodpop_max, s.lodpop_p95, s.lodpop_sum),
+            (None, None, None)
+        );
+        assert_eq!(
+            (
+                s.uncovered_px_mean,
+                s.crack_px_mean,
+                s.crack_px_max,
+                s.de2000_mean
+            ),
+            (None, None, None, None)
+        );
+        let tr = transitions(&rows, &[TransitionPair::None.with(0, 1); 4]);
+        assert_eq!(tr.len(), 1);
+        assert_eq!(
+            (
+                tr[0].lodpop_max,
+                tr[0].lodpop_max_frame,
+                tr[0].pop_max,
+                tr[0].rmse_max
+            ),
+            (None, None, None, None)
+        );
     }
 
     #[test]

@@ -122,19 +122,21 @@ impl<'a> BlockGpu<'a> {
     /// Creates the methods `labels` (a label `NAME#k` is another instance of NAME), warms each up
     /// ([`WarmUpPlan`]), then times them in `rounds` interleaved rounds: round r times every method over the
     /// frames [`round_frames`]`(r)`, in an order shuffled from `seed`, each method continuing its own walk along
-    /// the path. When no label is the reference, the reference is timed too (its time per frame is the
-    /// denominator of run.json's `quality_to_renders_ratio`) and returned last, labelled `reference`.
+    /// the path. When no label is the reference and `time_reference` (the quality pass runs), the reference is
+    /// timed too (its time per frame is the denominator of run.json's `quality_to_renders_ratio`) and returned
+    /// last, labelled `reference`.
     pub fn time_methods(
         &self,
         labels: &[String],
         warmup: u32,
         rounds: u32,
         seed: u64,
+        time_reference: bool,
         progress: &ProgressBar,
     ) -> Result<(Vec<TimedMethod<'a>>, BlockRounds)> {
         let (scene, frames) = (self.scene, self.scene.frames);
         let mut labels = labels.to_vec();
-        let timed_only: Vec<String> = if labels.iter().any(|l| is_reference(l)) {
+        let timed_only: Vec<String> = if !time_reference || labels.iter().any(|l| is_reference(l)) {
             Vec::new()
         } else {
             labels.push("reference".into());

@@ -489,3 +489,23 @@ fn adapter_by_index() {
         ],
     );
 }
+
+/// `--quality off` skips the quality pass, so what needs it is refused before any GPU work.
+#[test]
+fn quality_off_refuses_what_needs_the_quality_pass() {
+    for (extra, needle) in [
+        (&["--dump-frames"][..], "--dump-frames"),
+        (&["--metrics", "rmse,pop,de2000"][..], "--metrics de2000"),
+        (&["--metrics", "flip"][..], "--metrics flip"),
+    ] {
+        let mut args = vec!["run", "--quality", "off"];
+        args.extend_from_slice(extra);
+        fails_with(&lodbench(&args, &[]), &["--quality off", needle]);
+    }
+    let out = lodbench(&["run", "--quality", "of"], &[]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("--quality") && stderr.contains("off"),
+        "{stderr}"
+    );
+}

@@ -20,8 +20,9 @@ mod cli_input;
 // src/commands: the subcommands through the binary.
 mod commands_clips;
 mod commands_experiment;
-// src/measure: the quality pass's figures.
+// src/measure: the quality pass's figures, and runs without it.
 mod measure_lodpop;
+mod measure_quality_off;
 // src/methods: one method (or a family of variants) in images.
 mod methods_fsi;
 mod methods_registry;

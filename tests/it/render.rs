@@ -194,18 +194,17 @@ fn gpu_metrics_match_cpu_oracle() {
         .unwrap();
     assert_eq!(cpu.len(), out.rows.len());
     for (row, c) in out.rows.iter().zip(&cpu) {
+        let (rmse, pop) = (row.rmse.unwrap(), row.pop.unwrap());
         assert!(
-            (row.rmse - c.rmse).abs() < 1e-5,
-            "frame {}: gpu rmse {} cpu {}",
+            (rmse - c.rmse).abs() < 1e-5,
+            "frame {}: gpu rmse {rmse} cpu {}",
             row.frame,
-            row.rmse,
             c.rmse
         );
         assert!(
-            (row.pop - c.pop).abs() < 1e-5,
-            "frame {}: gpu pop {} cpu {}",
+            (pop - c.pop).abs() < 1e-5,
+            "frame {}: gpu pop {pop} cpu {}",
             row.frame,
-            row.pop,
             c.pop
         );
     }
