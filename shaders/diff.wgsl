@@ -4,7 +4,8 @@
 //
 // Both images are read through Rgba8Unorm views of the sRGB targets, i.e. as the stored sRGB-encoded bytes.
 // Per pixel, with d = a - b per channel: |d.r|^2 + |d.g|^2 + |d.b|^2 -> rms = sqrt(sum / (3 * 255^2 * pixels)).
-// One workgroup per row, 64 invocations, no barriers (as shaders/metrics.wgsl, for the same reasons); a run of at
+// One workgroup per row of the rectangle `x0..x1` by `y0..y1` (outside it the two frames are known to be equal:
+// lodpop's counterfactual is drawn only there, src/measure/quality.rs), 64 invocations, no barriers (as shaders/metrics.wgsl, for the same reasons); a run of at
 // most 8192 / 64 = 128 pixels keeps each partial sum below 2^32 (128 * 3 * 255^2).
 
 struct Params {
@@ -12,6 +13,10 @@ struct Params {
     height: u32,
     slot: u32,
     pad: u32,
+    x0: u32,
+    y0: u32,
+    x1: u32,
+    y1: u32,
 };
 
 @group(0) @binding(0) var a_img: texture_2d<f32>;
@@ -27,12 +32,12 @@ fn to_bytes(v: vec4<f32>) -> vec3<i32> {
 
 @compute @workgroup_size(64, 1, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let y = gid.y;
-    if (y >= params.height) {
+    let y = params.y0 + gid.y;
+    if (y >= params.y1) {
         return;
     }
     var sum = 0u;
-    for (var x = gid.x; x < params.width; x = x + LANES) {
+    for (var x = params.x0 + gid.x; x < params.x1; x = x + LANES) {
         let p = vec2<i32>(i32(x), i32(y));
         let d = to_bytes(textureLoad(a_img, p, 0)) - to_bytes(textureLoad(b_img, p, 0));
         sum = sum + u32(d.x * d.x + d.y * d.y + d.z * d.z);

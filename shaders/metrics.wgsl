@@ -19,15 +19,19 @@
 // e_t is kept per pixel in `prev_error` for the next frame. Each frame slot holds three 64-bit sums and the two
 // 32-bit counts (8 words; a count stays below 8192^2 = 2^26).
 // Two pipeline-overridable switches: DE2000 adds de2000 (`--metrics de2000`, which costs more than the rest);
-// WORKGROUP_REDUCE sums the row's 64 partial sums in workgroup memory behind a barrier and adds them with one
+// WORKGROUP_REDUCE sums the tile's 64 partial sums in workgroup memory behind a barrier and adds them with one
 // invocation (`--metric-reduction workgroup`) instead of each invocation adding its own (the default, `atomics`,
 // measured faster on lavapipe: docs/measurement.md, "Cost of the quality pass").
 //
-// One workgroup per row, 64 invocations; invocation i sums the pixels i, i + 64, i + 128, ... of its row
+// One workgroup per 16 x 16 tile of the frame, 64 invocations, over the tiles listed in `tiles` (the quality
+// pass lists those an instance can cover now or covered on the previous frame, src/measure/coverage.rs; every
+// tile where it cannot bound them): outside them both frames show the background and e_t = e_(t-1) = 0, so
+// every sum is the whole frame's. Invocation i reads the pixels (i % 16, i / 16 + 4 j), j = 0..3, of its tile
 // (neighbouring invocations read neighbouring pixels), then its sums reach a 64-bit total made of two u32
-// atomics per frame slot, directly or through the workgroup reduction. A run of at most 8192 / 64 = 128 pixels
-// keeps each partial sum below 2^32 (128 * 780300 for pop; 128 * 65536 * 120 for de2000, CIEDE2000 staying
-// below 120 between sRGB colours); the reduction carries into the high word.
+// atomics per frame slot, directly or through the workgroup reduction. Four pixels per invocation keep each
+// partial sum far below 2^32 (4 * 780300 for pop; 4 * 65536 * 120 for de2000, CIEDE2000 staying below 120
+// between sRGB colours); the reduction carries into the high word. The tiles come in rows of at most
+// MAX_ROW workgroups (a dispatch's limit per dimension): tile index = workgroup_id.y * MAX_ROW + workgroup_id.x.
 
 struct Params {
     width: u32,
@@ -36,9 +40,10 @@ struct Params {
     has_prev: u32,
     // The background's bytes, r | g << 8 | b << 16.
     background: u32,
+    // How many tiles `tiles` lists.
+    tile_count: u32,
     pad0: u32,
     pad1: u32,
-    pad2: u32,
 };
 
 @group(0) @binding(0) var method_img: texture_2d<f32>;
@@ -49,6 +54,8 @@ struct Params {
 // The frame's uncovered pixels (indices y * width + x), appended by `main`, checked for cracks by `crack_main`.
 @group(0) @binding(5) var<storage, read_write> uncovered_list: array<u32>;
 @group(0) @binding(6) var<storage, read_write> uncovered_count: atomic<u32>;
+// The tiles this frame reads, each as tx | ty << 16.
+@group(0) @binding(7) var<storage, read> tiles: array<u32>;
 
 fn to_bytes(v: vec4<f32>) -> vec3<i32> {
     return vec3<i32>(round(clamp(v.rgb, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0));
@@ -63,6 +70,8 @@ fn add_u64(lo: u32, value: u32) {
 }
 
 const LANES: u32 = 64u;
+const TILE: u32 = 16u;
+const MAX_ROW: u32 = 65535u;
 const CRACK_REACH: i32 = 4;
 const CRACK_MARGIN: i32 = 2;
 const SLOT_WORDS: u32 = 8u;
@@ -223,34 +232,47 @@ fn add_u64_pair(lo: u32, v: vec2<u32>) {
 override DE2000: bool = false;
 override WORKGROUP_REDUCE: bool = false;
 
+// Pixel j (0..3) of invocation `lid` in the tile at `origin`: (x, y), and whether it lies inside the frame.
+fn tile_pixel(origin: vec2<u32>, lid: u32, j: u32) -> vec3<u32> {
+    let x = origin.x + (lid & (TILE - 1u));
+    let y = origin.y + (lid >> 4u) + 4u * j;
+    return vec3<u32>(x, y, select(0u, 1u, x < params.width && y < params.height));
+}
+
 @compute @workgroup_size(64, 1, 1)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    let y = gid.y;
+fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let listed = wid.y * MAX_ROW + wid.x;
+    // Workgroups past the list still take part in the workgroup's barrier, with nothing to add.
+    let pixels = select(0u, 4u, listed < params.tile_count);
+    let packed = tiles[min(listed, max(params.tile_count, 1u) - 1u)];
+    let origin = vec2<u32>(packed & 0xffffu, packed >> 16u) * TILE;
     var rmse_sum = 0u;
     var pop_sum = 0u;
     var de_sum = 0u;
     var uncovered = 0u;
-    // Rows past the image still take part in the workgroup's barrier, with nothing to add.
-    let width = select(0u, params.width, y < params.height);
-    for (var x = gid.x; x < width; x = x + LANES) {
-        let p = vec2<i32>(i32(x), i32(y));
+    let bg = background_bytes();
+    for (var j = 0u; j < pixels; j = j + 1u) {
+        let q = tile_pixel(origin, lid, j);
+        if (q.z == 0u) {
+            continue;
+        }
+        let p = vec2<i32>(i32(q.x), i32(q.y));
         let a = to_bytes(textureLoad(method_img, p, 0));
         let b = to_bytes(textureLoad(reference_img, p, 0));
         let e = a - b;
-        let bg = background_bytes();
         uncovered = uncovered + select(0u, 1u, all(a == bg) && any(b != bg));
         let s = u32(abs(e.x) + abs(e.y) + abs(e.z));
         rmse_sum = rmse_sum + s * s;
         if (DE2000 && s != 0u) {
             de_sum = de_sum + u32(round(ciede2000(srgb_to_lab(a), srgb_to_lab(b)) * DE_SCALE));
         }
-        let idx = y * params.width + x;
+        let idx = q.y * params.width + q.x;
         if (params.has_prev != 0u) {
-            let q = prev_error[idx];
+            let w = prev_error[idx];
             let prev = vec3<i32>(
-                i32(q & 1023u),
-                i32((q >> 10u) & 1023u),
-                i32((q >> 20u) & 1023u),
+                i32(w & 1023u),
+                i32((w >> 10u) & 1023u),
+                i32((w >> 20u) & 1023u),
             ) - vec3<i32>(255);
             let d = e - prev;
             pop_sum = pop_sum + u32(d.x * d.x + d.y * d.y + d.z * d.z);
@@ -265,13 +287,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
     // times over).
     if (uncovered != 0u) {
         atomicAdd(&sums[slot + 6u], uncovered);
-        let bg = background_bytes();
-        for (var x = gid.x; x < width; x = x + LANES) {
-            let p = vec2<i32>(i32(x), i32(y));
+        for (var j = 0u; j < pixels; j = j + 1u) {
+            let q = tile_pixel(origin, lid, j);
+            if (q.z == 0u) {
+                continue;
+            }
+            let p = vec2<i32>(i32(q.x), i32(q.y));
             let a = to_bytes(textureLoad(method_img, p, 0));
             let b = to_bytes(textureLoad(reference_img, p, 0));
             if (all(a == bg) && any(b != bg)) {
-                uncovered_list[atomicAdd(&uncovered_count, 1u)] = y * params.width + x;
+                uncovered_list[atomicAdd(&uncovered_count, 1u)] = q.y * params.width + q.x;
             }
         }
     }

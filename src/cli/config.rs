@@ -6,7 +6,7 @@ use crate::cli::{RunArgs, SceneArgs};
 use crate::effects::OnOff;
 use crate::error::{Error, Result};
 use crate::formats::{COLOR_FORMAT, DEPTH_FORMAT, MAX_SIDE, MSAA_SAMPLES};
-use crate::measure::metrics::{Metric, MetricReduction};
+use crate::measure::metrics::{Metric, MetricReduction, MetricRegion};
 use crate::methods::{MethodOptions, Registry};
 use crate::scene::schedule::ScheduleParams;
 use crate::scene::{ProfileValues, SceneConfig, SceneKind};
@@ -117,6 +117,8 @@ pub struct RunConfig {
     /// `--metrics` (rmse, pop, de2000 always; flip when listed).
     pub metrics: Vec<Metric>,
     pub metric_reduction: MetricReduction,
+    /// `--metric-region`.
+    pub metric_region: MetricRegion,
     pub out: Option<PathBuf>,
     /// `--adapter`: an index into `lodbench list`'s adapters or a part of a name (run.json's `adapter` records
     /// the one chosen, with its `index`).
@@ -216,6 +218,7 @@ impl RunConfig {
             method_options: a.method_options,
             metrics: a.metrics.clone(),
             metric_reduction: a.metric_reduction,
+            metric_region: a.metric_region,
             out: a.out.clone(),
             adapter: a.adapter.clone(),
             quality: a.quality,

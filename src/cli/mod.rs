@@ -9,7 +9,7 @@ pub mod experiment_file;
 
 use crate::effects::OnOff;
 use crate::geometry::blocks::PartitionMode;
-use crate::measure::metrics::{Metric, MetricReduction};
+use crate::measure::metrics::{Metric, MetricReduction, MetricRegion};
 use crate::methods::MethodOptions;
 use crate::scene::schedule::FadeMode;
 use crate::scene::{CameraMode, Profile, SweepStart};
@@ -262,6 +262,11 @@ pub struct RunArgs {
     /// How the metric kernel sums a row: per-invocation atomics (default) or a workgroup-memory reduction.
     #[arg(long, value_enum, default_value_t = MetricReduction::Atomics)]
     pub metric_reduction: MetricReduction,
+    /// Which pixels the quality pass reads: `covered` (default) only those the instances can cover, where a
+    /// bound holds (no TAA, no shadows, methods that draw only their meshes), and lodpop's counterfactual only
+    /// where the instances whose state changed reach; `full` every pixel. The figures are the same.
+    #[arg(long, value_enum, default_value_t = MetricRegion::Covered)]
+    pub metric_region: MetricRegion,
     /// Output folder (default results/<scene>-<time>/).
     #[arg(long)]
     pub out: Option<PathBuf>,

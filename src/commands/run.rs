@@ -256,6 +256,7 @@ impl RunJob<'_> {
         let quality = QualityOptions {
             metrics: cfg.metrics.clone(),
             reduction: cfg.metric_reduction,
+            region: cfg.metric_region,
             timing_only: !cfg.quality_pass(),
         };
         let mut block =

@@ -48,6 +48,14 @@ pub fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     )
 }
 
+/// A compute stage's read-only storage buffer at `binding`.
+pub fn read_only_storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(
+        binding,
+        wgpu::BufferBindingType::Storage { read_only: true },
+    )
+}
+
 /// A compute stage's uniform buffer at `binding`.
 pub fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     buffer_entry(binding, wgpu::BufferBindingType::Uniform)

@@ -81,6 +81,9 @@ pub struct SceneGpu {
     /// The camera's bind group (group 0) with each shadow map ([`ShadowMap`]); draws use the active one.
     pub camera_groups: Vec<wgpu::BindGroup>,
     active_group: std::cell::Cell<usize>,
+    /// The scissor rectangle `[x, y, width, height]` every colour pass of [`SceneGpu::begin_pass`] draws
+    /// within ([`SceneGpu::scissored`]); None = the whole target.
+    scissor: std::cell::Cell<Option<[u32; 4]>>,
     /// The shadow maps' depth views, indexed like `camera_groups` (`--shadows on`; only the placeholder
     /// otherwise).
     pub shadow_views: Vec<wgpu::TextureView>,
@@ -317,6 +320,7 @@ impl SceneGpu {
             camera_layout,
             camera_groups,
             active_group: std::cell::Cell::new(ShadowMap::NONE.index()),
+            scissor: std::cell::Cell::new(None),
             shadow_views,
             shadow_maps,
             shadow_size,
@@ -382,6 +386,16 @@ impl SceneGpu {
         self.use_shadow_map(map);
         let out = draw();
         self.active_group.set(active);
+        out
+    }
+
+    /// Runs `draw` with every colour pass begun by [`SceneGpu::begin_pass`] limited to the scissor rectangle
+    /// `[x, y, width, height]` (inside every target drawn to; the clears still cover the whole target), then
+    /// restores the whole target.
+    pub fn scissored<T>(&self, rect: [u32; 4], draw: impl FnOnce() -> T) -> T {
+        let before = self.scissor.replace(Some(rect));
+        let out = draw();
+        self.scissor.set(before);
         out
     }
 
@@ -468,7 +482,7 @@ impl SceneGpu {
         } else {
             wgpu::LoadOp::Load
         };
-        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: color,
@@ -494,7 +508,11 @@ impl SceneGpu {
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
-        })
+        });
+        if let Some([x, y, w, h]) = self.scissor.get() {
+            pass.set_scissor_rect(x, y, w, h);
+        }
+        pass
     }
 
     /// Draws `count` instances from absolute instance `first` of `buffer` at (model, LOD) with `pipeline`;

@@ -207,6 +207,8 @@ impl<'a> BlockRunner<'a> {
             quality_to_renders_ratio: quality
                 .and_then(|q| reference_ms.map(|r| q.ms_per_frame / (timing_ms + r))),
             metric_gpu_ms_median: quality.and_then(|q| q.metric_gpu_ms_median),
+            metric_tile_share: quality.map(|q| q.metric_tile_share),
+            counterfactual_pixel_share: quality.and_then(|q| q.counterfactual_pixel_share),
             extra_target_bytes: timed.method.extra_target_bytes(),
             instance_bytes_listed_per_frame: timed.uploads.listed as f64 / frames,
             instance_bytes_written_per_frame: timed.uploads.written as f64 / frames,

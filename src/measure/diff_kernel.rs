@@ -6,6 +6,7 @@ use crate::error::Result;
 use crate::gpu::compute::{bind_group, results_buffers, uniform_buffer};
 use crate::gpu::context::GpuContext;
 use crate::gpu::targets::RenderTarget;
+use crate::measure::coverage::PixelRect;
 
 pub const DIFF_WGSL: &str = include_str!("../../shaders/diff.wgsl");
 
@@ -44,7 +45,7 @@ impl DiffKernel {
             cache: None,
         });
         let [sums, readback] = results_buffers(device, [label, label], frames as u64 * 8);
-        let params = uniform_buffer(device, label, 16);
+        let params = uniform_buffer(device, label, 32);
         let layout = pipeline.get_bind_group_layout(0);
         let bind_groups = pairs
             .iter()
@@ -85,19 +86,41 @@ impl DiffKernel {
         frame: u32,
         pair: usize,
     ) {
+        let all = PixelRect::full(self.width, self.height);
+        self.encode_in(queue, encoder, (frame, pair), all);
+    }
+
+    /// [`DiffKernel::encode`] reading only `rect`, for two frames known to be equal outside it (the RMS is
+    /// still over every pixel of the frame).
+    pub fn encode_in(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        (frame, pair): (u32, usize),
+        rect: PixelRect,
+    ) {
         let slot = frame.min(self.frames - 1);
-        queue.write_buffer(
-            &self.params,
+        let params = [
+            self.width,
+            self.height,
+            slot,
             0,
-            bytemuck::cast_slice(&[self.width, self.height, slot, 0]),
-        );
+            rect.x0,
+            rect.y0,
+            rect.x1.min(self.width),
+            rect.y1.min(self.height),
+        ];
+        queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params));
+        if rect.is_empty() {
+            return;
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("diff pass"),
             timestamp_writes: None,
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bind_groups[pair], &[]);
-        pass.dispatch_workgroups(1, self.height, 1);
+        pass.dispatch_workgroups(1, rect.y1 - rect.y0, 1);
     }
 
     /// The RMS difference of frames `0..frames` (0 for a frame never encoded), after their submissions.

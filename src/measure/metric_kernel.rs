@@ -1,13 +1,16 @@
 //! The metric kernels of `shaders/metrics.wgsl`: rmse and pop per frame, computed on the GPU and read back as
-//! scalars. Results of every frame of a block go to their own slot of one buffer, read once at the end.
+//! scalars. Results of every frame of a block go to their own slot of one buffer, read once at the end. Each
+//! frame reads the tiles it is given (all of them, or those [`crate::measure::coverage::Coverage`] says can
+//! differ from the background).
 
 use crate::error::Result;
 use crate::gpu::compute::{
-    bind_group, buffer, results_buffers, storage_entry, texture_entry, uniform_buffer,
-    uniform_entry,
+    bind_group, buffer, read_only_storage_entry, results_buffers, storage_entry, texture_entry,
+    uniform_buffer, uniform_entry,
 };
 use crate::gpu::context::GpuContext;
 use crate::gpu::targets::RenderTarget;
+use crate::measure::coverage::TILE;
 use crate::measure::metrics::{FrameMetrics, MetricReduction};
 use wgpu::BufferUsages as U;
 
@@ -19,6 +22,9 @@ pub struct MetricKernel {
     crack_pipeline: wgpu::ComputePipeline,
     uncovered_count: wgpu::Buffer,
     _uncovered_list: wgpu::Buffer,
+    /// The frame's tile list (`tiles` in the shader), each as `tx | ty << 16`.
+    tiles: wgpu::Buffer,
+    tiles_x: u32,
     bind_group: wgpu::BindGroup,
     params: wgpu::Buffer,
     sums: wgpu::Buffer,
@@ -41,6 +47,7 @@ fn metric_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             uniform_entry(4),
             storage_entry(5),
             storage_entry(6),
+            read_only_storage_entry(7),
         ],
     })
 }
@@ -87,6 +94,9 @@ fn metric_pipelines(
 /// Workgroups of `crack_main` (CRACK_GROUPS in the shader).
 const CRACK_GROUPS: u32 = 4;
 
+/// Workgroups per row of the tile dispatch (MAX_ROW in the shader: a dispatch's limit per dimension).
+const MAX_ROW: u32 = 65535;
+
 /// 32-bit words of a frame's slot in the sums buffer: three 64-bit sums, then uncovered_px and crack_px.
 const SLOT_WORDS: u32 = 8;
 
@@ -115,6 +125,13 @@ impl MetricKernel {
         let uncovered_list = buffer(device, "uncovered pixels", pixels.max(1) * 4, U::STORAGE);
         let uncovered_count = buffer(device, "uncovered pixel count", 4, U::STORAGE | U::COPY_DST);
         let prev_error = buffer(device, "previous error image", pixels * 4, U::STORAGE);
+        let (tiles_x, tiles_y) = (width.div_ceil(TILE), height.div_ceil(TILE));
+        let tiles = buffer(
+            device,
+            "metric tiles",
+            (tiles_x as u64 * tiles_y as u64).max(1) * 4,
+            U::STORAGE | U::COPY_DST,
+        );
         let [sums, readback] = results_buffers(
             device,
             ["metric sums", "metric read-back"],
@@ -129,6 +146,7 @@ impl MetricKernel {
             params.as_entire_binding(),
             uncovered_list.as_entire_binding(),
             uncovered_count.as_entire_binding(),
+            tiles.as_entire_binding(),
         ];
         let bind_group = bind_group(device, "metric bind group", &layout, resources);
         ctx.check_errors()?;
@@ -137,6 +155,8 @@ impl MetricKernel {
             crack_pipeline,
             uncovered_count,
             _uncovered_list: uncovered_list,
+            tiles,
+            tiles_x,
             bind_group,
             params,
             sums,
@@ -150,32 +170,48 @@ impl MetricKernel {
         })
     }
 
-    /// Records the metric pass for `frame` (0-based within the block; frame 0 has pop 0). The sums of the
-    /// block are zeroed when frame 0 is recorded.
-    pub fn encode(&self, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder, frame: u32) {
+    /// Records the metric pass for `frame` (0-based within the block; frame 0 has pop 0) over `tiles`
+    /// (indices `ty * tiles_x + tx`; frame 0 must list every tile, since it fills the previous error image).
+    /// The sums of the block are zeroed when frame 0 is recorded.
+    pub fn encode(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: u32,
+        tiles: &[u32],
+    ) {
         let slot = frame.min(self.frames - 1);
         if frame == 0 {
             encoder.clear_buffer(&self.sums, 0, None);
         }
         encoder.clear_buffer(&self.uncovered_count, 0, None);
+        let count = tiles.len() as u32;
         let params = [
             self.width,
             self.height,
             slot,
             (frame > 0) as u32,
             self.background,
-            0,
+            count,
             0,
             0,
         ];
         queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params));
+        if count == 0 {
+            return;
+        }
+        let packed: Vec<u32> = tiles
+            .iter()
+            .map(|t| (t % self.tiles_x) | (t / self.tiles_x) << 16)
+            .collect();
+        queue.write_buffer(&self.tiles, 0, bytemuck::cast_slice(&packed));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("metric pass"),
             timestamp_writes: None,
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bind_group, &[]);
-        pass.dispatch_workgroups(1, self.height, 1);
+        pass.dispatch_workgroups(count.min(MAX_ROW), count.div_ceil(MAX_ROW), 1);
         pass.set_pipeline(&self.crack_pipeline);
         pass.dispatch_workgroups(CRACK_GROUPS, 1, 1);
     }

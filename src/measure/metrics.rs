@@ -220,6 +220,28 @@ pub enum MetricReduction {
     Workgroup,
 }
 
+/// Which pixels the quality pass's kernels read and lodpop's counterfactual draws (`--metric-region`).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum MetricRegion {
+    /// Only the pixels the instances can cover (src/measure/coverage.rs) where that bound holds, else all:
+    /// the same figures for less work.
+    #[default]
+    Covered,
+    /// Every pixel of every frame, and every counterfactual drawn whole (the check of `covered`).
+    Full,
+}
+
 /// Mean FLIP error (LDR-FLIP, Andersson et al. 2020, via the `nv-flip` crate) of the method frame against the
 /// reference frame, at FLIP's default viewing condition (67 pixels per degree).
 pub fn flip_mean(method: &[u8], reference: &[u8], width: u32, height: u32) -> f64 {

@@ -12,6 +12,7 @@
 
 pub mod block;
 pub mod context;
+pub mod coverage;
 pub mod diff_kernel;
 pub mod driver;
 pub mod effects;

@@ -12,6 +12,7 @@
 //! The scalars of all frames are read back once at the end. FSI's combination pass is timed here.
 
 use super::context::BlockGpu;
+use super::coverage::{Coverage, PixelRect};
 use super::diff_kernel::DiffKernel;
 use super::driver::check_interrupt;
 use super::driver::FrameDriver;
@@ -20,11 +21,12 @@ use super::metric_kernel::MetricKernel;
 use crate::error::{Error, Result};
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::{GpuContext, RenderTarget, SceneGpu, TextureReadback};
-use crate::measure::metrics::{FrameMetrics, Metric, MetricReduction};
+use crate::measure::metrics::{FrameMetrics, Metric, MetricReduction, MetricRegion};
 use crate::methods::common::DumpKind;
 use crate::methods::{FrameInput, Method, Registry};
 use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
+use glam::Mat4;
 use indicatif::ProgressBar;
 use std::collections::VecDeque;
 use std::time::Instant;
@@ -36,6 +38,8 @@ pub struct QualityOptions {
     pub metrics: Vec<Metric>,
     /// `--metric-reduction`.
     pub reduction: MetricReduction,
+    /// `--metric-region`.
+    pub region: MetricRegion,
     /// `--quality off`: no quality pass at all (the block builds no stage; its figures are empty).
     pub timing_only: bool,
 }
@@ -128,6 +132,10 @@ pub struct QualityPass {
     pub stage_ms: Option<Vec<Option<f64>>>,
     pub ms_per_frame: f64,
     pub metric_gpu_ms_median: Option<f64>,
+    /// Mean share of the frame's 16 x 16 tiles the metric kernel read.
+    pub metric_tile_share: f64,
+    /// Mean share of the frame's pixels lodpop's counterfactual was drawn in, over the frames it was drawn.
+    pub counterfactual_pixel_share: Option<f64>,
 }
 
 /// The images of one dumped quality-pass frame, RGBA8.
@@ -164,6 +172,8 @@ pub struct QualityStage {
     taa: Option<TaaStreams>,
     /// `--shadows on`: the shadow's own share of the error.
     shadow_share: Option<ShadowShare>,
+    /// `--metric-region`.
+    region: MetricRegion,
 }
 
 /// Keep at most this many quality-pass frames queued on the GPU.
@@ -195,12 +205,19 @@ impl StateHistory {
     }
 
     /// Whether the frame after `push` can differ from its counterfactual: the states changed within the
-    /// history, a transition is under way with a history deeper than one frame, or the method says its
-    /// selection changed (asked last).
-    fn changed(&self, selection_changed: impl FnOnce() -> bool) -> bool {
+    /// history (an instance's state is not `same` as before), a transition is under way with a history
+    /// deeper than one frame, or the method says its selection changed (asked last).
+    fn changed(
+        &self,
+        same: impl Fn(&InstanceState, &InstanceState) -> bool,
+        selection_changed: impl FnOnce() -> bool,
+    ) -> bool {
         let h = &self.frames;
+        let same_frame = |a: &[InstanceState], b: &[InstanceState]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| same(x, y))
+        };
         h.len() > 1
-            && (h.iter().skip(1).any(|s| *s != h[0])
+            && (h.iter().skip(1).any(|s| !same_frame(s, &h[0]))
                 || (self.depth > 1 && h.iter().flatten().any(|s| s.in_transition()))
                 || selection_changed())
     }
@@ -211,13 +228,17 @@ impl StateHistory {
     }
 }
 
+/// Whether two states of an instance draw the same image of it (`Method::same_image_state`).
+type SameImage<'m> = dyn Fn(&InstanceState, &InstanceState) -> bool + 'm;
+
 /// Which counterfactual frames were drawn this frame.
 #[derive(Debug, Clone, Copy)]
 struct Counterfactuals {
     /// The frame without the method's lag (`now`): the method has one.
     unlagged: bool,
-    /// The frame with the previous schedule (`before`): it can differ from the frame.
-    changed: bool,
+    /// The frame with the previous schedule (`before`), drawn inside this rectangle: it can differ from the
+    /// frame there.
+    changed: Option<PixelRect>,
 }
 
 /// The read-backs one frame asked for.
@@ -238,6 +259,12 @@ struct Walk<'d> {
     in_flight: VecDeque<wgpu::SubmissionIndex>,
     flip: Vec<Option<f64>>,
     has_lag: bool,
+    /// Where the frames can differ from the background (the kernels' tiles, the counterfactual's scissor).
+    coverage: Coverage,
+    /// Tiles the metric kernel read, summed over the frames.
+    tiles_read: u64,
+    /// Pixels lodpop's counterfactual was drawn in, summed, and the frames it was drawn on.
+    counterfactual_pixels: (u64, u32),
 }
 
 impl QualityStage {
@@ -266,6 +293,7 @@ impl QualityStage {
             kernels,
             reference,
             de2000: quality.metrics.contains(&Metric::De2000),
+            region: quality.region,
             flip,
             readback,
             dumps: DumpPolicy {
@@ -293,11 +321,20 @@ impl QualityStage {
             in_flight: VecDeque::new(),
             flip: vec![None; frames as usize],
             has_lag: false,
+            coverage: Coverage::new(
+                base.scene,
+                self.region == MetricRegion::Covered
+                    && method.image_confined_to_instances()
+                    && self.reference.image_confined_to_instances(),
+            ),
+            tiles_read: 0,
+            counterfactual_pixels: (0, 0),
         };
         let pass_start = Instant::now();
         if let Some(taa) = &mut self.taa {
             taa.reset();
         }
+        walk.coverage.reset();
         for f in 0..frames {
             check_interrupt()?;
             driver.advance(f);
@@ -332,19 +369,34 @@ impl QualityStage {
         self.render_frames(base, method, &input, &mut encoder);
         let shadows = self.shadow_maps(base, method, &input, walk.history.previous());
         self.apply_effects(base, &input, &mut encoder, f);
-        self.encode_metrics(base, &mut encoder, f);
+        let view_proj = base.scene.camera(f).view_proj();
+        let tiles = walk
+            .coverage
+            .frame_tiles(base.scene, &driver.matrices, view_proj);
+        walk.tiles_read += tiles.len() as u64;
+        self.encode_metrics(base, &mut encoder, f, &tiles);
         let mut reads = self.request_reads(base, method, &mut encoder, dump);
         let mut index = ctx
             .queue
             .submit(shadows.into_iter().chain([encoder.finish()]));
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         walk.history.push(&driver.states);
-        let drawn = self.counterfactuals(base, method, &input, &walk.history, &mut encoder, f);
+        let drawn = self.counterfactuals(
+            base,
+            method,
+            (&input, &walk.history),
+            (&walk.coverage, dump),
+            &mut encoder,
+        );
         walk.has_lag |= drawn.unlagged;
+        if let Some(rect) = drawn.changed {
+            walk.counterfactual_pixels.0 += rect.pixels();
+            walk.counterfactual_pixels.1 += 1;
+        }
         if reads.dump {
             self.request_counterfactual_reads(base, drawn, &mut encoder, &mut reads);
         }
-        if drawn.unlagged || drawn.changed {
+        if drawn.unlagged || drawn.changed.is_some() {
             index = ctx.queue.submit([encoder.finish()]);
         }
         if let Some(taa) = &mut self.taa {
@@ -453,13 +505,19 @@ impl QualityStage {
         }
     }
 
-    /// Stage 4: the metric kernel on (method, reference), timed on its own.
-    fn encode_metrics(&self, base: &BlockGpu<'_>, encoder: &mut wgpu::CommandEncoder, f: u32) {
+    /// Stage 4: the metric kernel on (method, reference) over `tiles`, timed on its own.
+    fn encode_metrics(
+        &self,
+        base: &BlockGpu<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+        f: u32,
+        tiles: &[u32],
+    ) {
         let k = &self.kernels;
         if let Some(t) = &k.metric_timer {
             t.begin(encoder, f);
         }
-        k.metric.encode(&base.ctx.queue, encoder, f);
+        k.metric.encode(&base.ctx.queue, encoder, f, tiles);
         if let Some(t) = &k.metric_timer {
             t.end(encoder, f);
         }
@@ -511,17 +569,20 @@ impl QualityStage {
     }
 
     /// Stage 6: lodpop's and the lag's counterfactual frames at this pose, and their kernels (the method
-    /// writes its instance data again through the queue, so this goes in a submission of its own).
+    /// writes its instance data again through the queue, so this goes in a submission of its own). Where the
+    /// coverage is bounded and the frame is not dumped, lodpop's counterfactual is drawn and compared only
+    /// inside [`QualityStage::changed_rect`] (outside it the two frames are equal), and not at all when that
+    /// is empty.
     fn counterfactuals(
         &self,
         base: &BlockGpu<'_>,
         method: &mut dyn Method,
-        input: &FrameInput<'_>,
-        history: &StateHistory,
+        (input, history): (&FrameInput<'_>, &StateHistory),
+        (coverage, dump): (&Coverage, bool),
         encoder: &mut wgpu::CommandEncoder,
-        f: u32,
     ) -> Counterfactuals {
         let (ctx, gpu, t, k) = (base.ctx, &base.gpu, &self.targets, &self.kernels);
+        let f = input.frame;
         let taa = self.taa.as_ref();
         let unlagged = method.encode_unlagged(gpu, input, encoder, &t.now);
         if unlagged {
@@ -530,18 +591,92 @@ impl QualityStage {
             }
             k.lag.encode(&ctx.queue, encoder, f, 0);
         }
-        let changed = history.changed(|| method.selection_changed());
+        let full = PixelRect::full(base.scene.width, base.scene.height);
+        let covered = self.region == MetricRegion::Covered;
+        let same = |a: &InstanceState, b: &InstanceState| match covered {
+            true => method.same_image_state(a, b),
+            false => a == b,
+        };
+        let mut changed = history.changed(same, || method.selection_changed());
+        let rect = match (changed, dump) {
+            (true, false) => Self::changed_rect(base, input, history, (coverage, &same)),
+            _ => full,
+        };
+        changed &= !rect.is_empty();
         if changed {
             let earlier = history.earlier();
-            gpu.lit_by(ShadowRole::Before.map(), || {
-                method.encode_before(gpu, input, &earlier, encoder, &t.before)
-            });
+            // Inside a scissor, an instance whose rectangle misses it is drawn nowhere: its matrix is zeroed
+            // (every vertex at the clip-space origin, w = 0, so the clipper drops its triangles).
+            let culled: Vec<Mat4>;
+            let input = if rect == full {
+                *input
+            } else {
+                let view_proj = base.scene.camera(f).view_proj();
+                culled = input
+                    .matrices
+                    .iter()
+                    .enumerate()
+                    .map(|(i, m)| {
+                        match coverage
+                            .instance_rect(base.scene, i, *m, view_proj)
+                            .overlaps(&rect)
+                        {
+                            true => *m,
+                            false => Mat4::ZERO,
+                        }
+                    })
+                    .collect();
+                FrameInput {
+                    matrices: &culled,
+                    ..*input
+                }
+            };
+            let mut draw = || {
+                gpu.lit_by(ShadowRole::Before.map(), || {
+                    method.encode_before(gpu, &input, &earlier, encoder, &t.before)
+                })
+            };
+            if rect == full {
+                draw();
+            } else {
+                let [x, y] = [rect.x0, rect.y0];
+                gpu.scissored([x, y, rect.x1 - x, rect.y1 - y], draw);
+            }
             if let Some(taa) = taa {
                 taa.resolve_method_counterfactual(ctx, encoder, &t.before);
             }
-            k.lodpop.encode(&ctx.queue, encoder, f, unlagged as usize);
+            k.lodpop
+                .encode_in(&ctx.queue, encoder, (f, unlagged as usize), rect);
         }
-        Counterfactuals { unlagged, changed }
+        Counterfactuals {
+            unlagged,
+            changed: changed.then_some(rect),
+        }
+    }
+
+    /// Where this frame and its counterfactual can differ: the union of the rectangles of the instances whose
+    /// state differs from the previous frame's, when the coverage is bounded and the method's frame depends on
+    /// one earlier frame only (else the whole frame). Outside it both frames draw the same fragments of the
+    /// same instances in the same order.
+    fn changed_rect(
+        base: &BlockGpu<'_>,
+        input: &FrameInput<'_>,
+        history: &StateHistory,
+        (coverage, same): (&Coverage, &SameImage<'_>),
+    ) -> PixelRect {
+        let full = PixelRect::full(base.scene.width, base.scene.height);
+        let earlier = history.earlier();
+        if !coverage.bounded || history.depth != 1 || earlier.len() != 1 {
+            return full;
+        }
+        let (now, before) = (input.states, earlier[0]);
+        if now.len() != before.len() {
+            return full;
+        }
+        let view_proj = base.scene.camera(input.frame).view_proj();
+        coverage.rect_of(base.scene, input.matrices, view_proj, |i| {
+            !same(&now[i], &before[i])
+        })
     }
 
     /// With a dump: the counterfactual frames drawn this frame, for read-back.
@@ -554,7 +689,11 @@ impl QualityStage {
     ) {
         for (kind, show, target) in [
             (DumpKind::LodpopNow, drawn.unlagged, &self.targets.now),
-            (DumpKind::LodpopBefore, drawn.changed, &self.targets.before),
+            (
+                DumpKind::LodpopBefore,
+                drawn.changed.is_some(),
+                &self.targets.before,
+            ),
         ] {
             if show {
                 let rb = self.copy_of(base, encoder, kind, target);
@@ -624,6 +763,12 @@ impl QualityStage {
         ms_per_frame: f64,
     ) -> Result<QualityPass> {
         let (ctx, k, frames) = (base.ctx, &self.kernels, base.scene.frames);
+        let pixels = base.scene.width as f64 * base.scene.height as f64;
+        let metric_tile_share =
+            walk.tiles_read as f64 / (walk.coverage.tile_count() as f64 * frames.max(1) as f64);
+        let (drawn_pixels, drawn_frames) = walk.counterfactual_pixels;
+        let counterfactual_pixel_share =
+            (drawn_frames > 0).then(|| drawn_pixels as f64 / (pixels * drawn_frames as f64));
         let shadow = match &self.shadow_share {
             Some(share) => Some(ShadowFigures {
                 rmse: share.rmse.read(ctx, frames)?,
@@ -651,6 +796,8 @@ impl QualityStage {
             stage_ms: method.stage_gpu_ms(ctx)?,
             ms_per_frame,
             metric_gpu_ms_median,
+            metric_tile_share,
+            counterfactual_pixel_share,
         })
     }
 }
@@ -675,13 +822,19 @@ mod tests {
         let switched = states(&[(1, 1, 0.0), (3, 3, 0.0)]);
         let mut h = StateHistory::new(1);
         h.push(&steady);
-        assert!(!h.changed(|| true), "the first frame has no earlier frame");
+        assert!(
+            !h.changed(|a, b| a == b, || true),
+            "the first frame has no earlier frame"
+        );
         assert_eq!(h.previous(), Some(steady.as_slice()));
         h.push(&steady);
-        assert!(!h.changed(|| false), "the same states twice");
-        assert!(h.changed(|| true), "the method's own selection changed");
+        assert!(!h.changed(|a, b| a == b, || false), "the same states twice");
+        assert!(
+            h.changed(|a, b| a == b, || true),
+            "the method's own selection changed"
+        );
         h.push(&switched);
-        assert!(h.changed(|| false), "an instance switched");
+        assert!(h.changed(|a, b| a == b, || false), "an instance switched");
         assert_eq!(
             h.earlier(),
             vec![steady.as_slice()],
@@ -699,11 +852,11 @@ mod tests {
             deep.push(&blending);
         }
         assert!(
-            !shallow.changed(|| false),
+            !shallow.changed(|a, b| a == b, || false),
             "one frame back, the same blend state"
         );
         assert!(
-            deep.changed(|| false),
+            deep.changed(|a, b| a == b, || false),
             "two frames back, a transition under way"
         );
         assert_eq!(deep.earlier().len(), 2);

@@ -517,6 +517,12 @@ pub struct BlockInfo {
     pub quality_to_renders_ratio: Option<f64>,
     /// Median GPU time of the metric kernel alone per quality-pass frame (None without timestamps).
     pub metric_gpu_ms_median: Option<f64>,
+    /// The share of the frame's 16 x 16 pixel tiles the metric kernel read, mean over the quality pass's frames (1.0 with
+    /// `--metric-region full` or where no bound holds; docs/measurement.md, "Cost of the quality pass").
+    pub metric_tile_share: Option<f64>,
+    /// The share of the frame's pixels lodpop's counterfactual was drawn in, mean over the frames it was
+    /// drawn on (None when it never was).
+    pub counterfactual_pixel_share: Option<f64>,
     pub extra_target_bytes: u64,
     /// Instance data per timing-pass frame: what the method's draw lists held, and what was written to the
     /// GPU (only the entries that changed since the previous upload into the same buffer range).

@@ -38,6 +38,10 @@ impl Alpha {
 }
 
 impl Method for Alpha {
+    fn image_confined_to_instances(&self) -> bool {
+        true
+    }
+
     fn encode(
         &mut self,
         gpu: &SceneGpu,

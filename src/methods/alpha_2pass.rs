@@ -156,6 +156,10 @@ impl AlphaTwoPass {
 }
 
 impl Method for AlphaTwoPass {
+    fn image_confined_to_instances(&self) -> bool {
+        true
+    }
+
     fn extra_target_bytes(&self) -> u64 {
         let s = self.object_depth.size();
         s.width as u64 * s.height as u64 * 4

@@ -62,6 +62,10 @@ impl AlphaZWrite {
 }
 
 impl Method for AlphaZWrite {
+    fn image_confined_to_instances(&self) -> bool {
+        true
+    }
+
     fn encode(
         &mut self,
         gpu: &SceneGpu,

@@ -123,6 +123,24 @@ pub trait Method {
         false
     }
 
+    /// Whether the method's frame shows nothing but its instances' meshes (the vertices of their LOD chains,
+    /// blended or morphed among themselves, windmill blades turned about their hubs) over the background, with
+    /// each pixel a function of the fragments drawn there alone (no screen-space pass reading other pixels,
+    /// nothing carried from earlier frames). The quality pass then reads only the pixels the instances can
+    /// cover, and draws lodpop's counterfactual only where the instances whose state changed can reach
+    /// (`measure/coverage.rs`); the figures are the same. Default: false (every pixel is read and drawn).
+    fn image_confined_to_instances(&self) -> bool {
+        false
+    }
+
+    /// Whether instance states `a` and `b` draw the same image of the instance (the same fragments with the
+    /// same colours, at the same pose): lodpop's counterfactual is drawn only when some instance's state
+    /// changed by this test (`--metric-region covered`; `full` compares the states whole). Default: the
+    /// states are equal. `discrete` draws one LOD whatever k is.
+    fn same_image_state(&self, a: &InstanceState, b: &InstanceState) -> bool {
+        a == b
+    }
+
     /// How many earlier frames' states this method's frame depends on (1 for a frame that is a function of the
     /// current states; FSI's older LOD buffer makes it 2).
     fn lodpop_history(&self) -> usize {

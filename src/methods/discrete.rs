@@ -29,6 +29,16 @@ impl Discrete {
 }
 
 impl Method for Discrete {
+    fn image_confined_to_instances(&self) -> bool {
+        true
+    }
+
+    /// The LOD shown is the whole of the state's effect: k reaches the instance data (params.x) but the
+    /// opaque pipeline's fragment shader does not read it.
+    fn same_image_state(&self, a: &InstanceState, b: &InstanceState) -> bool {
+        a.discrete_lod() == b.discrete_lod()
+    }
+
     fn encode(
         &mut self,
         gpu: &SceneGpu,

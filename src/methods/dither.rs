@@ -143,6 +143,10 @@ pub fn temporal_offset(size: u32, frame: u32) -> [f32; 2] {
 }
 
 impl Method for Dither {
+    fn image_confined_to_instances(&self) -> bool {
+        true
+    }
+
     fn encode(
         &mut self,
         gpu: &SceneGpu,

@@ -85,6 +85,10 @@ impl Geomorph {
 }
 
 impl Method for Geomorph {
+    fn image_confined_to_instances(&self) -> bool {
+        true
+    }
+
     fn encode(
         &mut self,
         gpu: &SceneGpu,

@@ -20,6 +20,15 @@ impl Reference {
 }
 
 impl Method for Reference {
+    fn image_confined_to_instances(&self) -> bool {
+        true
+    }
+
+    /// LOD0 whatever the state.
+    fn same_image_state(&self, _a: &InstanceState, _b: &InstanceState) -> bool {
+        true
+    }
+
     fn encode(
         &mut self,
         gpu: &SceneGpu,

@@ -21,6 +21,7 @@ mod cli_input;
 mod commands_clips;
 mod commands_experiment;
 // src/measure: the quality pass's figures, and runs without it.
+mod measure_coverage;
 mod measure_lodpop;
 mod measure_quality_off;
 // src/methods: one method (or a family of variants) in images.

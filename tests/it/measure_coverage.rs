@@ -1,0 +1,157 @@
+//! `--metric-region covered` (the default) reads only the pixels the instances can cover and draws lodpop's
+//! counterfactual only where the instances whose state changed reach (src/measure/coverage.rs): every figure
+//! must equal `--metric-region full`'s, frame by frame, on scenes with moving instances (simple in 6 frames moves
+//! its objects across the screen by more than a tile a frame, so a pixel an object leaves must still be read for
+//! its pop),
+//! many instances, turning blades and alpha-tested leaves, and the bound must really have left pixels out.
+
+use crate::common::{read_csv, run_into};
+use std::path::Path;
+
+/// The quality pass's figures of frames.csv (timings left out: they differ run to run).
+const FIGURES: [&str; 8] = [
+    "rmse",
+    "pop",
+    "lodpop",
+    "de2000_mean",
+    "uncovered_px",
+    "crack_px",
+    "triangles",
+    "t_instances",
+];
+
+const METHODS: &str =
+    "reference,discrete,alpha,alpha-2pass,alpha-linear,alpha-zwrite,dither,geomorph";
+
+/// Per block of run.json: (method, metric_tile_share, counterfactual_pixel_share).
+fn shares(dir: &Path) -> Vec<(String, f64, Option<f64>)> {
+    let text = std::fs::read_to_string(dir.join("run.json")).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    json["blocks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| {
+            (
+                format!(
+                    "{} {}",
+                    b["scene"].as_str().unwrap(),
+                    b["method"].as_str().unwrap()
+                ),
+                b["metric_tile_share"].as_f64().unwrap(),
+                b["counterfactual_pixel_share"].as_f64(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn the_covered_region_gives_the_full_frames_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    for (scene, frames) in [
+        ("bunny-sweep", "240"),
+        ("simple", "60"),
+        ("windmills", "40"),
+        ("trees", "24"),
+    ] {
+        let mut figures = Vec::new();
+        for region in ["covered", "full"] {
+            let out = dir.path().join(format!("{scene}-{frames}-{region}"));
+            #[rustfmt::skip]
+            run_into(&out, &[
+                "--scene", scene, "--method", METHODS, "--frames", frames, "--width", "96", "--height", "72",
+                "--rounds", "1", "--warmup", "1", "--metrics", "rmse,pop,de2000", "--metric-region", region,
+            ]);
+            let rows = read_csv(&out.join("frames.csv"));
+            let cells: Vec<Vec<String>> = rows
+                .iter()
+                .map(|r| {
+                    let mut c = vec![r["method"].clone(), r["frame"].clone()];
+                    c.extend(FIGURES.iter().map(|f| r[*f].clone()));
+                    c
+                })
+                .collect();
+            figures.push((cells, shares(&out)));
+        }
+        let (covered, full) = (&figures[0], &figures[1]);
+        assert_eq!(covered.0.len(), full.0.len(), "{scene}: rows");
+        for (a, b) in covered.0.iter().zip(&full.0) {
+            assert_eq!(
+                a, b,
+                "{scene}: [method, frame, {FIGURES:?}] covered vs full"
+            );
+        }
+        assert!(
+            covered.0.iter().any(|c| c[4] != "0"),
+            "{scene}: some frame has lodpop > 0 (the counterfactual was compared)"
+        );
+        for (block, tiles, drawn) in &full.1 {
+            assert_eq!(*tiles, 1.0, "{block}: full reads every tile");
+            assert!(
+                drawn.is_none_or(|d| d == 1.0),
+                "{block}: full draws whole counterfactuals"
+            );
+        }
+        if (scene, frames) == ("bunny-sweep", "240") {
+            // One bunny, most of the path far away: most tiles left out, and the counterfactual of a blend drawn
+            // around the bunny only.
+            for (block, tiles, drawn) in &covered.1 {
+                assert!(*tiles < 0.8, "{block}: tile share {tiles}");
+                assert!(
+                    drawn.is_none_or(|d| d < 0.8),
+                    "{block}: counterfactual share {drawn:?}"
+                );
+            }
+        }
+    }
+}
+
+/// The metric kernel's tiles on a frame are those covered now and those covered on the last frame (a pixel
+/// left out must have had error 0 then): checked against each frame's own tiles on bunny-sweep in 12 frames,
+/// where the bunny shrinks by more than a tile a frame, so some tile covered on a frame is not covered on the
+/// next.
+#[test]
+fn the_tiles_are_this_frames_and_the_last_frames() {
+    use lodbench::measure::coverage::Coverage;
+    use lodbench::measure::FrameDriver;
+    use std::collections::BTreeSet;
+    let scene = crate::common::sweep_scene(&["--frames", "12", "--width", "96", "--height", "72"]);
+    let own = |matrices: &[glam::Mat4], f: u32| -> BTreeSet<u32> {
+        // A fresh coverage lists every tile on its first frame; the second call with the same frame lists
+        // this frame's own tiles.
+        let mut c = Coverage::new(&scene, true);
+        let vp = scene.camera(f).view_proj();
+        c.frame_tiles(&scene, matrices, vp);
+        c.frame_tiles(&scene, matrices, vp).into_iter().collect()
+    };
+    let mut coverage = Coverage::new(&scene, true);
+    assert!(coverage.bounded);
+    let mut driver = FrameDriver::new(&scene);
+    let mut last: Option<BTreeSet<u32>> = None;
+    let mut left_behind = 0;
+    for f in 0..scene.frames {
+        driver.advance(f);
+        let tiles: BTreeSet<u32> = coverage
+            .frame_tiles(&scene, &driver.matrices, scene.camera(f).view_proj())
+            .into_iter()
+            .collect();
+        let now = own(&driver.matrices, f);
+        match &last {
+            None => assert_eq!(
+                tiles.len() as u32,
+                coverage.tile_count(),
+                "frame 0: every tile"
+            ),
+            Some(before) => {
+                let union: BTreeSet<u32> = now.union(before).copied().collect();
+                assert_eq!(
+                    tiles, union,
+                    "frame {f}: this frame's tiles and the last frame's"
+                );
+                left_behind += before.difference(&now).count();
+            }
+        }
+        last = Some(now);
+    }
+    assert!(left_behind > 0, "the bunny left some tile behind");
+}
