@@ -1,10 +1,18 @@
 //! `lodbench perceptual RUN_DIR`: an independent perceptual check of the popping ranking. For each transition
 //! of a run (its transitions.csv), the dumped frames around it (`--dump-frames --dump-transitions`: the
-//! transition's frames, the 2 before and the 2 after) form a clip of each method and one of the reference; the
-//! clip's quality against the reference's is ColorVideoVDP's JOD (Mantiuk et al., SIGGRAPH 2024; 10 = no
+//! transition's frames, the 2 before and the 2 after) form three clips of each method: its own frames, its
+//! counterfactual frames (each frame drawn at its pose with the previous frame's schedule, lodpop's `before`
+//! frames), and the reference's. Two figures, each ColorVideoVDP's JOD (Mantiuk et al., SIGGRAPH 2024; 10 = no
 //! visible difference, lower is worse), computed by the pure-Rust port `colorvideovdp` (validated by its
-//! authors against the PyTorch reference to 3e-6 JOD). It reads only the PNGs, not lodbench's numbers, and
-//! writes `perceptual.csv` beside them with each transition's lodpop for comparison.
+//! authors against the PyTorch reference to 3e-6 JOD):
+//! - `jod_popping`: the method's clip against its own counterfactual clip: how visible the change of LOD
+//!   itself is, frame by frame, with the pose and the static LOD error the same on both sides (the perceptual
+//!   counterpart of lodpop);
+//! - `jod_reference`: the method's clip against the reference's: how far the clip is from the high-poly one
+//!   (quality), where the static LOD error of every frame dominates and a one-frame pop is diluted.
+//!
+//! It reads only the PNGs, not lodbench's numbers, and writes `perceptual.csv` beside them with each
+//! transition's lodpop for comparison.
 
 use crate::cli::PerceptualArgs;
 use crate::error::{Error, Result};
@@ -29,8 +37,11 @@ pub struct PerceptualRecord {
     /// The clip: frames `clip_first..=clip_last`.
     pub clip_first: u32,
     pub clip_last: u32,
-    /// ColorVideoVDP's JOD of the method's clip against the reference's (10 = no visible difference).
-    pub jod: f64,
+    /// ColorVideoVDP's JOD of the method's clip against its counterfactual clip (each frame with the previous
+    /// frame's schedule): the popping (10 = no visible difference).
+    pub jod_popping: f64,
+    /// ColorVideoVDP's JOD of the method's clip against the reference's: the quality.
+    pub jod_reference: f64,
     /// From transitions.csv, for comparison.
     pub lodpop_max: f64,
     pub pop_max: f64,
@@ -128,11 +139,16 @@ impl Clips<'_> {
         w
     }
 
-    /// The method's and the reference's clip of `t`, every frame of `window` dumped.
-    fn load(&self, t: &TransitionRecord, window: ClipWindow) -> Result<ClipPair> {
+    /// The method's, its counterfactual's and the reference's clip of `t`, every frame of `window` dumped. The
+    /// popping test frame is lodpop's `now` frame where the method has one (FSI's frame without its lag), else
+    /// the method's; the counterfactual frame is lodpop's `before` frame where the quality pass drew one, else
+    /// the test frame itself (nothing changed: the two are the same frame).
+    fn load(&self, t: &TransitionRecord, window: ClipWindow) -> Result<ClipSet> {
         let (first, last) = (window.first, window.last);
         let mut test = Vec::new();
         let mut reference = Vec::new();
+        let mut now = Vec::new();
+        let mut before = Vec::new();
         for f in window.frames() {
             let m = self.path(t, f, DumpKind::Method);
             if !m.is_file() {
@@ -146,17 +162,37 @@ impl Clips<'_> {
                     ),
                 ));
             }
-            test.push(load(&m)?);
+            let shown = load(&m)?;
+            let unlagged = self.path(t, f, DumpKind::LodpopNow);
+            let popping_test = match unlagged.is_file() {
+                true => load(&unlagged)?,
+                false => shown.clone(),
+            };
+            let counterfactual = self.path(t, f, DumpKind::LodpopBefore);
+            before.push(match counterfactual.is_file() {
+                true => load(&counterfactual)?,
+                false => popping_test.clone(),
+            });
+            now.push(popping_test);
+            test.push(shown);
             reference.push(load(&self.path(t, f, DumpKind::Reference))?);
         }
-        Ok(ClipPair { test, reference })
+        Ok(ClipSet {
+            test,
+            reference,
+            now,
+            before,
+        })
     }
 }
 
-/// The frames of one transition's clip: the method's (the test) and the reference's.
-struct ClipPair {
+/// The clips of one transition: the method's frames (the test) and the reference's; lodpop's two sides, the
+/// frames with this frame's schedule (`now`) and with the previous frame's (`before`).
+struct ClipSet {
     test: Vec<Image>,
     reference: Vec<Image>,
+    now: Vec<Image>,
+    before: Vec<Image>,
 }
 
 /// Scores every method's clip of every transition in `dir` and writes `dir/perceptual.csv`.
@@ -178,9 +214,14 @@ pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<Perceptual
         };
         let window = clips.window(t);
         let clip = clips.load(t, window)?;
-        let p = metric
-            .predict_video(&clip.test, &clip.reference, settings.fps, Color::Srgb)
-            .map_err(|e| Error::Perceptual(e.to_string()))?;
+        let jod = |test: &[Image], reference: &[Image]| {
+            metric
+                .predict_video(test, reference, settings.fps, Color::Srgb)
+                .map(|p| p.jod as f64)
+                .map_err(|e| Error::Perceptual(e.to_string()))
+        };
+        let jod_popping = jod(&clip.now, &clip.before)?;
+        let jod_reference = jod(&clip.test, &clip.reference)?;
         out.push(PerceptualRecord {
             scene: t.scene.clone(),
             method: t.method.clone(),
@@ -188,7 +229,8 @@ pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<Perceptual
             transition: t.transition,
             clip_first: window.first,
             clip_last: window.last,
-            jod: p.jod as f64,
+            jod_popping,
+            jod_reference,
             lodpop_max,
             pop_max,
         });
@@ -231,8 +273,8 @@ struct TransitionKey<'a> {
     transition: u32,
 }
 
-/// The table `lodbench perceptual` prints: per transition, each method's JOD and lodpop, and Kendall's tau
-/// between the ranking by JOD (higher is better) and by lodpop (lower is better).
+/// The table `lodbench perceptual` prints: per transition, each method's two JODs and lodpop, and Kendall's tau
+/// between the ranking by the popping JOD (higher is better) and by lodpop (lower is better).
 pub fn table(records: &[PerceptualRecord]) -> String {
     let mut out = String::new();
     let mut keys: Vec<TransitionKey> = Vec::new();
@@ -256,17 +298,17 @@ pub fn table(records: &[PerceptualRecord]) -> String {
             .iter()
             .filter(|r| r.scene == scene && r.count == count && r.transition == transition)
             .collect();
-        let jod: Vec<f64> = rows.iter().map(|r| r.jod).collect();
+        let jod: Vec<f64> = rows.iter().map(|r| r.jod_popping).collect();
         let lodpop: Vec<f64> = rows.iter().map(|r| -r.lodpop_max).collect();
         let tau = kendall_tau(&jod, &lodpop).map_or("-".into(), |t| format!("{t:.2}"));
         out.push_str(&format!(
-            "{scene} n={count} transition {transition} (frames {}-{}): Kendall tau(JOD, -lodpop) = {tau}\n",
+            "{scene} n={count} transition {transition} (frames {}-{}): Kendall tau(JOD popping, -lodpop) = {tau}\n",
             rows[0].clip_first, rows[0].clip_last
         ));
         for r in rows {
             out.push_str(&format!(
-                "  {:<16} JOD {:>7.4}  lodpop_max {:.5}  pop_max {:.5}\n",
-                r.method, r.jod, r.lodpop_max, r.pop_max
+                "  {:<16} JOD popping {:>7.4}  JOD vs reference {:>7.4}  lodpop_max {:.5}  pop_max {:.5}\n",
+                r.method, r.jod_popping, r.jod_reference, r.lodpop_max, r.pop_max
             ));
         }
     }

@@ -1,7 +1,6 @@
-//! The TAA resolve of `shaders/taa.wgsl` (`--taa on`, src/taa.rs): per image stream (the method's frames, the
-//! reference's), two history textures used in turn, so the frame's own resolve writes the new history while the
-//! counterfactual frames of the same pose (lodpop's, FSI's lag) are resolved against the same previous history
-//! without changing it.
+//! The TAA resolve of `shaders/taa.wgsl` (`--taa on`, src/effects/taa.rs): per image stream (the method's
+//! frames, the reference's, and each counterfactual stream of the quality pass, measure/effects.rs), two history
+//! textures used in turn: a frame's resolve reads the previous history and writes the next one.
 
 use crate::effects::taa::Taa;
 use crate::formats::COLOR_FORMAT;
@@ -20,8 +19,6 @@ pub struct TaaResolve {
 /// One image stream's history.
 pub struct TaaStream {
     history: [wgpu::Texture; 2],
-    /// Where a counterfactual resolve writes its history (discarded).
-    scratch_history: wgpu::Texture,
     /// The resolved frame before it is copied back into the target.
     resolved: wgpu::Texture,
     params: wgpu::Buffer,
@@ -79,7 +76,6 @@ impl TaaResolve {
                 texture("history 0", HISTORY_FORMAT),
                 texture("history 1", HISTORY_FORMAT),
             ],
-            scratch_history: texture("scratch", HISTORY_FORMAT),
             resolved: texture("resolved", COLOR_FORMAT),
             params: d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(&format!("{label} taa params")),
@@ -106,24 +102,18 @@ impl TaaResolve {
             .write_buffer(&stream.params, 0, bytemuck::cast_slice(&words));
     }
 
-    /// Resolves `target` in place against `stream`'s previous history. `commit`: this is the frame itself, whose
-    /// result is the next frame's history; otherwise a counterfactual of the same pose (the history is kept).
+    /// Resolves `target` in place against `stream`'s previous history, writing the stream's next history (the
+    /// stream's frame of this frame; [`TaaStream::advance`] after the frame's submissions).
     pub fn encode(
         &self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         stream: &TaaStream,
         target: &RenderTarget,
-        commit: bool,
     ) {
         let device = &ctx.device;
         let previous = stream.history[stream.previous].create_view(&Default::default());
-        let next = if commit {
-            &stream.history[1 - stream.previous]
-        } else {
-            &stream.scratch_history
-        }
-        .create_view(&Default::default());
+        let next = stream.history[1 - stream.previous].create_view(&Default::default());
         let resolved = stream.resolved.create_view(&Default::default());
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("taa resolve"),

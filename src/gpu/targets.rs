@@ -85,6 +85,19 @@ impl RenderTarget {
         }
     }
 
+    /// Records a copy of this target's colour into `to`'s (the same size).
+    pub fn copy_color_to(&self, encoder: &mut wgpu::CommandEncoder, to: &RenderTarget) {
+        encoder.copy_texture_to_texture(
+            self.color.as_image_copy(),
+            to.color.as_image_copy(),
+            wgpu::Extent3d {
+                width: self.width.min(to.width),
+                height: self.height.min(to.height),
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+
     /// Bytes of colour and depth this target holds.
     pub fn bytes(&self) -> u64 {
         self.width as u64 * self.height as u64 * 8

@@ -167,72 +167,98 @@ impl ShadowShare {
     }
 }
 
-/// `--taa on`: the resolve, and the image streams of the method and of the reference, each with its history.
+/// The quality pass's image streams under `--taa on`, each resolved against its own history every frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stream {
+    /// The method's frames: what the viewer sees.
+    Method,
+    /// The reference's frames.
+    Reference,
+    /// lodpop's counterfactual stream: every frame, the method drawn at this frame's pose with the previous
+    /// frame's schedule (the method's own frame where the two draw the same), so that lodpop_t = RMS(O_t - O'_t)
+    /// of two streams, each with the history it built (docs/measurement.md, "lodpop under TAA").
+    Before,
+    /// A lagged method's (FSI's) frames without the lag: the side lodpop compares with `Before`, and lag_rmse
+    /// with `Method`.
+    Unlagged,
+    /// `--shadows on`: the reference's objects lit by the method's shadow map, and by its counterfactual's.
+    ShadowNow,
+    ShadowBefore,
+}
+
+impl Stream {
+    const ALL: [Stream; 6] = [
+        Stream::Method,
+        Stream::Reference,
+        Stream::Before,
+        Stream::Unlagged,
+        Stream::ShadowNow,
+        Stream::ShadowBefore,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            Stream::Method => "method",
+            Stream::Reference => "reference",
+            Stream::Before => "lodpop before",
+            Stream::Unlagged => "unlagged",
+            Stream::ShadowNow => "shadow now",
+            Stream::ShadowBefore => "shadow before",
+        }
+    }
+}
+
+/// `--taa on`: the resolve, and the quality pass's image streams ([`Stream`]), each with its own history. A
+/// counterfactual never borrows another stream's history: a frame that differs once keeps differing through
+/// the history for a few frames after, as the viewer sees it.
 pub struct TaaStreams {
     pub resolve: TaaResolve,
-    pub method: TaaStream,
-    pub reference: TaaStream,
+    streams: Vec<TaaStream>,
 }
 
 impl TaaStreams {
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Option<TaaStreams> {
         let resolve = TaaResolve::new(ctx, scene.taa?);
         let (w, h) = (scene.width, scene.height);
-        Some(TaaStreams {
-            method: resolve.stream(ctx, "method", w, h),
-            reference: resolve.stream(ctx, "reference", w, h),
-            resolve,
-        })
+        let streams = Stream::ALL
+            .iter()
+            .filter(|s| {
+                scene.shadows.is_some() || !matches!(s, Stream::ShadowNow | Stream::ShadowBefore)
+            })
+            .map(|s| resolve.stream(ctx, s.name(), w, h))
+            .collect();
+        Some(TaaStreams { resolve, streams })
+    }
+
+    fn stream(&self, s: Stream) -> Option<&TaaStream> {
+        self.streams.get(s as usize)
     }
 
     pub fn reset(&mut self) {
-        self.method.reset();
-        self.reference.reset();
+        self.streams.iter_mut().for_each(TaaStream::reset);
     }
 
     pub fn begin_frame(&self, ctx: &GpuContext) {
-        self.resolve.begin_frame(ctx, &self.method);
-        self.resolve.begin_frame(ctx, &self.reference);
+        for s in &self.streams {
+            self.resolve.begin_frame(ctx, s);
+        }
     }
 
-    /// Both frames resolved in place, each against its own history, which they update.
-    pub fn resolve_frames(
+    /// `target`, stream `s`'s frame, resolved in place against the stream's history, which it updates.
+    pub fn resolve(
         &self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        method: &RenderTarget,
-        reference: &RenderTarget,
-    ) {
-        self.resolve
-            .encode(ctx, encoder, &self.method, method, true);
-        self.resolve
-            .encode(ctx, encoder, &self.reference, reference, true);
-    }
-
-    /// A counterfactual of the method's frame resolved against the method's history, leaving it as it is.
-    pub fn resolve_method_counterfactual(
-        &self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
+        s: Stream,
         target: &RenderTarget,
     ) {
-        self.resolve
-            .encode(ctx, encoder, &self.method, target, false);
+        if let Some(stream) = self.stream(s) {
+            self.resolve.encode(ctx, encoder, stream, target);
+        }
     }
 
-    /// A counterfactual of the reference's frame resolved against the reference's history, leaving it as it is.
-    pub fn resolve_reference_counterfactual(
-        &self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &RenderTarget,
-    ) {
-        self.resolve
-            .encode(ctx, encoder, &self.reference, target, false);
-    }
-
+    /// After the frame's submissions: every stream's new history becomes the previous one.
     pub fn advance(&mut self) {
-        self.method.advance();
-        self.reference.advance();
+        self.streams.iter_mut().for_each(TaaStream::advance);
     }
 }

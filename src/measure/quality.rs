@@ -16,7 +16,7 @@ use super::coverage::{Coverage, PixelRect};
 use super::diff_kernel::DiffKernel;
 use super::driver::check_interrupt;
 use super::driver::FrameDriver;
-use super::effects::{Casters, ShadowRole, ShadowShare, TaaStreams};
+use super::effects::{Casters, ShadowRole, ShadowShare, Stream, TaaStreams};
 use super::metric_kernel::MetricKernel;
 use crate::error::{Error, Result};
 use crate::gpu::timing::GpuTimer;
@@ -239,6 +239,8 @@ struct Counterfactuals {
     /// The frame with the previous schedule (`before`), drawn inside this rectangle: it can differ from the
     /// frame there.
     changed: Option<PixelRect>,
+    /// lodpop compared the frame with `before` (drawn, or under TAA the counterfactual stream's frame).
+    compared: bool,
 }
 
 /// The read-backs one frame asked for.
@@ -367,8 +369,9 @@ impl QualityStage {
             self.clear_kernels(&mut encoder);
         }
         self.render_frames(base, method, &input, &mut encoder);
-        let shadows = self.shadow_maps(base, method, &input, walk.history.previous());
-        self.apply_effects(base, &input, &mut encoder, f);
+        let previous = walk.history.previous();
+        let shadows = self.shadow_maps(base, method, &input, previous);
+        self.apply_effects(base, &input, &mut encoder, (f, previous.is_some()));
         let view_proj = base.scene.camera(f).view_proj();
         let tiles = walk
             .coverage
@@ -396,7 +399,7 @@ impl QualityStage {
         if reads.dump {
             self.request_counterfactual_reads(base, drawn, &mut encoder, &mut reads);
         }
-        if drawn.unlagged || drawn.changed.is_some() {
+        if drawn.unlagged || drawn.changed.is_some() || self.taa.is_some() {
             index = ctx.queue.submit([encoder.finish()]);
         }
         if let Some(taa) = &mut self.taa {
@@ -473,31 +476,40 @@ impl QualityStage {
         out
     }
 
-    /// Stage 3: TAA resolves both frames in place (each against its own history) before anything reads them;
-    /// the shadow's own share: LOD0 objects lit by the method's shadow map now and by its counterfactual's
-    /// (resolved against the reference's history under TAA, which they leave as it is).
+    /// Stage 3: TAA resolves both frames in place (each against its own history) before anything reads them,
+    /// after the method's frame is copied into lodpop's `before` target (the counterfactual stream's frame
+    /// unless stage 6 draws one); the shadow's own share: LOD0 objects lit by the method's shadow map now and
+    /// by its counterfactual's (on the first frame, which has no earlier schedule, the same frame), each its
+    /// own stream under TAA. `has_previous`: the frame has an earlier one.
     fn apply_effects(
         &mut self,
         base: &BlockGpu<'_>,
         input: &FrameInput<'_>,
         encoder: &mut wgpu::CommandEncoder,
-        f: u32,
+        (f, has_previous): (u32, bool),
     ) {
         let (ctx, gpu, t, reference) = (base.ctx, &base.gpu, &self.targets, &mut self.reference);
         if let Some(taa) = &self.taa {
-            taa.resolve_frames(ctx, encoder, &t.method, &t.reference);
+            t.method.copy_color_to(encoder, &t.before);
+            taa.resolve(ctx, encoder, Stream::Method, &t.method);
+            taa.resolve(ctx, encoder, Stream::Reference, &t.reference);
         }
         let Some(share) = &self.shadow_share else {
             return;
         };
-        for (role, target) in [
-            (ShadowRole::Method, &share.now),
-            (ShadowRole::Before, &share.before),
-        ] {
-            gpu.lit_by(role.map(), || reference.encode(gpu, input, encoder, target));
-            if let Some(taa) = &self.taa {
-                taa.resolve_reference_counterfactual(ctx, encoder, target);
-            }
+        gpu.lit_by(ShadowRole::Method.map(), || {
+            reference.encode(gpu, input, encoder, &share.now)
+        });
+        if has_previous {
+            gpu.lit_by(ShadowRole::Before.map(), || {
+                reference.encode(gpu, input, encoder, &share.before);
+            });
+        } else {
+            share.now.copy_color_to(encoder, &share.before);
+        }
+        if let Some(taa) = &self.taa {
+            taa.resolve(ctx, encoder, Stream::ShadowNow, &share.now);
+            taa.resolve(ctx, encoder, Stream::ShadowBefore, &share.before);
         }
         share.rmse.encode(&ctx.queue, encoder, f, 0);
         if f > 0 {
@@ -572,7 +584,10 @@ impl QualityStage {
     /// writes its instance data again through the queue, so this goes in a submission of its own). Where the
     /// coverage is bounded and the frame is not dumped, lodpop's counterfactual is drawn and compared only
     /// inside [`QualityStage::changed_rect`] (outside it the two frames are equal), and not at all when that
-    /// is empty.
+    /// is empty. Under TAA each counterfactual is a stream of its own: `before` is fed every frame (the
+    /// method's own frame, or the unlagged one, where the counterfactual is not drawn: the two are equal
+    /// there) and compared on every frame but the first, since the histories differ for some frames after any
+    /// difference.
     fn counterfactuals(
         &self,
         base: &BlockGpu<'_>,
@@ -584,18 +599,16 @@ impl QualityStage {
         let (ctx, gpu, t, k) = (base.ctx, &base.gpu, &self.targets, &self.kernels);
         let f = input.frame;
         let taa = self.taa.as_ref();
-        let unlagged = method.encode_unlagged(gpu, input, encoder, &t.now);
-        if unlagged {
-            if let Some(taa) = taa {
-                taa.resolve_method_counterfactual(ctx, encoder, &t.now);
-            }
-            k.lag.encode(&ctx.queue, encoder, f, 0);
-        }
         let full = PixelRect::full(base.scene.width, base.scene.height);
         let covered = self.region == MetricRegion::Covered;
-        let same = |a: &InstanceState, b: &InstanceState| match covered {
-            true => method.same_image_state(a, b),
-            false => a == b,
+        // A transition's moving pattern (dither --noise-temporal) changes an instance in transition every frame.
+        let moving = method.transition_pattern_moves();
+        let same = |a: &InstanceState, b: &InstanceState| {
+            !(moving && (a.in_transition() || b.in_transition()))
+                && match covered {
+                    true => method.same_image_state(a, b),
+                    false => a == b,
+                }
         };
         let mut changed = history.changed(same, || method.selection_changed());
         let rect = match (changed, dump) {
@@ -603,6 +616,16 @@ impl QualityStage {
             _ => full,
         };
         changed &= !rect.is_empty();
+        let unlagged = method.encode_unlagged(gpu, input, encoder, &t.now);
+        if unlagged {
+            if let Some(taa) = taa {
+                if !changed {
+                    t.now.copy_color_to(encoder, &t.before);
+                }
+                taa.resolve(ctx, encoder, Stream::Unlagged, &t.now);
+            }
+            k.lag.encode(&ctx.queue, encoder, f, 0);
+        }
         if changed {
             let earlier = history.earlier();
             // Inside a scissor, an instance whose rectangle misses it is drawn nowhere: its matrix is zeroed
@@ -642,15 +665,23 @@ impl QualityStage {
                 let [x, y] = [rect.x0, rect.y0];
                 gpu.scissored([x, y, rect.x1 - x, rect.y1 - y], draw);
             }
-            if let Some(taa) = taa {
-                taa.resolve_method_counterfactual(ctx, encoder, &t.before);
-            }
-            k.lodpop
-                .encode_in(&ctx.queue, encoder, (f, unlagged as usize), rect);
+        }
+        if let Some(taa) = taa {
+            taa.resolve(ctx, encoder, Stream::Before, &t.before);
+        }
+        let compared = changed || (taa.is_some() && f > 0);
+        if compared {
+            k.lodpop.encode_in(
+                &ctx.queue,
+                encoder,
+                (f, unlagged as usize),
+                if changed { rect } else { full },
+            );
         }
         Counterfactuals {
             unlagged,
             changed: changed.then_some(rect),
+            compared,
         }
     }
 
@@ -689,11 +720,7 @@ impl QualityStage {
     ) {
         for (kind, show, target) in [
             (DumpKind::LodpopNow, drawn.unlagged, &self.targets.now),
-            (
-                DumpKind::LodpopBefore,
-                drawn.changed.is_some(),
-                &self.targets.before,
-            ),
+            (DumpKind::LodpopBefore, drawn.compared, &self.targets.before),
         ] {
             if show {
                 let rb = self.copy_of(base, encoder, kind, target);

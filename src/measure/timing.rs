@@ -1,7 +1,9 @@
 //! The warm-up and the timing rounds of a block's methods.
 //!
-//! - Warm-up ([`WarmUpPlan`]): `warmup` untimed frames, then the first frames of each distinct transition, so
-//!   every pipeline a method uses has run once before timing.
+//! - Warm-up ([`WarmUpPlan`]): `warmup` untimed frames, then the first frames of each distinct transition on
+//!   each side of its midpoint, so every pipeline a method uses has run once before timing, then the first
+//!   timed frame's pose as the frame before it (`Method::replay_as_previous`), so the first timed frame finds
+//!   the state every later one finds.
 //! - Timing rounds ([`BlockRunner::time_methods`]): the path is cut into `rounds` consecutive segments; round r
 //!   times every method over segment r in a seeded shuffled order, each method continuing its own walk, so drift
 //!   of the machine's speed falls on all methods alike and each round pairs the methods on the same frames.
@@ -72,8 +74,11 @@ pub fn reference_ms_per_frame(timed: &[TimedMethod<'_>]) -> Option<f64> {
 }
 
 /// The frames every method renders untimed before the rounds: the first `warmup` frames of the path (wrapping),
-/// then the first frame of each distinct transition of the path (`lod_from -> lod_to` pair) and the two frames
-/// after it, so that every pipeline and buffer a method uses in a transition is used once before timing.
+/// then the first frame of each distinct transition of the path on each side of its midpoint (`lod_from ->
+/// lod_to` pair, and k below or from 0.5: a transition walked back has the same pair and starts from the other
+/// side) and the two frames after it, so that every pipeline and buffer a method uses in a transition is used
+/// once before timing (`alpha-zwrite` switches pipelines at k = 0.5). The warm-up then ends on frame 0 (see
+/// [`BlockGpu::time_methods`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct WarmUpPlan {
     pub warmup: u32,
@@ -84,12 +89,13 @@ impl WarmUpPlan {
     /// Walks the path once on the CPU to find the transitions.
     pub fn new(scene: &Scene, warmup: u32) -> WarmUpPlan {
         let mut driver = FrameDriver::new(scene);
-        let mut seen: Vec<TransitionPair> = Vec::new();
+        let mut seen: Vec<(TransitionPair, bool)> = Vec::new();
         let mut frames: Vec<u32> = Vec::new();
         for f in 0..scene.frames {
-            let pair = driver.advance(f).pair;
-            if pair != TransitionPair::None && !seen.contains(&pair) {
-                seen.push(pair);
+            let facts = driver.advance(f);
+            let key = (facts.pair, facts.k_mean.is_some_and(|k| k >= 0.5));
+            if facts.pair != TransitionPair::None && !seen.contains(&key) {
+                seen.push(key);
                 frames.extend((f..f + 3).filter(|&g| g < scene.frames));
             }
         }
@@ -204,7 +210,9 @@ impl<'a> BlockGpu<'a> {
         })
     }
 
-    /// `plan`'s warm-up frames, untimed.
+    /// `plan`'s warm-up frames, untimed, then frame 0 as the frame before the first timed frame (frame 0 of
+    /// round 0): drawn, then handed to `Method::replay_as_previous`, so that the first timed frame follows a
+    /// frame as every other does (FSI renders one LOD buffer there, not both).
     fn warm_up(
         &self,
         m: &mut TimedMethod<'_>,
@@ -228,6 +236,12 @@ impl<'a> BlockGpu<'a> {
             if plan.transition_frames.binary_search(&f).is_ok() {
                 self.render_untimed(m, f)?;
             }
+        }
+        m.driver.reset();
+        if scene.frames > 0 {
+            m.driver.advance(0);
+            self.render_untimed(m, 0)?;
+            m.method.replay_as_previous();
         }
         Ok(())
     }

@@ -141,6 +141,20 @@ pub trait Method {
         a == b
     }
 
+    /// The frame just drawn (untimed, at the pose of the frame that comes next) stands for the frame before the
+    /// next one: the warm-up ends this way on the first timed frame's pose, so that the first timed frame finds
+    /// the state every later timed frame finds (FSI: the older LOD buffer of the previous frame). Default:
+    /// nothing to do, for a method whose frame depends on the current frame alone.
+    fn replay_as_previous(&mut self) {}
+
+    /// Whether the frame of an instance in transition changes every frame at the same state, through an input
+    /// that exists only because of the transition (dither's pattern under `--noise-temporal`). That input is
+    /// part of the transition state: lodpop's counterfactual holds it at frame t-1 (`encode_before`), and an
+    /// instance in transition counts as changed on every frame. Default: false.
+    fn transition_pattern_moves(&self) -> bool {
+        false
+    }
+
     /// How many earlier frames' states this method's frame depends on (1 for a frame that is a function of the
     /// current states; FSI's older LOD buffer makes it 2).
     fn lodpop_history(&self) -> usize {

@@ -8,6 +8,7 @@ use super::common::{instance_raw, FrameInput, Method};
 use crate::gpu::{DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::methods::noise::threshold_texture;
 use crate::methods::noise::NoisePattern;
+use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
 
 /// `dither`'s flags.
@@ -44,6 +45,8 @@ pub struct Dither {
     params: wgpu::Buffer,
     /// `--noise-temporal`: the tile size (0: ign), whose pattern moves every frame.
     temporal: Option<u32>,
+    /// lodpop's counterfactual: the frame whose pattern phase to draw instead of the input's (t-1).
+    pattern_frame: Option<u32>,
 }
 
 impl Dither {
@@ -124,6 +127,7 @@ impl Dither {
             noise_group,
             params,
             temporal,
+            pattern_frame: None,
         }
     }
 }
@@ -145,6 +149,30 @@ pub fn temporal_offset(size: u32, frame: u32) -> [f32; 2] {
 impl Method for Dither {
     fn image_confined_to_instances(&self) -> bool {
         true
+    }
+
+    fn transition_pattern_moves(&self) -> bool {
+        self.temporal.is_some()
+    }
+
+    /// The previous frame's states, and under `--noise-temporal` the previous frame's pattern phase: the
+    /// pattern moves only because instances are in transition, so its motion is part of the transition.
+    fn encode_before(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        history: &[&[InstanceState]],
+        encoder: &mut wgpu::CommandEncoder,
+        before: &RenderTarget,
+    ) {
+        let previous = FrameInput {
+            states: history[0],
+            timed: false,
+            ..*input
+        };
+        self.pattern_frame = Some(input.frame.wrapping_sub(1));
+        self.encode(gpu, &previous, encoder, before);
+        self.pattern_frame = None;
     }
 
     fn encode(
@@ -181,7 +209,8 @@ impl Method for Dither {
         self.list.build();
         gpu.upload(&self.buffer, &self.list);
         if let Some(size) = self.temporal {
-            let [x, y] = temporal_offset(size, input.frame);
+            let frame = self.pattern_frame.unwrap_or(input.frame);
+            let [x, y] = temporal_offset(size, frame);
             let words = [size, 0, x.to_bits(), y.to_bits()];
             gpu.queue
                 .write_buffer(&self.params, 0, bytemuck::cast_slice(&words));

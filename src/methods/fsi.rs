@@ -867,6 +867,15 @@ impl Method for Fsi {
         }
     }
 
+    /// The frame just drawn becomes the previous one of the same frame number, so that frame follows it: its
+    /// older LOD buffer (rendered at that frame's pose, the same LODs) is reused and only the newer one is
+    /// rendered.
+    fn replay_as_previous(&mut self) {
+        if let Some((f, camera)) = self.previous {
+            self.previous = Some((f.wrapping_sub(1), camera));
+        }
+    }
+
     fn encode(
         &mut self,
         gpu: &SceneGpu,

@@ -193,3 +193,100 @@ fn bad_taa_flags_are_refused() {
         assert!(err.contains(flag), "{err}");
     }
 }
+
+/// bunny-sweep close up at 128x96 over `frames` frames, `methods` and the reference, with `extra` flags; the
+/// frames and the transitions of the run.
+fn sweep_run(
+    out: &Path,
+    methods: &str,
+    frames: u32,
+    extra: &[&str],
+) -> (crate::common::Rows, crate::common::Rows) {
+    let f = frames.to_string();
+    let mut args = vec![
+        "--scene",
+        "bunny-sweep",
+        "--frames",
+        &f,
+        "--width",
+        "128",
+        "--height",
+        "96",
+        "--sweep-start",
+        "close-up",
+        "--method",
+        methods,
+        "--warmup",
+        "0",
+        "--rounds",
+        "1",
+    ];
+    args.extend_from_slice(extra);
+    let dir = run_into(out, &args);
+    (
+        read_csv(&dir.join("frames.csv")),
+        read_csv(&dir.join("transitions.csv")),
+    )
+}
+
+/// lodpop under TAA is the difference of two TAA streams, each with its own history (the method's, and its
+/// counterfactual fed every frame with the frame of the previous schedule): (1) discrete's hard switch scores
+/// about alpha x Delta on its frame and a decaying tail after it, on at least 5 frames, while the same path
+/// without TAA scores on the switch frame alone; (2) alpha's ramp keeps its per-frame slope through the
+/// history, so its largest lodpop per transition under TAA is at least half of what it is without TAA (a
+/// counterfactual resolved against the method's own history would report about alpha = 0.1 of it).
+#[test]
+fn lodpop_under_taa_is_the_difference_of_two_streams() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (plain, plain_t) = sweep_run(&tmp.path().join("plain"), "discrete,alpha", 200, &[]);
+    let (taa, taa_t) = sweep_run(
+        &tmp.path().join("taa"),
+        "discrete,alpha",
+        200,
+        &["--taa", "on"],
+    );
+
+    let switches: Vec<usize> = col(&plain, "discrete", "lodpop")
+        .iter()
+        .enumerate()
+        .filter(|(_, &x)| x > 0.0)
+        .map(|(f, _)| f)
+        .collect();
+    let lodpop = col(&taa, "discrete", "lodpop");
+    // Every switch with 5 frames after it on the path (the last one, back at LOD0, may lie nearer the end).
+    let switches: Vec<usize> = switches
+        .into_iter()
+        .filter(|&s| s + 6 <= lodpop.len())
+        .collect();
+    assert!(switches.len() >= 4, "discrete switches: {switches:?}");
+    for &s in &switches {
+        let tail = &lodpop[s..s + 6];
+        eprintln!("discrete under TAA from switch frame {s}: {tail:.5?}");
+        assert!(tail.iter().all(|&x| x > 0.0), "frame {s}: {tail:?}");
+        for w in tail.windows(2) {
+            assert!(
+                w[1] < w[0],
+                "switch {s}: the tail does not decrease: {tail:?}"
+            );
+        }
+    }
+
+    let max_of = |rows: &crate::common::Rows, t: &str| -> f64 {
+        rows.iter()
+            .find(|r| r["method"] == "alpha" && r["transition"] == t)
+            .unwrap_or_else(|| panic!("alpha transition {t}"))["lodpop_max"]
+            .parse()
+            .unwrap()
+    };
+    let n = plain_t.iter().filter(|r| r["method"] == "alpha").count();
+    assert!(n >= 2);
+    for t in 0..n {
+        let t = t.to_string();
+        let (without, with) = (max_of(&plain_t, &t), max_of(&taa_t, &t));
+        eprintln!("alpha transition {t}: lodpop_max {without:.5} without TAA, {with:.5} with");
+        assert!(
+            with >= 0.5 * without,
+            "transition {t}: alpha's lodpop_max {with} under TAA, {without} without"
+        );
+    }
+}

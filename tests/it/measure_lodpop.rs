@@ -181,3 +181,48 @@ fn gpu_lodpop_and_lag_match_the_cpu_oracle() {
         .filter(|r| r["method"] == "alpha")
         .all(|r| r["lag_rmse"].is_empty()));
 }
+
+/// dither's moving pattern (`--noise-temporal`) moves only because an instance is in transition, so its
+/// motion is part of the transition: a static bunny held at its first switch distance (k = 0.5 on every frame,
+/// a fixed camera, no change of state; its LODs in two colours) scores lodpop > 0 on every frame but the first
+/// with the moving pattern, and exactly 0 with the fixed one; `--metric-region full` (the check of the covered
+/// region) agrees.
+#[test]
+fn a_moving_dither_pattern_pops_at_a_fixed_state() {
+    use lodbench::measure::metrics::MetricRegion;
+    use lodbench::measure::{BlockRunner, MethodSetup, QualityOptions};
+    let ctx = crate::common::gpu();
+    let d = crate::common::near_distance();
+    let scene = crate::common::static_scene(&[d], [d, 1.5 * d, 2.0 * d], 12, "fixed");
+    let lodpop_of = |moving: bool, region: MetricRegion| -> (Vec<f64>, Vec<f64>) {
+        let mut setup = MethodSetup {
+            registry: lodbench::methods::Registry::builtin(),
+            options: Default::default(),
+            seed: 1,
+        };
+        setup.options.dither.noise_temporal = moving;
+        let quality = QualityOptions {
+            region,
+            ..Default::default()
+        };
+        let mut block = BlockRunner::new(&ctx, &scene, setup, false, &quality).unwrap();
+        let out = block
+            .run_method("dither", 0, 1, &indicatif::ProgressBar::hidden(), |_, _| {
+                Ok(())
+            })
+            .unwrap();
+        let k = out.rows.iter().map(|r| r.k_mean.unwrap_or(-1.0)).collect();
+        (out.rows.iter().map(|r| r.lodpop.unwrap()).collect(), k)
+    };
+    let (lodpop, k) = lodpop_of(true, MetricRegion::Covered);
+    assert!(k.iter().all(|&k| (k - 0.5).abs() < 1e-3), "k: {k:?}");
+    assert_eq!(lodpop[0], 0.0);
+    assert!(
+        lodpop[1..].iter().all(|&x| x > 0.0),
+        "moving pattern: {lodpop:?}"
+    );
+    let (full, _) = lodpop_of(true, MetricRegion::Full);
+    assert_eq!(full, lodpop, "--metric-region full differs");
+    let (fixed, _) = lodpop_of(false, MetricRegion::Covered);
+    assert!(fixed.iter().all(|&x| x == 0.0), "fixed pattern: {fixed:?}");
+}

@@ -508,8 +508,9 @@ fn e_static_transitions_toggle_out_of_phase() {
         "every bunny in transition: {:?}",
         out.rows.iter().map(|r| r.t_instances).collect::<Vec<_>>()
     );
-    // The first frame draws the scene twice.
-    assert!(tris[0] > tris[1] * 3 / 2, "{tris:?}");
+    // The warm-up replays frame 0 as the previous frame, so the first timed frame draws one LOD buffer like the
+    // rest (it drew the scene twice before).
+    assert!(tris[0] < tris[1] * 3 / 2, "{tris:?}");
     let alternation = lodbench::measure::records::tri_alternation_max(&out.rows);
     assert!(alternation < 0.02, "{alternation} {tris:?}");
 }
