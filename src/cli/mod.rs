@@ -143,6 +143,14 @@ pub struct MergeArgs {
     /// Merge the complete runs when some are missing, failed or were interrupted (listed either way).
     #[arg(long)]
     pub allow_partial: bool,
+    /// Merge runs made on different adapters (name, driver): shards on different GPUs. Every merged CSV has
+    /// the `adapter` column, which keeps their rows apart; nothing is averaged across adapters.
+    #[arg(long)]
+    pub allow_adapters: bool,
+    /// Merge runs built from uncommitted changes (git_commit ending in -dirty) even where their changes differ
+    /// or cannot be told apart (no `source_diff_hash` in run.json). Better: commit, rebuild and rerun.
+    #[arg(long)]
+    pub allow_dirty: bool,
 }
 
 #[derive(Debug, Clone, Args)]
