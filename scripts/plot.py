@@ -29,7 +29,9 @@ nothing but the folder's own files, see scripts/report_html.py):
                             against the pixel error, per method.
 Experiment folders carry the swept variable as the first CSV column. A `viewport` sweep gets fig8 and a `pixel-error`
 sweep the unified figure, and their first value in the other figures; any other swept variable (`fsi-check`, `noise`, ...) makes each (method, value) pair its own
-series, labelled `method (variable value)`.
+series, labelled `method (variable value)`. A merged folder (`lodbench merge`) has an `adapter` column after it:
+with more than one adapter (`merge --allow-adapters`) each (method, adapter) pair is its own series, labelled
+`method [adapter]`, so no curve mixes two GPUs.
 """
 import argparse
 import csv
@@ -473,13 +475,19 @@ def report(folder: Path, transition: str = "worst") -> list:
     made = []
     tables = []
     first_column = next(iter(summary[0]), None) if summary else None
-    variable = first_column if first_column not in (None, "scene") else None
+    # A merged folder's `adapter` column is no swept variable (it follows the variable, or leads without one).
+    variable = first_column if first_column not in (None, "scene", "adapter") else None
     swept = variable in ("viewport", "pixel-error")
     first_viewport = summary[0][variable] if swept else None
     if variable and not swept:
         # Each value of the swept variable is its own series, in the figures and the tables.
         for r in summary + frames + (transitions_csv or []):
             r["method"] = f"{r['method']} ({variable} {r[variable]})"
+    adapters = sorted({r["adapter"] for r in summary if "adapter" in r})
+    if len(adapters) > 1:
+        # Runs on different GPUs (merge --allow-adapters): each (method, adapter) is its own series.
+        for r in summary + frames + (transitions_csv or []):
+            r["method"] = f"{r['method']} [{r['adapter']}]"
     for (scene,), all_viewports in group(summary, "scene").items():
         if variable == "viewport":
             fig8(scene, all_viewports, figs / f"fig8_{scene}.png")
@@ -522,7 +530,8 @@ def report(folder: Path, transition: str = "worst") -> list:
         if any(r["rmse_mean"] != "" for r in scene_summary):
             cost(scene, scene_summary, figs / f"cost_{scene}.png")
             made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
-    columns = ([variable] if variable else []) + ["scene", "method", "count", "frames", "gpu_ms_median",
+    columns = ([variable] if variable else []) + (["adapter"] if len(adapters) > 1 else []) + [
+               "scene", "method", "count", "frames", "gpu_ms_median",
                "gpu_ms_median_transition", "ratio_to_baseline", "ratio_to_baseline_ci95_lo", "ratio_to_baseline_ci95_hi",
                "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
                "de2000_mean"] + (["lodpop_max", "lodpop_sum"] if summary and "lodpop_max" in summary[0] else []) \

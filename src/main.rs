@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use lodbench::cli::{Cli, Command};
-use lodbench::commands::{clips, describe, experiment, list, merge, perceptual, run};
+use lodbench::commands::{clips, compare, describe, experiment, list, merge, perceptual, run};
 use lodbench::Error;
 use std::process::ExitCode;
 
@@ -15,6 +15,7 @@ fn main() -> ExitCode {
         Command::Describe(args) => describe::execute(&args),
         Command::Experiment(args) => experiment::execute(&args),
         Command::Merge(args) => merge::execute(&args),
+        Command::Compare(args) => compare::execute(&args),
         Command::Perceptual(args) => perceptual::execute(&args),
         Command::Clips(args) => clips::execute(&args),
     };

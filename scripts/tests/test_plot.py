@@ -1,4 +1,5 @@
 """plot.py makes every figure its folder's data allows, and a report.md that embeds them."""
+import csv
 import shutil
 import subprocess
 import sys
@@ -137,3 +138,61 @@ def test_clip_window_and_crop_mirror_the_rust():
     assert plot_module.CROP_MAX_SHARE == float(rust_const("CROP_MAX_SHARE"))
     assert list(plot_module.clip_window([10, 11, 12])) == list(range(8, 15))
     assert list(plot_module.clip_window([1]))[0] == 0
+
+
+def with_adapters(src: Path, dst: Path, adapters):
+    """A copy of run folder src as a merged folder of one run per adapter: every CSV with an `adapter` column first
+    and its rows once per adapter (each further adapter's GPU times doubled)."""
+    dst.mkdir()
+    for name in ("frames.csv", "summary.csv", "transitions.csv"):
+        if not (src / name).is_file():
+            continue
+        with open(src / name, newline="") as f:
+            rows = list(csv.DictReader(f))
+        if not rows:
+            continue
+        with open(dst / name, "w", newline="") as f:
+            w = csv.DictWriter(f, ["adapter"] + list(rows[0]))
+            w.writeheader()
+            for i, adapter in enumerate(adapters):
+                for r in rows:
+                    r = dict(r, adapter=adapter)
+                    for k in ("gpu_ms", "gpu_ms_median"):
+                        if r.get(k):
+                            r[k] = str(float(r[k]) * (1 + i))
+                    w.writerow(r)
+
+
+def load_plot():
+    import importlib.util
+    sys.path.insert(0, str(SCRIPT.parent))
+    spec = importlib.util.spec_from_file_location("plot", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_one_curve_per_method_and_adapter(grid, tmp_path, monkeypatch):
+    """A merged folder of runs on two adapters: fig5 draws a curve per (method, adapter), the adapter in its label,
+    and the summary table has the adapter column; with one adapter the labels are the methods' alone."""
+    plot_module = load_plot()
+    curves = []
+    fig5 = plot_module.fig5
+
+    def spy(scene, summary, path):
+        curves.append(sorted({r["method"] for r in summary}))
+        fig5(scene, summary, path)
+
+    monkeypatch.setattr(plot_module, "fig5", spy)
+    two = tmp_path / "two"
+    with_adapters(grid, two, ["GPU A", "GPU B"])
+    plot_module.report(two)
+    assert curves == [["alpha [GPU A]", "alpha [GPU B]", "discrete [GPU A]", "discrete [GPU B]"]]
+    report = (two / "report.md").read_text()
+    assert "| GPU B | bunny-grid | discrete [GPU B] | 2 |" in report, report
+    curves.clear()
+    one = tmp_path / "one"
+    with_adapters(grid, one, ["GPU A"])
+    plot_module.report(one)
+    assert curves == [["alpha", "discrete"]]
+    assert "| bunny-grid | discrete | 2 |" in (one / "report.md").read_text()

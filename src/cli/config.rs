@@ -9,7 +9,7 @@ use crate::formats::{COLOR_FORMAT, DEPTH_FORMAT, MAX_SIDE, MSAA_SAMPLES};
 use crate::measure::metrics::{Metric, MetricReduction, MetricRegion};
 use crate::methods::{MethodOptions, Registry};
 use crate::scene::schedule::ScheduleParams;
-use crate::scene::{ProfileValues, SceneConfig, SceneKind};
+use crate::scene::{ProfileValues, SceneConfig, SceneKind, SweepStart};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -132,6 +132,28 @@ pub struct RunConfig {
     pub msaa_samples: u32,
     pub color_format: String,
     pub depth_format: String,
+    /// What each scene runs with once the profile and the defaults are applied (the flags above keep what was
+    /// given: `null` for "the profile's"), so run.json records the values a run used, not only the flags, and
+    /// `experiment --resume` and `merge` compare them. Filled by [`RunConfig::from_args_in`] from the fields
+    /// above ([`RunConfig::resolve_scenes`]).
+    pub resolved: Vec<ResolvedScene>,
+}
+
+/// One scene of a run with everything resolved: the profile's values with the flags applied, the instance
+/// counts, the pixel error its switch distances are made for, the methods it runs and its baseline.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ResolvedScene {
+    pub scene: SceneKind,
+    pub width: u32,
+    pub height: u32,
+    pub frames: u32,
+    pub warmup: u32,
+    /// Where the bunny scenes' path starts (recorded for every scene; only the bunny scenes read it).
+    pub sweep_start: SweepStart,
+    pub pixel_error: f32,
+    pub counts: Vec<u32>,
+    pub methods: Vec<String>,
+    pub baseline: Option<String>,
 }
 
 impl RunConfig {
@@ -206,7 +228,7 @@ impl RunConfig {
                 )));
             }
         }
-        Ok(RunConfig {
+        let mut cfg = RunConfig {
             scenes,
             methods,
             methods_given,
@@ -228,7 +250,33 @@ impl RunConfig {
             msaa_samples: MSAA_SAMPLES,
             color_format: format!("{COLOR_FORMAT:?}"),
             depth_format: format!("{DEPTH_FORMAT:?}"),
-        })
+            resolved: Vec::new(),
+        };
+        cfg.resolved = cfg.resolve_scenes();
+        Ok(cfg)
+    }
+
+    /// Each scene's resolved values (what [`RunConfig::resolved`] holds).
+    pub fn resolve_scenes(&self) -> Vec<ResolvedScene> {
+        self.scenes
+            .iter()
+            .map(|&kind| {
+                let v = self.resolved(kind);
+                let methods = self.methods_for(kind);
+                ResolvedScene {
+                    scene: kind,
+                    width: v.width,
+                    height: v.height,
+                    frames: v.frames,
+                    warmup: v.warmup,
+                    sweep_start: v.sweep_start,
+                    pixel_error: self.scene.pixel_error(kind, v.height),
+                    counts: self.scene.counts(kind),
+                    baseline: self.baseline_for(&methods),
+                    methods,
+                }
+            })
+            .collect()
     }
 
     /// The labels `scene` runs: `--method`'s, or by default every method that fits the scene (the unified
@@ -406,6 +454,33 @@ mod tests {
             c.scene.counts(SceneKind::BunnyGrid),
             crate::scene::PAPER_COUNTS.to_vec()
         );
+    }
+
+    #[test]
+    fn the_resolved_values_are_recorded() {
+        let c = RunConfig::from_args(&run_args(&[
+            "--scene",
+            "bunny-sweep,bunny-grid",
+            "--profile",
+            "regress",
+            "--frames",
+            "7",
+            "--method",
+            "discrete,alpha",
+        ]))
+        .unwrap();
+        assert_eq!(c.resolved, c.resolve_scenes());
+        let r = &c.resolved[1];
+        assert_eq!(r.scene, SceneKind::BunnyGrid);
+        assert_eq!((r.width, r.height, r.frames, r.warmup), (96, 72, 7, 2));
+        assert_eq!(r.sweep_start, SweepStart::CloseUp);
+        assert_eq!(r.counts, [50]);
+        assert_eq!(r.baseline.as_deref(), Some("discrete"));
+        // run.json records the flag as given and the value it resolved to.
+        let j = serde_json::to_value(&c).unwrap();
+        assert_eq!(j["scene"]["sweep_start"], serde_json::Value::Null);
+        assert_eq!(j["resolved"][0]["sweep_start"], "close-up");
+        assert_eq!(j["resolved"][0]["scene"], "bunny-sweep");
     }
 
     #[test]

@@ -41,6 +41,9 @@ pub enum Command {
     Experiment(ExperimentArgs),
     /// Merge the folders of an experiment's shards (`experiment --shard`) into one results folder.
     Merge(MergeArgs),
+    /// Compare two methods' frame times in a results folder: A's time over B's per block, paired round by
+    /// round, with its 95 % interval and whether the two differ (all frames, in transition, steady).
+    Compare(CompareArgs),
     /// Score each method's clip of each transition of a run (made with --dump-frames --dump-transitions)
     /// against the reference's with ColorVideoVDP; writes perceptual.csv and compares with lodpop.
     Perceptual(PerceptualArgs),
@@ -140,6 +143,30 @@ pub struct MergeArgs {
     /// Merge the complete runs when some are missing, failed or were interrupted (listed either way).
     #[arg(long)]
     pub allow_partial: bool,
+    /// Merge runs made on different adapters (name, driver): shards on different GPUs. Every merged CSV has
+    /// the `adapter` column, which keeps their rows apart; nothing is averaged across adapters.
+    #[arg(long)]
+    pub allow_adapters: bool,
+    /// Merge runs built from uncommitted changes (git_commit ending in -dirty) even where their changes differ
+    /// or cannot be told apart (no `source_diff_hash` in run.json). Better: commit, rebuild and rerun.
+    #[arg(long)]
+    pub allow_dirty: bool,
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct CompareArgs {
+    /// A results folder: a run's, an experiment's or a merged one (its frames.csv).
+    pub dir: PathBuf,
+    /// The method whose time is the numerator.
+    pub a: String,
+    /// The method whose time is the denominator.
+    pub b: String,
+    /// Only the blocks of this scene.
+    #[arg(long)]
+    pub scene: Option<String>,
+    /// Only the blocks of this instance count.
+    #[arg(long)]
+    pub count: Option<u32>,
 }
 
 /// Flags that change what a scene is (shared by `run` and `describe`).

@@ -3,9 +3,11 @@
 
 use crate::cli::config::RunConfig;
 use crate::cli::ExperimentArgs;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::results::files::{FRAMES_CSV, RUN_JSON, SUMMARY_CSV};
-use crate::results::manifest::{read_json, ExperimentRecord, RunManifestRecord, RunStatus};
+use crate::results::manifest::{
+    first_difference, read_json, BuildVersion, ExperimentRecord, RunManifestRecord, RunStatus,
+};
 use std::path::{Path, PathBuf};
 
 pub use crate::cli::experiment_file::{run_keys, Experiment, PlannedRun, Shard};
@@ -16,7 +18,8 @@ pub use crate::results::files::{run_folder_of, RUN_CSVS};
 pub struct RunOptions {
     /// Only this shard's runs.
     pub shard: Option<Shard>,
-    /// Skip the runs whose run.json says complete with the planned configuration.
+    /// Skip the runs whose run.json says complete, made by this build, with the planned configuration
+    /// ([`reusable`]); rerun the others, saying why.
     pub resume: bool,
 }
 
@@ -114,7 +117,19 @@ impl Experiment {
             let folder = self.run_folder(out, k);
             let mut cfg = self.runs[k].config.clone();
             cfg.out = Some(folder.clone());
-            if options.resume && completed(&folder, &cfg) {
+            let reuse = if options.resume {
+                match reusable(&folder, &cfg) {
+                    Ok(()) => true,
+                    Err(Some(why)) => {
+                        eprintln!("{}: rerun (--resume): {why}", folder.display());
+                        false
+                    }
+                    Err(None) => false,
+                }
+            } else {
+                false
+            };
+            if reuse {
                 eprintln!("{}: complete, skipped (--resume)", folder.display());
             } else {
                 crate::commands::run::run(&cfg)?;
@@ -138,21 +153,52 @@ impl Experiment {
     }
 }
 
-/// Whether `folder` holds a complete run of `cfg`: its run.json says `complete` and records the same
-/// configuration.
-fn completed(folder: &Path, cfg: &RunConfig) -> bool {
-    let Ok(Ok(run)) = read_json::<RunManifestRecord>(&folder.join(RUN_JSON)) else {
-        return false;
+/// Whether `folder` holds a complete run of `cfg` that `--resume` may keep: its run.json says `complete`, was
+/// written by this build (lodbench version, git commit and, for a `-dirty` commit, the hash of the
+/// uncommitted changes), and records the same configuration, resolved values included; its frames.csv and
+/// summary.csv are there. Err(Some(why)) when a run is there but cannot be kept, Err(None) when none was
+/// started.
+fn reusable(folder: &Path, cfg: &RunConfig) -> std::result::Result<(), Option<String>> {
+    let path = folder.join(RUN_JSON);
+    if !path.is_file() {
+        return Err(None);
+    }
+    let run = match read_json::<RunManifestRecord>(&path) {
+        Ok(Ok(run)) => run,
+        Ok(Err(e)) => return Err(Some(format!("its run.json is not valid ({e})"))),
+        Err(e) => return Err(Some(format!("its run.json cannot be read ({e})"))),
     };
+    if run.status != Some(RunStatus::Complete) {
+        return Err(Some(format!(
+            "its run.json says {}",
+            run.status.map_or("no status", RunStatus::name)
+        )));
+    }
+    let (made_by, this) = (run.version(), BuildVersion::this());
+    if made_by != this {
+        return Err(Some(format!(
+            "it was made by {}, this is {}",
+            made_by.text(),
+            this.text()
+        )));
+    }
     // Compared as written: an f32 flag reads back from its text as another f64 than it converts to.
     let planned = serde_json::to_string(cfg)
         .ok()
-        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok());
-    run.status == Some(RunStatus::Complete)
-        && planned.is_some_and(|c| c == run.config)
-        && [FRAMES_CSV, SUMMARY_CSV]
-            .iter()
-            .all(|f| folder.join(f).is_file())
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .unwrap_or_default();
+    if let Some(d) = first_difference(&run.config, &planned) {
+        return Err(Some(format!(
+            "its flags differ from the plan's (config.{d})"
+        )));
+    }
+    match [FRAMES_CSV, SUMMARY_CSV]
+        .iter()
+        .find(|f| !folder.join(f).is_file())
+    {
+        Some(f) => Err(Some(format!("it has no {f}"))),
+        None => Ok(()),
+    }
 }
 
 /// One run's CSV in a joined CSV: the values of the leading columns for its rows, and the file.
@@ -161,10 +207,44 @@ pub(crate) struct CsvPart {
     pub source: PathBuf,
 }
 
+/// Every part's header is the same (parts with an empty file, which have none, aside): a part with another one
+/// (a run of another lodbench, an edited file) is an error naming it and the part it differs from.
+pub(crate) fn check_headers(parts: &[CsvPart]) -> Result<()> {
+    let mut first: Option<(&Path, csv::StringRecord)> = None;
+    for part in parts {
+        let header = csv::Reader::from_path(&part.source)?.headers()?.clone();
+        if header.is_empty() {
+            continue;
+        }
+        let Some((from, h)) = &first else {
+            first = Some((&part.source, header));
+            continue;
+        };
+        if *h != header {
+            let detail = match h.iter().zip(header.iter()).position(|(a, b)| a != b) {
+                Some(i) => format!("column {}: {} against {}", i + 1, &header[i], &h[i]),
+                None => format!("{} columns against {}", header.len(), h.len()),
+            };
+            return Err(Error::results(
+                part.source.parent().unwrap_or(Path::new(".")),
+                format!(
+                    "its {} has another header than {} ({detail}): made by another lodbench, or edited?",
+                    part.source
+                        .file_name()
+                        .map_or(String::new(), |n| n.to_string_lossy().to_string()),
+                    from.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Writes `path`: under `lead_header` and the parts' own header, each part's CSV rows after its lead values. A
 /// part whose file is empty (a run without rows of it, e.g. no transition on its path, writes no header) adds
-/// nothing.
+/// nothing. The parts' headers must agree ([`check_headers`]; nothing is written otherwise).
 pub(crate) fn concat_csv(path: &Path, lead_header: &[&str], parts: &[CsvPart]) -> Result<()> {
+    check_headers(parts)?;
     let mut w = csv::Writer::from_path(path)?;
     let mut header_written = false;
     for part in parts {
@@ -184,5 +264,5 @@ pub(crate) fn concat_csv(path: &Path, lead_header: &[&str], parts: &[CsvPart]) -
             w.write_record(&row)?;
         }
     }
-    w.flush().map_err(|e| crate::error::Error::io(path, e))
+    w.flush().map_err(|e| Error::io(path, e))
 }

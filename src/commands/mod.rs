@@ -1,5 +1,5 @@
-//! One file per subcommand: what `lodbench run`, `experiment`, `merge`, `clips`, `perceptual`, `list` and
-//! `describe` do, from the parsed flags to a results folder or a printed report. Each file's `execute` is what
+//! One file per subcommand: what `lodbench run`, `experiment`, `merge`, `compare`, `clips`, `perceptual`, `list`
+//! and `describe` do, from the parsed flags to a results folder or a printed report. Each file's `execute` is what
 //! the binary calls.
 
 /// `print!` / `println!` to stdout that give up quietly when stdout is gone (`lodbench describe ... | head`):
@@ -19,6 +19,7 @@ macro_rules! outln {
 // Defined before the modules, so every subcommand's file has them in scope.
 
 pub mod clips;
+pub mod compare;
 pub mod describe;
 pub mod experiment;
 pub mod list;

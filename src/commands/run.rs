@@ -6,13 +6,16 @@ use crate::cli::RunArgs;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::measure::records::{
-    round_records, BlockInfo, FrameRecord, RoundRecord, SummaryRecord, TransitionRecord,
+    pair_records, round_records, BlockInfo, Clock, FrameRecord, PairRecord, RoundRecord,
+    SummaryRecord, TransitionRecord,
 };
 use crate::measure::{
     reference_ms_per_frame, BlockRunner, FrameImages, MethodSetup, QualityOptions,
 };
 use crate::methods::{is_reference, Registry};
-use crate::results::csv::{write_rounds, write_summary, write_transitions, FramesWriter};
+use crate::results::csv::{
+    write_pairs, write_rounds, write_summary, write_transitions, FramesWriter,
+};
 use crate::results::files::{stale_run_files, WRITE_PROBE};
 use crate::results::manifest::{now_rfc3339, RunManifest, RunStatus};
 use crate::results::png::{DumpImages, FrameDumper, FrameId};
@@ -139,6 +142,7 @@ struct RunOutput {
     summaries: Vec<SummaryRecord>,
     transitions: Vec<TransitionRecord>,
     rounds: Vec<RoundRecord>,
+    pairs: Vec<PairRecord>,
 }
 
 /// What every block of a run shares.
@@ -180,6 +184,7 @@ fn run_blocks(
         summaries: Vec::new(),
         transitions: Vec::new(),
         rounds: Vec::new(),
+        pairs: Vec::new(),
     };
     let job = RunJob {
         cfg,
@@ -201,6 +206,7 @@ fn run_blocks(
     write_summary(out_dir, &output.summaries)?;
     write_transitions(out_dir, &output.transitions)?;
     write_rounds(out_dir, &output.rounds)?;
+    write_pairs(out_dir, &output.pairs)?;
     Ok(output.summaries)
 }
 
@@ -300,13 +306,28 @@ impl RunJob<'_> {
             manifest.blocks.push(out.info);
             manifest.write(self.out_dir)?;
         }
-        summarise(cfg, baseline.as_deref(), &measured, &mut output.summaries);
+        // The reported methods in the order they were listed (pairs.csv's a before b), and the block's one clock.
+        measured.sort_by_key(|m| {
+            m.rows
+                .first()
+                .and_then(|r| methods.iter().position(|l| *l == r.method))
+        });
+        let clock = Clock::of(measured.iter().flat_map(|m| &m.rows));
+        summarise(
+            cfg,
+            baseline.as_deref(),
+            &measured,
+            clock,
+            &mut output.summaries,
+        );
         let block_rows: Vec<Vec<FrameRecord>> = measured.into_iter().map(|m| m.rows).collect();
         output.rounds.extend(round_records(
             &block_rows,
             &block_rounds,
             baseline.as_deref(),
+            clock,
         ));
+        output.pairs.extend(pair_records(&block_rows, clock));
         manifest.timing_rounds.push(block_rounds);
         manifest.write(self.out_dir)
     }
@@ -339,11 +360,13 @@ impl RunJob<'_> {
     }
 }
 
-/// Each measured method's summary row, with its ratios to the baseline where the baseline was measured too.
+/// Each measured method's summary row, with its ratios to the baseline where the baseline was measured too, on
+/// the block's `clock`.
 fn summarise(
     cfg: &RunConfig,
     baseline: Option<&str>,
     measured: &[MeasuredMethod],
+    clock: Clock,
     summaries: &mut Vec<SummaryRecord>,
 ) {
     let baseline_rows = baseline.and_then(|b| {
@@ -355,7 +378,9 @@ fn summarise(
     for m in measured {
         // Each block's bootstrap has its own seed, derived from --seed and the block's position.
         let block_seed = cfg.seed.wrapping_add(summaries.len() as u64 + 1);
-        if let Some(mut s) = SummaryRecord::from_frames(&m.rows, m.extra_target_bytes, block_seed) {
+        if let Some(mut s) =
+            SummaryRecord::from_frames(&m.rows, m.extra_target_bytes, block_seed, clock)
+        {
             if let (Some(b), Some(base)) = (baseline, baseline_rows) {
                 s.set_ratios(b, &m.rows, base);
             }
@@ -420,8 +445,9 @@ pub fn summary_table(s: &RunSummary) -> String {
     let baseline = s.summaries.iter().find_map(|r| r.baseline.clone());
     out.push_str(&format!(
         "gpu_ms and cpu_ms are medians; q/r = quality-pass time per frame / (method's + reference's timing-pass time \
-         per frame); ratio = time over {}'s, paired by timing round, geometric mean and 95 % t interval over rounds; \
-         '-' = not measured (no timestamps; --quality off: no image figures)\n",
+         per frame); ratio = time over {}'s, paired by timing round, geometric mean and 95 % t interval over rounds \
+         (every other pair: pairs.csv, lodbench compare DIR A B); '-' = not measured (no timestamps; --quality off: \
+         no image figures)\n",
         baseline.as_deref().unwrap_or("the baseline (none run)")
     ));
     out

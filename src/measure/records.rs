@@ -118,6 +118,8 @@ pub struct SummaryRecord {
     pub shadow_lodpop_max: Option<f64>,
     /// `--baseline`: this method's time over the baseline's, paired round by round ([`PairedRatios`]).
     pub baseline: Option<String>,
+    /// The frame time every ratio of the block is of ([`Clock::of_block`]), the same on every row of a block.
+    pub clock: Clock,
     pub rounds: u32,
     pub ratio_to_baseline: Option<f64>,
     pub ratio_to_baseline_ci95_lo: Option<f64>,
@@ -131,11 +133,13 @@ pub struct SummaryRecord {
 }
 
 impl SummaryRecord {
-    /// Summarises one block's rows (all of the same scene, method and count); `seed` drives the bootstrap.
+    /// Summarises one block's rows (all of the same scene, method and count); `seed` drives the bootstrap,
+    /// `clock` is the block's ([`Clock::of_block`], over every method of the block).
     pub fn from_frames(
         rows: &[FrameRecord],
         extra_target_bytes: u64,
         seed: u64,
+        clock: Clock,
     ) -> Option<SummaryRecord> {
         let first = rows.first()?;
         let lag: Option<Vec<f64>> = rows.iter().map(|r| r.lag_rmse).collect();
@@ -210,6 +214,7 @@ impl SummaryRecord {
             shadow_rmse_mean: shadow_rmse.as_ref().map(|v| mean(v.iter().copied())),
             shadow_lodpop_max: shadow_lodpop.map(|v| v.into_iter().fold(0.0, f64::max)),
             baseline: None,
+            clock,
             rounds: rows.iter().map(|r| r.round + 1).max().unwrap_or(0),
             ratio_to_baseline: None,
             ratio_to_baseline_ci95_lo: None,
@@ -223,22 +228,17 @@ impl SummaryRecord {
         })
     }
 
-    /// Fills the ratio columns from this block's rows and the baseline's (same scene, count, frames, rounds).
+    /// Fills the ratio columns from this block's rows and the baseline's (same scene, count, frames, rounds),
+    /// of the block's clock.
     pub fn set_ratios(
         &mut self,
         baseline: &str,
         rows: &[FrameRecord],
         baseline_rows: &[FrameRecord],
     ) {
-        let r = PairedRatios::new(rows, baseline_rows);
+        let r = PairedRatios::new(rows, baseline_rows, self.clock);
         self.baseline = Some(baseline.to_string());
-        let split = |x: Option<Ratio>| {
-            (
-                x.map(|x| x.ratio),
-                x.and_then(|x| x.ci95.map(|c| c.0)),
-                x.and_then(|x| x.ci95.map(|c| c.1)),
-            )
-        };
+        let split = Ratio::columns;
         (
             self.ratio_to_baseline,
             self.ratio_to_baseline_ci95_lo,
@@ -277,21 +277,63 @@ impl FrameSet {
     }
 }
 
-/// The time a ratio is taken of: gpu_ms when every frame of both blocks has one, else cpu_ms.
-fn frame_time(r: &FrameRecord, gpu: bool) -> f64 {
-    if gpu {
-        r.gpu_ms.unwrap_or(f64::NAN)
-    } else {
-        r.cpu_ms
+/// The frame time the ratios of a block are of: `gpu_ms` when every timed frame of every method of the block
+/// has one, else `cpu_ms`. Decided once per block ([`Clock::of_block`]) and passed to every ratio of it
+/// (summary.csv's `ratio_to_baseline`, rounds.csv, pairs.csv), so one missing timestamp cannot switch some of
+/// a block's ratios to another clock than the others.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Clock {
+    GpuMs,
+    CpuMs,
+}
+
+impl Clock {
+    /// The clock of a block: `blocks` each method's frame records.
+    pub fn of_block(blocks: &[Vec<FrameRecord>]) -> Clock {
+        Clock::of(blocks.iter().flatten())
+    }
+
+    /// `gpu_ms` when every one of `rows` has it (and there is one), else `cpu_ms`.
+    pub fn of<'a>(rows: impl IntoIterator<Item = &'a FrameRecord>) -> Clock {
+        let mut any = false;
+        for r in rows {
+            if r.gpu_ms.is_none() {
+                return Clock::CpuMs;
+            }
+            any = true;
+        }
+        if any {
+            Clock::GpuMs
+        } else {
+            Clock::CpuMs
+        }
+    }
+
+    /// The column name: `gpu_ms` or `cpu_ms`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Clock::GpuMs => "gpu_ms",
+            Clock::CpuMs => "cpu_ms",
+        }
+    }
+
+    /// A frame's time on this clock (NaN for a frame without it, which [`percentile`] leaves out).
+    fn time(self, r: &FrameRecord) -> f64 {
+        match self {
+            Clock::GpuMs => r.gpu_ms.unwrap_or(f64::NAN),
+            Clock::CpuMs => r.cpu_ms,
+        }
     }
 }
 
-/// Per round, the median frame time over the round's frames of `set` (None where the round has none).
-pub fn round_medians(rows: &[FrameRecord], set: FrameSet, gpu: bool) -> Vec<Option<f64>> {
+/// Per round, the median frame time on `clock` over the round's frames of `set` (None where the round has
+/// none).
+pub fn round_medians(rows: &[FrameRecord], set: FrameSet, clock: Clock) -> Vec<Option<f64>> {
     let rounds = rows.iter().map(|r| r.round + 1).max().unwrap_or(0) as usize;
     let mut per: Vec<Vec<f64>> = vec![Vec::new(); rounds];
     for r in rows.iter().filter(|r| set.holds(r)) {
-        per[r.round as usize].push(frame_time(r, gpu));
+        per[r.round as usize].push(clock.time(r));
     }
     per.iter().map(|v| percentile(v, 50.0)).collect()
 }
@@ -306,7 +348,24 @@ pub struct Ratio {
     pub rounds: usize,
 }
 
-/// A method's time over the baseline's: over all frames, over frames in transition, over steady frames.
+impl Ratio {
+    /// Whether the 95 % interval excludes 1.0 (the two costs differ); None without an interval.
+    pub fn different(&self) -> Option<bool> {
+        self.ci95.map(|(lo, hi)| lo > 1.0 || hi < 1.0)
+    }
+
+    /// The ratio and its interval's bounds as CSV columns (each empty where there is none).
+    pub fn columns(x: Option<Ratio>) -> (Option<f64>, Option<f64>, Option<f64>) {
+        (
+            x.map(|x| x.ratio),
+            x.and_then(|x| x.ci95.map(|c| c.0)),
+            x.and_then(|x| x.ci95.map(|c| c.1)),
+        )
+    }
+}
+
+/// A method's time over the baseline's (or over any other method's of the same block): over all frames, over
+/// frames in transition, over steady frames.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PairedRatios {
     pub all: Option<Ratio>,
@@ -315,12 +374,12 @@ pub struct PairedRatios {
 }
 
 impl PairedRatios {
-    pub fn new(rows: &[FrameRecord], baseline: &[FrameRecord]) -> PairedRatios {
-        let gpu = rows.iter().chain(baseline).all(|r| r.gpu_ms.is_some());
+    /// `rows`' time over `baseline`'s, both of the same block, on the block's `clock`.
+    pub fn new(rows: &[FrameRecord], baseline: &[FrameRecord], clock: Clock) -> PairedRatios {
         let ratio = |set| {
             let (m, b) = (
-                round_medians(rows, set, gpu),
-                round_medians(baseline, set, gpu),
+                round_medians(rows, set, clock),
+                round_medians(baseline, set, clock),
             );
             let logs: Vec<f64> = m
                 .iter()
@@ -555,8 +614,8 @@ pub struct RoundRecord {
     pub position: u32,
     pub first_frame: u32,
     pub end_frame: u32,
-    /// `gpu_ms` or `cpu_ms`: which frame time the medians are of.
-    pub time: String,
+    /// `gpu_ms` or `cpu_ms`: which frame time the medians are of (the block's clock).
+    pub time: Clock,
     pub median_ms: Option<f64>,
     pub median_ms_transition: Option<f64>,
     pub median_ms_steady: Option<f64>,
@@ -565,15 +624,15 @@ pub struct RoundRecord {
     pub ratio_to_baseline: Option<f64>,
 }
 
-/// The rows of rounds.csv for one block: `blocks` each method's frame records (in any order).
+/// The rows of rounds.csv for one block: `blocks` each method's frame records (in any order), `clock` the
+/// block's.
 pub fn round_records(
     blocks: &[Vec<FrameRecord>],
     info: &BlockRounds,
     baseline: Option<&str>,
+    clock: Clock,
 ) -> Vec<RoundRecord> {
-    let all: Vec<&FrameRecord> = blocks.iter().flatten().collect();
-    let gpu = all.iter().all(|r| r.gpu_ms.is_some());
-    let medians = |rows: &[FrameRecord], set| round_medians(rows, set, gpu);
+    let medians = |rows: &[FrameRecord], set| round_medians(rows, set, clock);
     let base = baseline.and_then(|b| {
         blocks
             .iter()
@@ -603,7 +662,7 @@ pub fn round_records(
                     .unwrap_or(0) as u32,
                 first_frame: round.frames[0],
                 end_frame: round.frames[1],
-                time: if gpu { "gpu_ms" } else { "cpu_ms" }.into(),
+                time: clock,
                 median_ms: at(&m),
                 median_ms_transition: at(&t),
                 median_ms_steady: at(&st),
@@ -613,6 +672,120 @@ pub fn round_records(
         }
     }
     out
+}
+
+/// One row of pairs.csv: two methods of one block, method_a's time over method_b's, paired round by round
+/// ([`PairedRatios`], on the block's clock): how to compare any two methods' costs.
+#[derive(Debug, Clone, Serialize, serde::Deserialize, PartialEq)]
+pub struct PairRecord {
+    pub scene: String,
+    pub count: u32,
+    pub method_a: String,
+    pub method_b: String,
+    pub clock: Clock,
+    /// Rounds the all-frames ratio is over (those holding frames of both methods).
+    pub rounds: u32,
+    pub ratio: Option<f64>,
+    pub ratio_ci95_lo: Option<f64>,
+    pub ratio_ci95_hi: Option<f64>,
+    pub ratio_transition: Option<f64>,
+    pub ratio_transition_ci95_lo: Option<f64>,
+    pub ratio_transition_ci95_hi: Option<f64>,
+    pub ratio_steady: Option<f64>,
+    pub ratio_steady_ci95_lo: Option<f64>,
+    pub ratio_steady_ci95_hi: Option<f64>,
+    /// The all-frames interval excludes 1.0 (empty without an interval).
+    pub different: Option<bool>,
+}
+
+impl PairRecord {
+    /// `a`'s time over `b`'s (the frame records of two methods of one block) on the block's `clock`; None when
+    /// either has no rows.
+    pub fn new(a: &[FrameRecord], b: &[FrameRecord], clock: Clock) -> Option<PairRecord> {
+        let (first_a, first_b) = (a.first()?, b.first()?);
+        let r = PairedRatios::new(a, b, clock);
+        let (ratio, ratio_ci95_lo, ratio_ci95_hi) = Ratio::columns(r.all);
+        let (ratio_transition, ratio_transition_ci95_lo, ratio_transition_ci95_hi) =
+            Ratio::columns(r.transition);
+        let (ratio_steady, ratio_steady_ci95_lo, ratio_steady_ci95_hi) = Ratio::columns(r.steady);
+        Some(PairRecord {
+            scene: first_a.scene.clone(),
+            count: first_a.count,
+            method_a: first_a.method.clone(),
+            method_b: first_b.method.clone(),
+            clock,
+            rounds: r.all.map_or(0, |x| x.rounds as u32),
+            ratio,
+            ratio_ci95_lo,
+            ratio_ci95_hi,
+            ratio_transition,
+            ratio_transition_ci95_lo,
+            ratio_transition_ci95_hi,
+            ratio_steady,
+            ratio_steady_ci95_lo,
+            ratio_steady_ci95_hi,
+            different: r.all.and_then(|x| x.different()),
+        })
+    }
+}
+
+/// The rows of pairs.csv for one block: `blocks` each reported method's frame records in the order the methods
+/// were listed; a row per unordered pair (a before b in that order), on the block's `clock`.
+pub fn pair_records(blocks: &[Vec<FrameRecord>], clock: Clock) -> Vec<PairRecord> {
+    let mut out = Vec::new();
+    for (i, a) in blocks.iter().enumerate() {
+        for b in &blocks[i + 1..] {
+            out.extend(PairRecord::new(a, b, clock));
+        }
+    }
+    out
+}
+
+/// A frame's timing as frames.csv holds it, read back (`lodbench compare`): the columns the paired ratios need,
+/// of any version of frames.csv that has them (`round` is empty in a run made before the timing rounds).
+#[derive(Debug, Clone, serde::Deserialize, PartialEq)]
+pub struct FrameTimes {
+    pub scene: String,
+    pub method: String,
+    pub count: u32,
+    pub frame: u32,
+    pub gpu_ms: Option<f64>,
+    pub cpu_ms: f64,
+    pub t_instances: u32,
+    #[serde(default)]
+    pub round: Option<u32>,
+}
+
+impl FrameTimes {
+    /// The frame record of these times, every other figure empty or 0; None without a round.
+    pub fn record(self) -> Option<FrameRecord> {
+        Some(FrameRecord {
+            round: self.round?,
+            scene: self.scene,
+            method: self.method,
+            count: self.count,
+            frame: self.frame,
+            gpu_ms: self.gpu_ms,
+            cpu_ms: self.cpu_ms,
+            triangles: 0,
+            draw_calls: 0,
+            units_drawn: 0,
+            t_instances: self.t_instances,
+            lod_mean: 0.0,
+            k_mean: None,
+            rmse: None,
+            pop: None,
+            lodpop: None,
+            de2000_mean: None,
+            uncovered_px: None,
+            crack_px: None,
+            flip_mean: None,
+            combine_gpu_ms: None,
+            lag_rmse: None,
+            shadow_rmse: None,
+            shadow_lodpop: None,
+        })
+    }
 }
 
 /// One timing round: its frames `[first, end)` and the order the methods were timed in.
@@ -681,7 +854,11 @@ pub(crate) mod tests {
         let tr = |f: u32| f.is_multiple_of(4);
         let base = timed_rows(6, 8, tr, |r, _| drift(r));
         let method = timed_rows(6, 8, tr, |r, f| drift(r) * if tr(f) { 1.5 } else { 1.0 });
-        let p = PairedRatios::new(&method, &base);
+        let p = PairedRatios::new(
+            &method,
+            &base,
+            Clock::of([&method, &base].into_iter().flatten()),
+        );
         let (all, t, s) = (p.all.unwrap(), p.transition.unwrap(), p.steady.unwrap());
         assert!((t.ratio - 1.5).abs() < 1e-12 && (s.ratio - 1.0).abs() < 1e-12);
         assert!(
@@ -696,7 +873,7 @@ pub(crate) mod tests {
         let noisy = timed_rows(6, 8, tr, |r, f| {
             drift(r) * (1.0 + 0.01 * ((f * 7) % 5) as f64)
         });
-        let aa = PairedRatios::new(&noisy, &base).all.unwrap();
+        let aa = PairedRatios::new(&noisy, &base, Clock::GpuMs).all.unwrap();
         let (lo, hi) = aa.ci95.unwrap();
         assert!(lo < aa.ratio && aa.ratio < hi, "{aa:?}");
     }
@@ -719,15 +896,92 @@ pub(crate) mod tests {
                 ..r.clone()
             })
             .collect();
-        let p = PairedRatios::new(&method, &base);
+        let p = PairedRatios::new(
+            &method,
+            &base,
+            Clock::of([&method, &base].into_iter().flatten()),
+        );
         let t = p.transition.unwrap();
         assert_eq!((t.ratio, t.ci95, t.rounds), (1.5, None, 1));
         assert_eq!(p.all.unwrap().rounds, 3);
-        let mut s = SummaryRecord::from_frames(&method, 0, 1).unwrap();
+        let mut s = SummaryRecord::from_frames(&method, 0, 1, Clock::CpuMs).unwrap();
         s.set_ratios("discrete", &method, &base);
         assert_eq!(s.rounds, 3);
         assert_eq!(s.ratio_to_baseline, Some(1.5));
         assert_eq!(s.baseline.as_deref(), Some("discrete"));
+    }
+
+    #[test]
+    fn one_missing_timestamp_puts_every_ratio_of_the_block_on_cpu_time() {
+        // Three methods; on the GPU clock b and c cost 2x a, on the CPU clock 3x. One frame of c lacks its
+        // gpu_ms: every ratio of the block, b over a included, is of cpu_ms.
+        let method = |name: &str, gpu: f64, cpu: f64| -> Vec<FrameRecord> {
+            timed_rows(4, 5, |f| f % 3 == 0, |r, _| 1.0 + 0.1 * r as f64)
+                .into_iter()
+                .map(|r| FrameRecord {
+                    method: name.into(),
+                    gpu_ms: r.gpu_ms.map(|t| t * gpu),
+                    cpu_ms: r.gpu_ms.unwrap_or(1.0) * cpu,
+                    ..r
+                })
+                .collect()
+        };
+        let (a, b, mut c) = (
+            method("a", 1.0, 1.0),
+            method("b", 2.0, 3.0),
+            method("c", 2.0, 3.0),
+        );
+        c[7].gpu_ms = None;
+        let blocks = vec![a.clone(), b.clone(), c.clone()];
+        let clock = Clock::of_block(&blocks);
+        assert_eq!(clock, Clock::CpuMs);
+        assert_eq!(Clock::of_block(&blocks[..2]), Clock::GpuMs);
+        let mut s = SummaryRecord::from_frames(&b, 0, 1, clock).unwrap();
+        s.set_ratios("a", &b, &a);
+        assert_eq!(s.clock, Clock::CpuMs);
+        assert!((s.ratio_to_baseline.unwrap() - 3.0).abs() < 1e-12, "{s:?}");
+        let pairs = pair_records(&blocks, clock);
+        assert_eq!(
+            pairs
+                .iter()
+                .map(|p| (p.method_a.as_str(), p.method_b.as_str(), p.clock))
+                .collect::<Vec<_>>(),
+            [
+                ("a", "b", Clock::CpuMs),
+                ("a", "c", Clock::CpuMs),
+                ("b", "c", Clock::CpuMs)
+            ]
+        );
+        assert!(
+            (pairs[0].ratio.unwrap() - 1.0 / 3.0).abs() < 1e-12,
+            "{:?}",
+            pairs[0]
+        );
+        assert!((pairs[2].ratio.unwrap() - 1.0).abs() < 1e-12);
+        // No spread between rounds: the interval is the point, which excludes 1 for a, b and holds it for b, c.
+        assert_eq!(
+            (pairs[0].different, pairs[2].different),
+            (Some(true), Some(false))
+        );
+        assert_eq!(pairs[0].rounds, 4);
+        let info = BlockRounds {
+            scene: "s".into(),
+            count: 1,
+            seed: 0,
+            warmup_transition_frames: vec![],
+            timed_only: vec![],
+            rounds: (0..4)
+                .map(|r| Round {
+                    round: r,
+                    frames: [r * 5, r * 5 + 5],
+                    order: vec!["a".into(), "b".into(), "c".into()],
+                })
+                .collect(),
+        };
+        let rounds = round_records(&blocks, &info, Some("a"), clock);
+        assert!(rounds.iter().all(|r| r.time == Clock::CpuMs));
+        let b0 = rounds.iter().find(|r| r.method == "b").unwrap();
+        assert!((b0.ratio_to_baseline.unwrap() - 3.0).abs() < 1e-12);
     }
 
     #[test]
@@ -757,7 +1011,7 @@ pub(crate) mod tests {
             row(1, Some(3.0), 0.2, 0.5),
             row(2, Some(2.0), 0.1, 0.1),
         ];
-        let s = SummaryRecord::from_frames(&rows, 0, 7).unwrap();
+        let s = SummaryRecord::from_frames(&rows, 0, 7, Clock::GpuMs).unwrap();
         assert_eq!(s.frames, 3);
         assert_eq!(s.gpu_ms_median, Some(2.0));
         assert!((s.rmse_mean.unwrap() - 0.1).abs() < 1e-12);
@@ -771,7 +1025,7 @@ pub(crate) mod tests {
                 ..r.clone()
             })
             .collect();
-        let s_no_gpu = SummaryRecord::from_frames(&no_gpu, 0, 7).unwrap();
+        let s_no_gpu = SummaryRecord::from_frames(&no_gpu, 0, 7, Clock::CpuMs).unwrap();
         assert_eq!(s_no_gpu.gpu_ms_median, None);
         assert_eq!(s_no_gpu.gpu_ms_median_steady, None);
         // The intervals hold the statistic, and are the same for the same seed.
@@ -781,7 +1035,10 @@ pub(crate) mod tests {
             s.rmse_mean_ci95_hi.unwrap(),
         );
         assert!(lo <= m && m <= hi);
-        assert_eq!(s, SummaryRecord::from_frames(&rows, 0, 7).unwrap());
+        assert_eq!(
+            s,
+            SummaryRecord::from_frames(&rows, 0, 7, Clock::GpuMs).unwrap()
+        );
     }
 
     #[test]
@@ -834,7 +1091,7 @@ pub(crate) mod tests {
                 ..row(f, Some(1.0 + f as f64), 0.0, 0.0)
             })
             .collect();
-        let s = SummaryRecord::from_frames(&rows, 0, 1).unwrap();
+        let s = SummaryRecord::from_frames(&rows, 0, 1, Clock::GpuMs).unwrap();
         assert_eq!(s.gpu_ms_median, Some(2.5));
         assert_eq!(
             (

@@ -1,14 +1,18 @@
-//! frames.csv and summary.csv: serialisation only (the records are `crate::measure::records`). frames.csv is written as
+//! frames.csv, summary.csv, transitions.csv, rounds.csv and pairs.csv: serialisation only (the records are `crate::measure::records`). frames.csv is written as
 //! `frames.csv.partial`, flushed after each block, and renamed to `frames.csv` only when the run completes, so
 //! an interrupted run keeps what it measured without leaving a file that looks complete.
 
 use crate::error::{Error, Result};
-use crate::measure::records::{FrameRecord, RoundRecord, SummaryRecord, TransitionRecord};
+use crate::measure::records::{
+    FrameRecord, FrameTimes, PairRecord, RoundRecord, SummaryRecord, TransitionRecord,
+};
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use super::files::partial;
-pub use super::files::{FRAMES_CSV, PARTIAL_SUFFIX, ROUNDS_CSV, SUMMARY_CSV, TRANSITIONS_CSV};
+pub use super::files::{
+    FRAMES_CSV, PAIRS_CSV, PARTIAL_SUFFIX, ROUNDS_CSV, SUMMARY_CSV, TRANSITIONS_CSV,
+};
 
 /// Appends frame rows to `frames.csv.partial`; `finish` renames it to `frames.csv`.
 pub struct FramesWriter {
@@ -90,6 +94,51 @@ pub fn read_transitions(dir: &Path) -> Result<Vec<TransitionRecord>> {
 /// Writes rounds.csv (whole or not at all).
 pub fn write_rounds(dir: &Path, rows: &[RoundRecord]) -> Result<PathBuf> {
     write_whole(dir, ROUNDS_CSV, rows)
+}
+
+/// Writes pairs.csv (whole or not at all).
+pub fn write_pairs(dir: &Path, rows: &[PairRecord]) -> Result<PathBuf> {
+    write_whole(dir, PAIRS_CSV, rows)
+}
+
+/// frames.csv of a run or experiment folder read back for its timing: the names of the columns before `scene`
+/// (a merged or experiment folder's swept variable and `adapter`; none in a run folder) and, per row, their
+/// values with the row's times. A folder without frames.csv is one error naming it.
+pub struct FramesTimes {
+    pub lead_header: Vec<String>,
+    pub rows: Vec<(Vec<String>, FrameTimes)>,
+}
+
+/// Reads `dir/frames.csv` as [`FramesTimes`].
+pub fn read_frame_times(dir: &Path) -> Result<FramesTimes> {
+    if !dir.is_dir() {
+        return Err(Error::results(dir, "does not exist or is not a folder"));
+    }
+    let path = dir.join(FRAMES_CSV);
+    if !path.is_file() {
+        return Err(Error::results(
+            dir,
+            "has no frames.csv (a complete lodbench run or merged experiment?)",
+        ));
+    }
+    let mut r = ::csv::Reader::from_path(&path)?;
+    let header = r.headers()?.clone();
+    let lead = header.iter().position(|h| h == "scene").ok_or_else(|| {
+        Error::results(
+            dir,
+            "frames.csv has no scene column (not lodbench's frames.csv?)",
+        )
+    })?;
+    let mut rows = Vec::new();
+    for rec in r.records() {
+        let rec = rec?;
+        let times: FrameTimes = rec.deserialize(Some(&header))?;
+        rows.push((rec.iter().take(lead).map(str::to_string).collect(), times));
+    }
+    Ok(FramesTimes {
+        lead_header: header.iter().take(lead).map(str::to_string).collect(),
+        rows,
+    })
 }
 
 #[cfg(test)]

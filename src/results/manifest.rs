@@ -31,6 +31,9 @@ pub struct RunManifest {
     pub error: Option<String>,
     pub lodbench_version: &'static str,
     pub git_commit: Option<&'static str>,
+    /// With a `-dirty` git_commit: a hash of the uncommitted changes to the build's sources
+    /// ([`BuildVersion::this`]).
+    pub source_diff_hash: Option<&'static str>,
     pub seed: u64,
     pub start_time: String,
     pub end_time: Option<String>,
@@ -46,6 +49,18 @@ pub struct RunManifest {
     pub timing_rounds: Vec<BlockRounds>,
 }
 
+/// This build's `git describe --always --dirty` (None when not built from a checkout).
+const GIT_COMMIT: Option<&str> = match option_env!("LODBENCH_GIT_COMMIT") {
+    Some(c) if !c.is_empty() => Some(c),
+    _ => None,
+};
+
+/// This build's hash of its uncommitted source changes (build.rs; None for a clean commit).
+const SOURCE_DIFF_HASH: Option<&str> = match option_env!("LODBENCH_SOURCE_DIFF_HASH") {
+    Some(h) if !h.is_empty() => Some(h),
+    _ => None,
+};
+
 pub fn now_rfc3339() -> String {
     humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()
 }
@@ -56,7 +71,8 @@ impl RunManifest {
             status: RunStatus::Running,
             error: None,
             lodbench_version: env!("CARGO_PKG_VERSION"),
-            git_commit: option_env!("LODBENCH_GIT_COMMIT").filter(|s| !s.is_empty()),
+            git_commit: GIT_COMMIT,
+            source_diff_hash: SOURCE_DIFF_HASH,
             seed: config.seed,
             start_time: now_rfc3339(),
             end_time: None,
@@ -104,23 +120,71 @@ pub struct RunManifestRecord {
     #[serde(default)]
     pub git_commit: Option<String>,
     #[serde(default)]
+    pub source_diff_hash: Option<String>,
+    #[serde(default)]
     pub adapter: Option<AdapterRecord>,
+    /// `gpu-timestamps` or `cpu-clock` (null before the adapter was opened).
+    #[serde(default)]
+    pub timing_source: Option<String>,
     #[serde(default)]
     pub config: serde_json::Value,
 }
 
-/// The adapter of a run.json read back: its name.
+/// The adapter of a run.json read back: what `lodbench merge` compares.
 #[derive(Debug, Clone, Deserialize)]
 pub struct AdapterRecord {
     #[serde(default)]
     pub name: Option<String>,
+    #[serde(default)]
+    pub driver: Option<String>,
+    #[serde(default)]
+    pub driver_info: Option<String>,
 }
 
-/// The build that made a run or an experiment folder: `lodbench merge` merges folders of one build only.
+/// The build that made a run or an experiment folder: `lodbench merge` merges folders of one build only, and
+/// `lodbench experiment --resume` reuses only runs of this build.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct BuildVersion {
     pub lodbench_version: Option<String>,
     pub git_commit: Option<String>,
+    /// With a `-dirty` git_commit: a hash of the uncommitted changes to the sources the binary is built from
+    /// (build.rs: FNV-1a 64 of `git diff HEAD --binary` over src/, shaders/, scenes/, Cargo.toml, Cargo.lock
+    /// and build.rs, and of their untracked files); None for a clean commit or a run.json from before it.
+    pub source_diff_hash: Option<String>,
+}
+
+impl BuildVersion {
+    /// This binary's.
+    pub fn this() -> BuildVersion {
+        BuildVersion {
+            lodbench_version: Some(env!("CARGO_PKG_VERSION").to_string()),
+            git_commit: GIT_COMMIT.map(str::to_string),
+            source_diff_hash: SOURCE_DIFF_HASH.map(str::to_string),
+        }
+    }
+
+    /// Whether the build had uncommitted changes (git_commit ends in `-dirty`).
+    pub fn dirty(&self) -> bool {
+        self.git_commit
+            .as_deref()
+            .is_some_and(|c| c.ends_with("-dirty"))
+    }
+
+    /// `lodbench 0.1.0 (abc123-dirty, changes 0123456789abcdef)`, as messages quote it.
+    pub fn text(&self) -> String {
+        let mut out = format!(
+            "lodbench {} ({}",
+            self.lodbench_version.as_deref().unwrap_or("unknown"),
+            self.git_commit.as_deref().unwrap_or("no commit")
+        );
+        if self.dirty() {
+            out += &format!(
+                ", changes {}",
+                self.source_diff_hash.as_deref().unwrap_or("unknown")
+            );
+        }
+        out + ")"
+    }
 }
 
 impl RunManifestRecord {
@@ -128,8 +192,51 @@ impl RunManifestRecord {
         BuildVersion {
             lodbench_version: self.lodbench_version.clone(),
             git_commit: self.git_commit.clone(),
+            source_diff_hash: self.source_diff_hash.clone(),
         }
     }
+}
+
+/// The first place where two JSON values differ, as `path: a against b` (`resolved[0].frames: 12 against
+/// 24`); None when they are equal.
+pub fn first_difference(a: &serde_json::Value, b: &serde_json::Value) -> Option<String> {
+    use serde_json::Value;
+    fn walk(path: String, a: &Value, b: &Value) -> Option<String> {
+        let join = |key: &str| {
+            if path.is_empty() {
+                key.to_string()
+            } else {
+                format!("{path}.{key}")
+            }
+        };
+        match (a, b) {
+            (Value::Object(x), Value::Object(y)) => {
+                let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
+                keys.sort();
+                keys.dedup();
+                keys.into_iter().find_map(|k| {
+                    walk(
+                        join(k),
+                        x.get(k).unwrap_or(&Value::Null),
+                        y.get(k).unwrap_or(&Value::Null),
+                    )
+                })
+            }
+            (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
+                .iter()
+                .zip(y)
+                .enumerate()
+                .find_map(|(i, (p, q))| walk(format!("{path}[{i}]"), p, q)),
+            _ if a == b => None,
+            _ => Some(format!(
+                "{}: {} against {}",
+                if path.is_empty() { "(whole)" } else { &path },
+                a,
+                b
+            )),
+        }
+    }
+    walk(String::new(), a, b)
 }
 
 /// `value` as JSON text (a string quoted, None as `null`), as the messages that quote run.json write it.
@@ -172,6 +279,8 @@ pub struct ExperimentRecord<R> {
     #[serde(default)]
     pub git_commit: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source_diff_hash: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub merged_from: Option<Vec<String>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub left_out: Option<Vec<String>>,
@@ -188,9 +297,8 @@ impl<'e> ExperimentRecord<&'e PlannedRun> {
             runs: experiment.runs.iter().collect(),
             shard,
             lodbench_version: Some(env!("CARGO_PKG_VERSION").to_string()),
-            git_commit: option_env!("LODBENCH_GIT_COMMIT")
-                .filter(|s| !s.is_empty())
-                .map(str::to_string),
+            git_commit: GIT_COMMIT.map(str::to_string),
+            source_diff_hash: SOURCE_DIFF_HASH.map(str::to_string),
             merged_from: None,
             left_out: None,
         }
@@ -216,4 +324,43 @@ pub fn write_experiment_json<T: Serialize + ?Sized>(dir: &Path, value: &T) -> Re
     let path = dir.join(EXPERIMENT_JSON);
     std::fs::write(&path, serde_json::to_string_pretty(value)? + "\n")
         .map_err(|e| Error::io(&path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn first_difference_names_the_path() {
+        let a = json!({"out": "x", "resolved": [{"frames": 12, "scene": "s"}]});
+        let b = json!({"out": "x", "resolved": [{"frames": 24, "scene": "s"}]});
+        assert_eq!(
+            first_difference(&a, &b).as_deref(),
+            Some("resolved[0].frames: 12 against 24")
+        );
+        assert_eq!(first_difference(&a, &a), None);
+        let c = json!({"out": "x"});
+        assert_eq!(
+            first_difference(&c, &a).as_deref(),
+            Some("resolved: null against [{\"frames\":12,\"scene\":\"s\"}]")
+        );
+    }
+
+    #[test]
+    fn a_dirty_build_says_so() {
+        let v = BuildVersion {
+            lodbench_version: Some("0.1.0".into()),
+            git_commit: Some("abc-dirty".into()),
+            source_diff_hash: None,
+        };
+        assert!(v.dirty());
+        assert_eq!(v.text(), "lodbench 0.1.0 (abc-dirty, changes unknown)");
+        let clean = BuildVersion {
+            git_commit: Some("abc".into()),
+            ..v
+        };
+        assert!(!clean.dirty());
+        assert_eq!(clean.text(), "lodbench 0.1.0 (abc)");
+    }
 }

@@ -1,7 +1,7 @@
 //! `lodbench experiment --shard i/n`, `lodbench merge` and `lodbench experiment --resume`, through the binary
 //! on the software adapter: a small bunny-sweep experiment of four runs (a `band` sweep).
 
-use crate::common::{lodbench, read_csv, Rows};
+use crate::common::{fails_with, lodbench, read_csv, Rows};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -214,6 +214,205 @@ fn merge_refuses_what_does_not_fit() {
     );
 }
 
+/// A copy of experiment folder `from` at `to` with `edit` applied to the run.json of every run named in `runs`
+/// (`band=0.05`; all its runs when empty).
+fn edited(from: &Path, to: &Path, runs: &[&str], edit: impl Fn(&mut serde_json::Value)) -> PathBuf {
+    copy_dir(from, to);
+    for entry in std::fs::read_dir(to.join("runs")).unwrap() {
+        let entry = entry.unwrap();
+        let name = entry.file_name().to_string_lossy().to_string();
+        if !runs.is_empty() && !runs.contains(&name.as_str()) {
+            continue;
+        }
+        let p = entry.path().join("run.json");
+        let mut j: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+        edit(&mut j);
+        std::fs::write(&p, serde_json::to_string_pretty(&j).unwrap()).unwrap();
+    }
+    to.to_path_buf()
+}
+
+/// Merge refuses runs made on other adapters (name, driver; allowed with --allow-adapters, which keeps them
+/// apart by the adapter column of every merged CSV), on another timing clock, by builds from different dirty
+/// trees (allowed with --allow-dirty; the same changes pass), with other flags than their plan, and CSVs whose
+/// headers differ: each with one error line naming the runs (or the file) and the field. Only one adapter
+/// enumerates here, so the other adapter is an edited run.json.
+#[test]
+fn merge_refuses_other_adapters_clocks_builds_flags_and_headers() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = experiment_file(dir.path(), 12);
+    let shard = |i: u32| {
+        let out = dir.path().join(format!("shard-{i}"));
+        ok(lodbench(
+            &[
+                "experiment",
+                s(&file),
+                "--shard",
+                &format!("{i}/2"),
+                "--out",
+                s(&out),
+            ],
+            &[],
+        ));
+        out
+    };
+    let (a, b) = (shard(1), shard(2));
+    let out = dir.path().join("merged");
+    let merge = |b: &Path, extra: &[&str]| {
+        let mut args = vec!["merge", s(&a), s(b), "--out", s(&out)];
+        args.extend_from_slice(extra);
+        lodbench(&args, &[])
+    };
+    let set = |key: &'static str, value: serde_json::Value| {
+        move |j: &mut serde_json::Value| j[key] = value.clone()
+    };
+    let set_adapter = |key: &'static str, value: &'static str| {
+        move |j: &mut serde_json::Value| j["adapter"][key] = value.into()
+    };
+
+    let gpu = edited(
+        &b,
+        &dir.path().join("gpu"),
+        &[],
+        set_adapter("name", "Other GPU"),
+    );
+    fails_with(
+        &merge(&gpu, &[]),
+        &[
+            "band=0.05 in",
+            "band=0.02 in",
+            "adapter name",
+            "\"Other GPU\"",
+            "--allow-adapters",
+        ],
+    );
+    ok(merge(&gpu, &["--allow-adapters"]));
+    let name = |rows: &Rows| {
+        let mut names: Vec<String> = rows.iter().map(|r| r["adapter"].clone()).collect();
+        names.sort();
+        names.dedup();
+        names
+    };
+    let frames = read_csv(&out.join("frames.csv"));
+    let names = name(&frames);
+    assert_eq!(names.len(), 2, "{names:?}");
+    assert!(names.contains(&"Other GPU".to_string()), "{names:?}");
+    for f in ["summary.csv", "transitions.csv", "rounds.csv", "pairs.csv"] {
+        assert_eq!(name(&read_csv(&out.join(f))), names, "{f}");
+    }
+    // The other GPU's runs are their own blocks: compare keeps them apart.
+    let text = String::from_utf8_lossy(
+        &ok(lodbench(&["compare", s(&out), "dither", "discrete"], &[])).stdout,
+    )
+    .to_string();
+    assert!(
+        text.contains("band=0.05, adapter=Other GPU, bunny-sweep, count 1: dither over discrete"),
+        "{text}"
+    );
+    assert_eq!(text.matches(": dither over discrete").count(), 4, "{text}");
+
+    let driver = edited(
+        &b,
+        &dir.path().join("driver"),
+        &["band=0.15"],
+        set_adapter("driver", "other 2.0"),
+    );
+    fails_with(
+        &merge(&driver, &[]),
+        &["band=0.15 in", "adapter driver", "other 2.0"],
+    );
+    ok(merge(&driver, &["--allow-adapters"]));
+    // The other clock than this adapter's, which --allow-adapters does not allow.
+    let ours: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(a.join("runs/band=0.02/run.json")).unwrap())
+            .unwrap();
+    let other = if ours["timing_source"] == "cpu-clock" {
+        "gpu-timestamps"
+    } else {
+        "cpu-clock"
+    };
+    let clock = edited(
+        &b,
+        &dir.path().join("clock"),
+        &["band=0.15"],
+        set("timing_source", other.into()),
+    );
+    fails_with(
+        &merge(&clock, &["--allow-adapters"]),
+        &["band=0.15 in", "timing_source", other, "one clock"],
+    );
+
+    // Other flags than the plan's: a run whose resolved frame count is not the one planned.
+    let flags = edited(&b, &dir.path().join("flags"), &["band=0.05"], |j| {
+        j["config"]["resolved"][0]["frames"] = 99.into()
+    });
+    fails_with(
+        &merge(&flags, &[]),
+        &[
+            "band=0.05 in",
+            "other flags",
+            "config.resolved[0].frames: 99 against 12",
+        ],
+    );
+
+    // Dirty trees: the same changes merge, other or unknown changes only with --allow-dirty.
+    let dirty = |name: &str, hash: serde_json::Value| {
+        let to = dir.path().join(name);
+        edited(&b, &to, &[], |j| {
+            j["git_commit"] = "0123456789ab-dirty".into();
+            j["source_diff_hash"] = hash.clone();
+        })
+    };
+    let a_dirty = edited(&a, &dir.path().join("a-dirty"), &[], |j| {
+        j["git_commit"] = "0123456789ab-dirty".into();
+        j["source_diff_hash"] = "00000000000000aa".into();
+    });
+    let merge_dirty = |b: &Path, extra: &[&str]| {
+        let mut args = vec!["merge", s(&a_dirty), s(b), "--out", s(&out)];
+        args.extend_from_slice(extra);
+        lodbench(&args, &[])
+    };
+    ok(merge_dirty(&dirty("same", "00000000000000aa".into()), &[]));
+    let other = dirty("other", "00000000000000bb".into());
+    fails_with(
+        &merge_dirty(&other, &[]),
+        &[
+            "band=0.05 in",
+            "band=0.02 in",
+            "dirty tree",
+            "0123456789ab-dirty",
+            "00000000000000bb",
+            "commit",
+            "--allow-dirty",
+        ],
+    );
+    ok(merge_dirty(&other, &["--allow-dirty"]));
+    fails_with(
+        &merge_dirty(&dirty("unknown", serde_json::Value::Null), &[]),
+        &["dirty tree", "no source_diff_hash", "--allow-dirty"],
+    );
+
+    // A CSV whose header differs from the other runs': refused, naming the file, before anything is written.
+    let header = dir.path().join("header");
+    copy_dir(&b, &header);
+    let summary = header.join("runs/band=0.15/summary.csv");
+    let text = std::fs::read_to_string(&summary)
+        .unwrap()
+        .replacen("rmse_mean", "rmse_average", 1);
+    std::fs::write(&summary, text).unwrap();
+    let fresh = dir.path().join("fresh");
+    fails_with(
+        &lodbench(&["merge", s(&a), s(&header), "--out", s(&fresh)], &[]),
+        &[
+            "band=0.15",
+            "summary.csv has another header than",
+            "rmse_average against rmse_mean",
+        ],
+    );
+    assert!(!fresh.exists(), "a refused merge writes nothing");
+}
+
 fn copy_dir(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
     for entry in std::fs::read_dir(from).unwrap() {
@@ -282,6 +481,71 @@ fn resume_after_sigterm_ends_like_an_uninterrupted_run() {
     assert_eq!(
         deterministic(&read_csv(&out.join("frames.csv"))),
         deterministic(&read_csv(&whole.join("frames.csv")))
+    );
+}
+
+/// `--resume` keeps a complete run only when this build made it with the planned flags: a run whose run.json
+/// names another lodbench version, or other resolved flags, is rerun, with a line saying why; run.json records
+/// the resolved values (the sweep's start, which the flags leave to the profile).
+#[test]
+fn resume_reruns_runs_of_another_build_or_other_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = experiment_file(dir.path(), 12);
+    let out = dir.path().join("exp");
+    ok(lodbench(&["experiment", s(&file), "--out", s(&out)], &[]));
+    let run_json = |run: &str| -> serde_json::Value {
+        serde_json::from_str(
+            &std::fs::read_to_string(out.join("runs").join(run).join("run.json")).unwrap(),
+        )
+        .unwrap()
+    };
+    let first = run_json("band=0.02");
+    assert_eq!(
+        first["config"]["scene"]["sweep_start"],
+        serde_json::Value::Null
+    );
+    assert_eq!(first["config"]["resolved"][0]["sweep_start"], "fit");
+    assert_eq!(first["config"]["resolved"][0]["frames"], 12);
+    let edit = |run: &str, f: &dyn Fn(&mut serde_json::Value)| {
+        let p = out.join("runs").join(run).join("run.json");
+        let mut j: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+        f(&mut j);
+        std::fs::write(&p, serde_json::to_string_pretty(&j).unwrap()).unwrap();
+    };
+    edit("band=0.05", &|j| j["lodbench_version"] = "9.9.9".into());
+    edit("band=0.1", &|j| {
+        j["config"]["resolved"][0]["sweep_start"] = "close-up".into()
+    });
+    let resumed = ok(lodbench(
+        &["experiment", s(&file), "--out", s(&out), "--resume"],
+        &[],
+    ));
+    let note = String::from_utf8_lossy(&resumed.stderr);
+    assert!(
+        note.contains("band=0.02: complete, skipped (--resume)"),
+        "{note}"
+    );
+    assert!(
+        note.contains("band=0.15: complete, skipped (--resume)"),
+        "{note}"
+    );
+    assert!(
+        note.contains("band=0.05: rerun (--resume): it was made by lodbench 9.9.9"),
+        "{note}"
+    );
+    assert!(
+        note.contains("band=0.1: rerun (--resume): its flags differ from the plan's (config.resolved[0].sweep_start: \"close-up\" against \"fit\")"),
+        "{note}"
+    );
+    assert!(!note.contains("band=0.05: complete"), "{note}");
+    assert_eq!(
+        run_json("band=0.05")["lodbench_version"],
+        env!("CARGO_PKG_VERSION")
+    );
+    assert_eq!(
+        run_json("band=0.1")["config"]["resolved"][0]["sweep_start"],
+        "fit"
     );
 }
 

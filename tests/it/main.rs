@@ -19,6 +19,7 @@ mod common;
 mod cli_input;
 // src/commands: the subcommands through the binary.
 mod commands_clips;
+mod commands_compare;
 mod commands_experiment;
 // src/measure: the quality pass's figures, and runs without it.
 mod measure_coverage;

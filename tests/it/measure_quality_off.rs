@@ -74,6 +74,10 @@ fn quality_off_leaves_the_image_figures_empty_and_times() {
     );
     all_filled(&transitions, &["first_frame", "last_frame", "lods"], "transitions.csv");
     all_filled(&read_csv(&out.join("rounds.csv")), &["median_ms", "ratio_to_baseline"], "rounds.csv");
+    // The pairs need only the timing rounds: written as with the pass.
+    let pairs = read_csv(&out.join("pairs.csv"));
+    assert_eq!(pairs.len(), 1);
+    all_filled(&pairs, &["method_a", "method_b", "clock", "ratio", "ratio_ci95_lo", "different"], "pairs.csv");
 
     let run: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
