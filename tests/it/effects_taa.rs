@@ -234,7 +234,9 @@ fn sweep_run(
 /// about alpha x Delta on its frame and a decaying tail after it, on at least 5 frames, while the same path
 /// without TAA scores on the switch frame alone; (2) alpha's ramp keeps its per-frame slope through the
 /// history, so its largest lodpop per transition under TAA is at least half of what it is without TAA (a
-/// counterfactual resolved against the method's own history would report about alpha = 0.1 of it).
+/// counterfactual resolved against the method's own history would report about alpha = 0.1 of it). (2) holds on
+/// this short path; on the ci path alpha's largest lodpop without TAA is its k = 0.5 swap of the opaque LOD, a
+/// step that TAA spreads like discrete's switch (docs/findings/engine-effects.md).
 #[test]
 fn lodpop_under_taa_is_the_difference_of_two_streams() {
     let tmp = tempfile::tempdir().unwrap();
