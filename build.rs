@@ -14,8 +14,12 @@ const SOURCES: [&str; 6] = [
 ];
 
 fn main() {
-    println!("cargo:rerun-if-changed=.git/HEAD");
-    println!("cargo:rerun-if-changed=.git/index");
+    // The commit: HEAD, and the branch it points at (a commit moves the branch, not HEAD). Not .git/index:
+    // git rewrites it on `git status` (and on the `git describe --dirty` below), which made every build after
+    // one rebuild the crate.
+    for path in git_paths() {
+        println!("cargo:rerun-if-changed={path}");
+    }
     // An edited source makes the build dirty: without these, `--dirty` was computed only when HEAD or the index
     // changed, and a run from an edited tree recorded the clean parent commit.
     for path in SOURCES {
@@ -31,6 +35,20 @@ fn main() {
     };
     println!("cargo:rustc-env=LODBENCH_GIT_COMMIT={commit}");
     println!("cargo:rustc-env=LODBENCH_SOURCE_DIFF_HASH={hash}");
+}
+
+/// The files of the git directory that say which commit is checked out: HEAD, the branch it names and the
+/// packed refs, those that exist (cargo reruns a build script on every build while a watched file is missing;
+/// none outside a checkout).
+fn git_paths() -> Vec<String> {
+    let text = |args: &[&str]| git(args).map(|o| String::from_utf8_lossy(&o).trim().to_string());
+    let mut names = vec!["HEAD".to_string(), "packed-refs".to_string()];
+    names.extend(text(&["symbolic-ref", "-q", "HEAD"]));
+    names
+        .iter()
+        .filter_map(|n| text(&["rev-parse", "--git-path", n]))
+        .filter(|p| std::path::Path::new(p).exists())
+        .collect()
 }
 
 /// `git ARGS`'s stdout, None when git fails (no git, not a checkout).

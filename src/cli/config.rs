@@ -125,6 +125,8 @@ pub struct RunConfig {
     pub adapter: Option<String>,
     /// `--quality off`: the timing rounds only, no quality pass (its figures empty).
     pub quality: OnOff,
+    /// `--reference-cache-mib`.
+    pub reference_cache_mib: u64,
     pub dump_frames: bool,
     pub dump_every: u32,
     /// With `dump_frames`: only frames with an instance in transition.
@@ -244,6 +246,7 @@ impl RunConfig {
             out: a.out.clone(),
             adapter: a.adapter.clone(),
             quality: a.quality,
+            reference_cache_mib: a.reference_cache_mib,
             dump_frames: a.dump_frames,
             dump_every: a.dump_every,
             dump_transitions: a.dump_transitions,

@@ -308,6 +308,11 @@ pub struct RunArgs {
     /// times null. Refused with --dump-frames and --metrics de2000/flip, which need the pass.
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     pub quality: OnOff,
+    /// GPU memory (MiB) a scene block may keep of the reference's frames, so that its second and later methods
+    /// copy the reference frame instead of drawing it again (every figure is the same; the first frames that
+    /// fit are kept). 0 draws it in every method's pass. Not used under TAA or with shadows.
+    #[arg(long, default_value_t = 1024, value_name = "MIB")]
+    pub reference_cache_mib: u64,
     /// Write PNGs of the method frame, the reference frame and an error heat-map.
     #[arg(long)]
     pub dump_frames: bool,

@@ -264,6 +264,12 @@ impl RunJob<'_> {
             reduction: cfg.metric_reduction,
             region: cfg.metric_region,
             timing_only: !cfg.quality_pass(),
+            // Kept only for a block whose quality pass runs more than one method.
+            reference_cache_bytes: if methods.len() > 1 {
+                cfg.reference_cache_mib << 20
+            } else {
+                0
+            },
         };
         let mut block =
             BlockRunner::new(&self.ctx, &scene, setup, self.dumper.is_some(), &quality)?;

@@ -106,7 +106,10 @@ impl<'a> BlockRunner<'a> {
         let quality = match self.quality.as_mut() {
             Some(stage) => Some(stage.pass(
                 &self.base,
-                timed.method.as_mut(),
+                (
+                    timed.method.as_mut(),
+                    crate::methods::is_reference(&timed.label),
+                ),
                 &mut timed.driver,
                 &dump_frames,
                 progress,
@@ -204,8 +207,11 @@ impl<'a> BlockRunner<'a> {
             timing_pass_ms_per_frame: timing_ms,
             quality_pass_ms_per_frame: quality.map(|q| q.ms_per_frame),
             quality_to_timing_ratio: quality.map(|q| q.ms_per_frame / timing_ms),
-            quality_to_renders_ratio: quality
-                .and_then(|q| reference_ms.map(|r| q.ms_per_frame / (timing_ms + r))),
+            quality_to_renders_ratio: quality.and_then(|q| {
+                let drawn = 1.0 - q.reference_frames_copied as f64 / frames;
+                reference_ms.map(|r| q.ms_per_frame / (timing_ms + r * drawn))
+            }),
+            reference_frames_copied: quality.map(|q| q.reference_frames_copied),
             metric_gpu_ms_median: quality.and_then(|q| q.metric_gpu_ms_median),
             metric_tile_share: quality.map(|q| q.metric_tile_share),
             counterfactual_pixel_share: quality.and_then(|q| q.counterfactual_pixel_share),

@@ -6,6 +6,7 @@
 //! - `quality.rs`: the quality pass in stages (render, shadow maps, effects, metrics, read-back requests,
 //!   counterfactuals, collect);
 //! - `effects.rs`: which shadow map stands for what, the shadow's share, the lights, the TAA streams;
+//! - `reference_cache.rs`: the reference's frames kept for the block's next methods;
 //! - `block.rs`: the block's GPU objects and the records built from both passes;
 //! - `records.rs`, `stats.rs`: the records and their statistics; `metrics.rs`: the CPU definitions of every
 //!   image figure (the GPU kernels' oracle); `metric_kernel.rs`, `diff_kernel.rs`: the GPU reductions.
@@ -20,6 +21,7 @@ pub mod metric_kernel;
 pub mod metrics;
 pub mod quality;
 pub mod records;
+pub mod reference_cache;
 pub mod stats;
 pub mod timing;
 

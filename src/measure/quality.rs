@@ -18,6 +18,7 @@ use super::driver::check_interrupt;
 use super::driver::FrameDriver;
 use super::effects::{Casters, ShadowRole, ShadowShare, Stream, TaaStreams};
 use super::metric_kernel::MetricKernel;
+use super::reference_cache::ReferenceCache;
 use crate::error::{Error, Result};
 use crate::gpu::timing::GpuTimer;
 use crate::gpu::{GpuContext, RenderTarget, SceneGpu, TextureReadback};
@@ -42,6 +43,9 @@ pub struct QualityOptions {
     pub region: MetricRegion,
     /// `--quality off`: no quality pass at all (the block builds no stage; its figures are empty).
     pub timing_only: bool,
+    /// Bytes the block may keep of the reference's frames for its next methods (`--reference-cache-mib`;
+    /// 0: draw the reference in every method's pass). [`ReferenceCache`] says where it is not used.
+    pub reference_cache_bytes: u64,
 }
 
 impl QualityOptions {
@@ -136,6 +140,9 @@ pub struct QualityPass {
     pub metric_tile_share: f64,
     /// Mean share of the frame's pixels lodpop's counterfactual was drawn in, over the frames it was drawn.
     pub counterfactual_pixel_share: Option<f64>,
+    /// Frames whose reference frame was copied instead of drawn: from the block's [`ReferenceCache`], or in
+    /// the reference's own pass from its frame.
+    pub reference_frames_copied: u32,
 }
 
 /// The images of one dumped quality-pass frame, RGBA8.
@@ -174,6 +181,12 @@ pub struct QualityStage {
     shadow_share: Option<ShadowShare>,
     /// `--metric-region`.
     region: MetricRegion,
+    /// The reference's frames, kept by the first pass for the next (None: drawn in every pass).
+    reference_cache: Option<ReferenceCache>,
+    /// The reference frame is made by the frame alone (no TAA history, no shadow map drawn with it).
+    reference_copyable: bool,
+    /// The method of the current pass is the reference (its frame is the reference frame).
+    method_is_reference: bool,
 }
 
 /// Keep at most this many quality-pass frames queued on the GPU.
@@ -267,6 +280,8 @@ struct Walk<'d> {
     tiles_read: u64,
     /// Pixels lodpop's counterfactual was drawn in, summed, and the frames it was drawn on.
     counterfactual_pixels: (u64, u32),
+    /// Frames whose reference frame was copied, not drawn.
+    reference_copied: u32,
 }
 
 impl QualityStage {
@@ -288,8 +303,20 @@ impl QualityStage {
             None => None,
             Some(_) => Some(ShadowShare::new(ctx, scene, &targets.reference)?),
         };
+        let taa = TaaStreams::new(ctx, scene);
+        // Under TAA the reference frame carries its stream's history, and with shadows its shadow map is drawn
+        // in the same pass: the frame alone does not make it.
+        let reference_copyable = taa.is_none() && shadow_share.is_none();
+        let reference_cache = if reference_copyable {
+            ReferenceCache::new(ctx, (w, h), scene.frames, quality.reference_cache_bytes)
+        } else {
+            None
+        };
         Ok(QualityStage {
-            taa: TaaStreams::new(ctx, scene),
+            taa,
+            reference_cache,
+            reference_copyable,
+            method_is_reference: false,
             shadow_share,
             targets,
             kernels,
@@ -305,17 +332,19 @@ impl QualityStage {
         })
     }
 
-    /// The quality pass of `method` walking `driver`; `dump_frames`: per frame, whether it goes to `on_frames`.
+    /// The quality pass of `method` (`is_reference`: the reference itself) walking `driver`; `dump_frames`: per
+    /// frame, whether it goes to `on_frames`.
     pub(super) fn pass(
         &mut self,
         base: &BlockGpu<'_>,
-        method: &mut dyn Method,
+        (method, is_reference): (&mut dyn Method, bool),
         driver: &mut FrameDriver<'_>,
         dump_frames: &[bool],
         progress: &ProgressBar,
         on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<QualityPass> {
         let frames = base.scene.frames;
+        self.method_is_reference = is_reference;
         driver.reset();
         let mut walk = Walk {
             dump_frames,
@@ -331,6 +360,7 @@ impl QualityStage {
             ),
             tiles_read: 0,
             counterfactual_pixels: (0, 0),
+            reference_copied: 0,
         };
         let pass_start = Instant::now();
         if let Some(taa) = &mut self.taa {
@@ -345,6 +375,9 @@ impl QualityStage {
         }
         base.ctx.wait_idle()?;
         let ms_per_frame = pass_start.elapsed().as_secs_f64() * 1e3 / frames as f64;
+        if let Some(cache) = &mut self.reference_cache {
+            cache.stored(frames);
+        }
         self.read_figures(base, method, walk, ms_per_frame)
     }
 
@@ -368,7 +401,9 @@ impl QualityStage {
         if f == 0 {
             self.clear_kernels(&mut encoder);
         }
-        self.render_frames(base, method, &input, &mut encoder);
+        if self.render_frames(base, method, (&input, f), &mut encoder) {
+            walk.reference_copied += 1;
+        }
         let previous = walk.history.previous();
         let shadows = self.shadow_maps(base, method, &input, previous);
         self.apply_effects(base, &input, &mut encoder, (f, previous.is_some()));
@@ -418,21 +453,36 @@ impl QualityStage {
         }
     }
 
-    /// Stage 1: the reference and the method, each lit by its own shadow map.
+    /// Stage 1: the reference and the method, each lit by its own shadow map. The reference frame is not drawn
+    /// (returns true) where an earlier pass kept frame `f` in the cache, or where the method is the reference
+    /// itself without TAA and shadows (its frame is the same draw: copied); a drawn or copied reference frame is
+    /// kept for the next pass where the cache has room.
     fn render_frames(
         &mut self,
         base: &BlockGpu<'_>,
         method: &mut dyn Method,
-        input: &FrameInput<'_>,
+        (input, f): (&FrameInput<'_>, u32),
         encoder: &mut wgpu::CommandEncoder,
-    ) {
+    ) -> bool {
         let (gpu, t, reference) = (&base.gpu, &self.targets, &mut self.reference);
-        gpu.lit_by(ShadowRole::Reference.map(), || {
-            reference.encode(gpu, input, encoder, &t.reference)
-        });
+        let cache = self.reference_cache.as_ref();
+        let from_cache = cache.is_some_and(|c| c.restore(encoder, f, &t.reference));
+        let from_method = !from_cache && self.method_is_reference && self.reference_copyable;
+        if !from_cache && !from_method {
+            gpu.lit_by(ShadowRole::Reference.map(), || {
+                reference.encode(gpu, input, encoder, &t.reference)
+            });
+        }
         gpu.lit_by(ShadowRole::Method.map(), || {
             method.encode(gpu, input, encoder, &t.method)
         });
+        if from_method {
+            t.method.copy_color_to(encoder, &t.reference);
+        }
+        if let (false, Some(c)) = (from_cache, cache) {
+            c.store(encoder, f, &t.reference);
+        }
+        from_cache || from_method
     }
 
     /// Stage 2 (`--shadows on`): the frame's shadow maps: the reference's LOD0, the method's casters, and, for
@@ -825,6 +875,7 @@ impl QualityStage {
             metric_gpu_ms_median,
             metric_tile_share,
             counterfactual_pixel_share,
+            reference_frames_copied: walk.reference_copied,
         })
     }
 }

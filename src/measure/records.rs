@@ -571,8 +571,13 @@ pub struct BlockInfo {
     /// quality_pass_ms_per_frame / timing_pass_ms_per_frame (2.0 is the floor: the reference doubles the work).
     pub quality_to_timing_ratio: Option<f64>,
     /// quality_pass_ms_per_frame / (this method's + the reference's timing_pass_ms_per_frame): what the
-    /// quality pass costs over its two renders (1.0 would be a free metric).
+    /// quality pass costs over the renders it makes (1.0 would be a free metric). The reference's time counts
+    /// only on the frames where it was drawn (`reference_frames_copied`).
     pub quality_to_renders_ratio: Option<f64>,
+    /// Frames of the quality pass whose reference frame was copied instead of drawn: from the block's
+    /// reference cache, kept by an earlier method's pass, or in the reference's own pass from its own frame
+    /// (0: all drawn; None: no quality pass).
+    pub reference_frames_copied: Option<u32>,
     /// Median GPU time of the metric kernel alone per quality-pass frame (None without timestamps).
     pub metric_gpu_ms_median: Option<f64>,
     /// The share of the frame's 16 x 16 pixel tiles the metric kernel read, mean over the quality pass's frames (1.0 with

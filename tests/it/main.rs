@@ -25,6 +25,7 @@ mod commands_experiment;
 mod measure_coverage;
 mod measure_lodpop;
 mod measure_quality_off;
+mod measure_reference_cache;
 mod measure_timing;
 // src/methods: one method (or a family of variants) in images.
 mod methods_fsi;

@@ -49,10 +49,10 @@ fn shares(dir: &Path) -> Vec<(String, f64, Option<f64>)> {
 fn the_covered_region_gives_the_full_frames_figures() {
     let dir = tempfile::tempdir().unwrap();
     for (scene, frames) in [
-        ("bunny-sweep", "240"),
+        ("bunny-sweep", "120"),
         ("simple", "60"),
         ("windmills", "40"),
-        ("trees", "24"),
+        ("trees", "12"),
     ] {
         let mut figures = Vec::new();
         for region in ["covered", "full"] {
@@ -92,7 +92,7 @@ fn the_covered_region_gives_the_full_frames_figures() {
                 "{block}: full draws whole counterfactuals"
             );
         }
-        if (scene, frames) == ("bunny-sweep", "240") {
+        if (scene, frames) == ("bunny-sweep", "120") {
             // One bunny, most of the path far away: most tiles left out, and the counterfactual of a blend drawn
             // around the bunny only.
             for (block, tiles, drawn) in &covered.1 {

@@ -43,7 +43,7 @@ fn sweep(dir: &Path) -> Rows {
             "--scene",
             "bunny-sweep",
             "--frames",
-            "400",
+            "200",
             "--width",
             "160",
             "--height",

@@ -116,7 +116,7 @@ fn same_flags_same_metrics() {
             "--height",
             "120",
             "--frames",
-            "120",
+            "60",
             "--metrics",
             "rmse,pop,de2000",
             "--out",
@@ -139,7 +139,7 @@ fn same_flags_same_metrics() {
             "lod_mean",
         ] {
             let (x, y) = (col(&a, method, name), col(&b, method, name));
-            assert_eq!(x.len(), 120, "{method}");
+            assert_eq!(x.len(), 60, "{method}");
             assert_eq!(
                 x, y,
                 "{method}: column {name} differs between identical runs"
