@@ -183,10 +183,6 @@ pub struct QualityStage {
     region: MetricRegion,
     /// The reference's frames, kept by the first pass for the next (None: drawn in every pass).
     reference_cache: Option<ReferenceCache>,
-    /// The reference frame is made by the frame alone (no TAA history, no shadow map drawn with it).
-    reference_copyable: bool,
-    /// The method of the current pass is the reference (its frame is the reference frame).
-    method_is_reference: bool,
 }
 
 /// Keep at most this many quality-pass frames queued on the GPU.
@@ -280,6 +276,9 @@ struct Walk<'d> {
     tiles_read: u64,
     /// Pixels lodpop's counterfactual was drawn in, summed, and the frames it was drawn on.
     counterfactual_pixels: (u64, u32),
+    /// The method is the reference and its frame is made by the frame alone: the reference frame is a copy
+    /// of the method's.
+    reference_is_method_frame: bool,
     /// Frames whose reference frame was copied, not drawn.
     reference_copied: u32,
 }
@@ -304,10 +303,7 @@ impl QualityStage {
             Some(_) => Some(ShadowShare::new(ctx, scene, &targets.reference)?),
         };
         let taa = TaaStreams::new(ctx, scene);
-        // Under TAA the reference frame carries its stream's history, and with shadows its shadow map is drawn
-        // in the same pass: the frame alone does not make it.
-        let reference_copyable = taa.is_none() && shadow_share.is_none();
-        let reference_cache = if reference_copyable {
+        let reference_cache = if Self::reference_copyable(&taa, &shadow_share) {
             ReferenceCache::new(ctx, (w, h), scene.frames, quality.reference_cache_bytes)
         } else {
             None
@@ -315,8 +311,6 @@ impl QualityStage {
         Ok(QualityStage {
             taa,
             reference_cache,
-            reference_copyable,
-            method_is_reference: false,
             shadow_share,
             targets,
             kernels,
@@ -332,6 +326,12 @@ impl QualityStage {
         })
     }
 
+    /// Whether the reference frame is made by the frame alone, so that a copy of it can stand in for a draw: not
+    /// under TAA (its stream carries a history) nor with shadows (its shadow map is drawn in the same pass).
+    fn reference_copyable(taa: &Option<TaaStreams>, shadow_share: &Option<ShadowShare>) -> bool {
+        taa.is_none() && shadow_share.is_none()
+    }
+
     /// The quality pass of `method` (`is_reference`: the reference itself) walking `driver`; `dump_frames`: per
     /// frame, whether it goes to `on_frames`.
     pub(super) fn pass(
@@ -344,7 +344,6 @@ impl QualityStage {
         on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<QualityPass> {
         let frames = base.scene.frames;
-        self.method_is_reference = is_reference;
         driver.reset();
         let mut walk = Walk {
             dump_frames,
@@ -360,6 +359,8 @@ impl QualityStage {
             ),
             tiles_read: 0,
             counterfactual_pixels: (0, 0),
+            reference_is_method_frame: is_reference
+                && Self::reference_copyable(&self.taa, &self.shadow_share),
             reference_copied: 0,
         };
         let pass_start = Instant::now();
@@ -401,7 +402,8 @@ impl QualityStage {
         if f == 0 {
             self.clear_kernels(&mut encoder);
         }
-        if self.render_frames(base, method, (&input, f), &mut encoder) {
+        let copy_method = walk.reference_is_method_frame;
+        if self.render_frames(base, method, (&input, f, copy_method), &mut encoder) {
             walk.reference_copied += 1;
         }
         let previous = walk.history.previous();
@@ -454,20 +456,20 @@ impl QualityStage {
     }
 
     /// Stage 1: the reference and the method, each lit by its own shadow map. The reference frame is not drawn
-    /// (returns true) where an earlier pass kept frame `f` in the cache, or where the method is the reference
-    /// itself without TAA and shadows (its frame is the same draw: copied); a drawn or copied reference frame is
-    /// kept for the next pass where the cache has room.
+    /// (returns true) where an earlier pass kept frame `f` in the cache, or where `copy_method` says the
+    /// method's frame is the same draw (copied); a drawn or copied reference frame is kept for the next pass
+    /// where the cache has room.
     fn render_frames(
         &mut self,
         base: &BlockGpu<'_>,
         method: &mut dyn Method,
-        (input, f): (&FrameInput<'_>, u32),
+        (input, f, copy_method): (&FrameInput<'_>, u32, bool),
         encoder: &mut wgpu::CommandEncoder,
     ) -> bool {
         let (gpu, t, reference) = (&base.gpu, &self.targets, &mut self.reference);
         let cache = self.reference_cache.as_ref();
         let from_cache = cache.is_some_and(|c| c.restore(encoder, f, &t.reference));
-        let from_method = !from_cache && self.method_is_reference && self.reference_copyable;
+        let from_method = !from_cache && copy_method;
         if !from_cache && !from_method {
             gpu.lit_by(ShadowRole::Reference.map(), || {
                 reference.encode(gpu, input, encoder, &t.reference)

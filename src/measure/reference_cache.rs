@@ -22,6 +22,8 @@ pub struct ReferenceCache {
     height: u32,
     /// One row of a frame in the buffers (`COPY_BYTES_PER_ROW_ALIGNMENT`).
     bytes_per_row: u32,
+    /// One frame in the buffers (`bytes_per_row` x `height`).
+    frame_bytes: u64,
     frames_per_chunk: u32,
     chunks: Vec<wgpu::Buffer>,
     /// Frames `0..capacity` have a slot.
@@ -63,6 +65,7 @@ impl ReferenceCache {
             width,
             height,
             bytes_per_row,
+            frame_bytes,
             frames_per_chunk,
             chunks,
             capacity,
@@ -72,11 +75,10 @@ impl ReferenceCache {
 
     /// Frame `f`'s slot.
     fn slot(&self, f: u32) -> wgpu::TexelCopyBufferInfo<'_> {
-        let frame_bytes = self.bytes_per_row as u64 * self.height as u64;
         wgpu::TexelCopyBufferInfo {
             buffer: &self.chunks[(f / self.frames_per_chunk) as usize],
             layout: wgpu::TexelCopyBufferLayout {
-                offset: (f % self.frames_per_chunk) as u64 * frame_bytes,
+                offset: (f % self.frames_per_chunk) as u64 * self.frame_bytes,
                 bytes_per_row: Some(self.bytes_per_row),
                 rows_per_image: Some(self.height),
             },
@@ -89,11 +91,6 @@ impl ReferenceCache {
             height: self.height,
             depth_or_array_layers: 1,
         }
-    }
-
-    /// Frames whose reference a pass copies instead of drawing.
-    pub fn filled(&self) -> u32 {
-        self.filled
     }
 
     /// Records the copy of frame `f`'s reference into `target`'s colour; false (nothing recorded) when the
@@ -126,10 +123,5 @@ impl ReferenceCache {
     /// A pass stored frames `0..frames` and ended: later passes copy them.
     pub fn stored(&mut self, frames: u32) {
         self.filled = self.filled.max(frames.min(self.capacity));
-    }
-
-    /// Bytes the cache holds.
-    pub fn bytes(&self) -> u64 {
-        self.chunks.iter().map(wgpu::Buffer::size).sum()
     }
 }
