@@ -209,8 +209,11 @@ impl<'a> BlockRunner<'a> {
             quality_to_timing_ratio: quality.map(|q| q.ms_per_frame / timing_ms),
             quality_to_renders_ratio: quality.and_then(|q| {
                 let drawn = 1.0 - q.reference_frames_copied as f64 / frames;
-                reference_ms.map(|r| q.ms_per_frame / (timing_ms + r * drawn))
+                let counterfactual = q.counterfactual_frames as f64 / frames;
+                reference_ms
+                    .map(|r| q.ms_per_frame / (timing_ms * (1.0 + counterfactual) + r * drawn))
             }),
+            counterfactual_frame_share: quality.map(|q| q.counterfactual_frames as f64 / frames),
             reference_frames_copied: quality.map(|q| q.reference_frames_copied),
             metric_gpu_ms_median: quality.and_then(|q| q.metric_gpu_ms_median),
             metric_tile_share: quality.map(|q| q.metric_tile_share),

@@ -140,6 +140,9 @@ pub struct QualityPass {
     pub metric_tile_share: f64,
     /// Mean share of the frame's pixels lodpop's counterfactual was drawn in, over the frames it was drawn.
     pub counterfactual_pixel_share: Option<f64>,
+    /// Frames on which lodpop's counterfactual was drawn (a render of the method's frame with the earlier
+    /// states, inside the changed instances' rectangle).
+    pub counterfactual_frames: u32,
     /// Frames whose reference frame was copied instead of drawn: from the block's [`ReferenceCache`], or in
     /// the reference's own pass from its frame.
     pub reference_frames_copied: u32,
@@ -877,6 +880,7 @@ impl QualityStage {
             metric_gpu_ms_median,
             metric_tile_share,
             counterfactual_pixel_share,
+            counterfactual_frames: drawn_frames,
             reference_frames_copied: walk.reference_copied,
         })
     }

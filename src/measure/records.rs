@@ -570,10 +570,17 @@ pub struct BlockInfo {
     pub quality_pass_ms_per_frame: Option<f64>,
     /// quality_pass_ms_per_frame / timing_pass_ms_per_frame (2.0 is the floor: the reference doubles the work).
     pub quality_to_timing_ratio: Option<f64>,
-    /// quality_pass_ms_per_frame / (this method's + the reference's timing_pass_ms_per_frame): what the
-    /// quality pass costs over the renders it makes (1.0 would be a free metric). The reference's time counts
-    /// only on the frames where it was drawn (`reference_frames_copied`).
+    /// quality_pass_ms_per_frame over the timing-pass time of the renders the quality pass makes: the method's
+    /// frame, the reference's (only on the frames where it was drawn, `reference_frames_copied`) and lodpop's
+    /// counterfactual (one more render of the method, on the share of frames it was drawn,
+    /// `counterfactual_frame_share`). What the pass costs beyond its renders: 1.0 would be free kernels,
+    /// copies and read-backs. The counterfactual counts as a whole render though it is drawn inside a scissor,
+    /// so where it is drawn often this is a lower bound of that overhead; `quality_to_timing_ratio` is the plain
+    /// ratio.
     pub quality_to_renders_ratio: Option<f64>,
+    /// The share of the quality pass's frames on which lodpop's counterfactual was drawn (some instance's
+    /// image-state changed; None: no quality pass).
+    pub counterfactual_frame_share: Option<f64>,
     /// Frames of the quality pass whose reference frame was copied instead of drawn: from the block's
     /// reference cache, kept by an earlier method's pass, or in the reference's own pass from its own frame
     /// (0: all drawn; None: no quality pass).
