@@ -97,6 +97,52 @@ impl LodChain {
         Ok(LodChain { lods })
     }
 
+    /// Simplifies `mesh` until each error in `errors_abs` (object-space units, increasing): LOD i + 1 is the
+    /// coarsest simplification of LOD0 whose error stays within `errors_abs[i]` (meshoptimizer's `simplify`
+    /// with no triangle target and that error bound). A level that keeps more than 95 % of the previous one's
+    /// triangles ends the chain (the mesh cannot lose detail at that error), so the chain may be shorter.
+    pub fn build_by_error(name: &str, mesh: &Mesh, errors_abs: &[f32]) -> Result<LodChain> {
+        let increasing = errors_abs.iter().all(|e| e.is_finite() && *e > 0.0)
+            && errors_abs.windows(2).all(|w| w[1] > w[0]);
+        if !increasing {
+            return Err(Error::Config(format!(
+                "LOD errors for {name} must be positive and increase: {errors_abs:?}"
+            )));
+        }
+        let bytes: &[u8] = bytemuck::cast_slice(&mesh.positions);
+        let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| Error::Mesh {
+            path: name.to_string(),
+            problem: format!("meshopt rejected the vertices: {e}"),
+        })?;
+        let t0 = mesh.triangle_count();
+        let mut lods = vec![Lod {
+            mesh: mesh.clone(),
+            target_fraction: 1.0,
+            error_abs: 0.0,
+        }];
+        for &bound in errors_abs {
+            let mut error = 0.0f32;
+            let indices = meshopt::simplify(
+                &mesh.indices,
+                &adapter,
+                3,
+                bound,
+                meshopt::SimplifyOptions::ErrorAbsolute,
+                Some(&mut error),
+            );
+            let previous = lods.last().map_or(t0, |l| l.mesh.triangle_count());
+            if indices.is_empty() || indices.len() / 3 * 100 > previous * 95 {
+                break;
+            }
+            lods.push(Lod {
+                mesh: compact(name, mesh, &indices)?,
+                target_fraction: (indices.len() / 3) as f32 / t0 as f32,
+                error_abs: error,
+            });
+        }
+        Ok(LodChain { lods })
+    }
+
     /// A hand-made ("artist-style") chain: LOD0 first, each next mesh coarser. `error_abs[i]` is LOD i's
     /// deviation from LOD0 in object-space units (0 for LOD0), as the caller measured it; it drives the
     /// switch distances like the simplifier's error does for [`LodChain::build`].
@@ -178,6 +224,18 @@ pub fn switch_distance(
     error_abs * scale * height_px as f32 / (2.0 * pixel_error * (fov_y * 0.5).tan())
 }
 
+/// The object-space error (at instance scale `scale`) that projects to `pixel_error` pixels at distance
+/// `distance`: the inverse of [`switch_distance`].
+pub fn error_at_distance(
+    distance: f32,
+    scale: f32,
+    pixel_error: f32,
+    height_px: u32,
+    fov_y: f32,
+) -> f32 {
+    distance * 2.0 * pixel_error * (fov_y * 0.5).tan() / (height_px as f32 * scale)
+}
+
 /// Switch distances for LOD1.. of a chain: where LOD i's error reaches `pixel_error` pixels. Made strictly
 /// increasing (a LOD whose error is not larger than the previous one's switches just after it), so that the
 /// schedule always moves one LOD at a time.
@@ -207,6 +265,29 @@ mod tests {
 
     fn bunny() -> Mesh {
         Mesh::load_obj(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bunny.obj")).unwrap()
+    }
+
+    /// Each LOD is the coarsest within its error bound: error at most the bound, fewer triangles at each
+    /// larger bound; a bound the mesh cannot simplify within (under 5 % fewer triangles) ends the chain.
+    #[test]
+    fn chain_by_error_stays_within_each_bound() {
+        let bounds = [0.03, 0.07, 0.15];
+        let chain = LodChain::build_by_error("bunny", &bunny(), &bounds).unwrap();
+        assert_eq!(chain.lods.len(), 4);
+        for (lod, bound) in chain.lods[1..].iter().zip(bounds) {
+            assert!(
+                lod.error_abs <= bound && lod.error_abs > bound * 0.5,
+                "{} vs {bound}",
+                lod.error_abs
+            );
+        }
+        for w in chain.lods.windows(2) {
+            assert!(w[1].mesh.triangle_count() < w[0].mesh.triangle_count());
+        }
+        let stuck = LodChain::build_by_error("bunny", &bunny(), &[1e-7, 0.15]).unwrap();
+        assert_eq!(stuck.lods.len(), 1, "{:?}", stuck.info());
+        assert!(LodChain::build_by_error("bunny", &bunny(), &[0.1, 0.05]).is_err());
+        assert!(LodChain::build_by_error("bunny", &bunny(), &[f32::NAN]).is_err());
     }
 
     #[test]

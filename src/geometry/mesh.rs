@@ -1,8 +1,8 @@
-//! Validated triangle meshes, and loading them from OBJ (tobj) and glTF 2.0 (.gltf / .glb, the gltf crate).
+//! Validated triangle meshes, and loading them from OBJ (tobj) and glTF 2.0 (.gltf / .glb, `gltf_read.rs`).
 
 use crate::error::{Error, Result};
-use glam::{Mat3, Mat4, Vec3};
-use std::borrow::Cow;
+use crate::geometry::gltf_read;
+use glam::{Mat3, Vec3};
 use std::path::Path;
 
 /// The mesh file formats [`Mesh::load`] reads, as its error messages list them.
@@ -208,30 +208,36 @@ impl Mesh {
         Mesh::parse_obj(&name, &bytes)
     }
 
-    /// Loads a glTF 2.0 file, JSON (`.gltf`) or binary (`.glb`; the content decides, not the extension).
+    /// Loads a glTF 2.0 file, JSON (`.gltf`) or binary (`.glb`; the content decides, not the extension), read by
+    /// [`gltf_read`].
     ///
-    /// The geometry taken is every triangle primitive of every mesh instance in the default scene (scene 0
+    /// The geometry taken is every triangle primitive of every mesh placement in the default scene (scene 0
     /// when the file names no default; every mesh, untransformed, when the file has no scenes), merged into
-    /// one mesh with each node's world transform applied: positions by the matrix, normals by its inverse
-    /// transpose and renormalised; a node whose transform mirrors (negative determinant) gets its triangles'
-    /// winding reversed, as glTF specifies. A mesh used by two nodes is merged twice.
+    /// one mesh with each placement's world transform applied: positions by the matrix, normals by its inverse
+    /// transpose and renormalised; a transform that mirrors (negative determinant) gets its triangles' winding
+    /// reversed, as glTF specifies. A mesh used by two nodes is merged twice, and a node with
+    /// EXT_mesh_gpu_instancing once per instance (whether or not the file marks the extension required).
     ///
     /// - Primitive modes: TRIANGLES is taken as is, TRIANGLE_STRIP and TRIANGLE_FAN are triangulated (the
     ///   spec's vertex orders), POINTS and the LINE modes are skipped. A primitive without indices uses its
     ///   vertices in order.
-    /// - Normals: the file's when every merged primitive has float NORMALs (and no node transform is
-    ///   singular), otherwise all are computed as [`Mesh::new`] does, as for OBJ files.
-    /// - Not read: sparse accessors (an error says so), quantized positions (float VEC3 only, an error),
-    ///   morph targets and skins (the base, unskinned geometry is used), materials, UVs and images (never
-    ///   decoded). Files that require an extension the gltf crate does not support (Draco, meshopt
-    ///   compression, KHR_mesh_quantization) fail as not readable.
+    /// - Attributes: float, or integer as KHR_mesh_quantization allows (normalised or not, dequantised; the
+    ///   node's transform then scales them back), and meshopt-compressed buffer views (EXT_ and
+    ///   KHR_meshopt_compression) are decoded.
+    /// - Normals: the file's when every merged primitive has NORMALs (and no transform is singular), otherwise
+    ///   all are computed as [`Mesh::new`] does, as for OBJ files.
+    /// - Refused with the reason: a file holding an authored LOD chain (MSFT_lod, or `NAME_LODn` siblings:
+    ///   merging its levels would draw them over each other), Draco compression (with the command that rewrites
+    ///   the file with meshopt compression), any other required extension that changes geometry, sparse
+    ///   accessors. Not read: morph targets and skins (the base, unskinned geometry is used), materials, UVs and
+    ///   images (never decoded).
     /// - Buffers: the GLB binary chunk, base64 `data:` URIs, or files named by relative (percent-encoded)
     ///   URIs, read from the .gltf file's folder; only buffers the merged primitives use are read.
     pub fn load_gltf(path: &Path) -> Result<Mesh> {
         let name = path.display().to_string();
         let bytes = read_mesh_file(path, &name)?;
         let dir = path.parent().unwrap_or(Path::new(""));
-        parse_gltf(&name, &bytes, dir).map_err(|problem| mesh_error(&name, problem))
+        parse_gltf(&bytes, dir).map_err(|problem| mesh_error(&name, problem))
     }
 
     /// Parses OBJ text held in memory; `name` is used in error messages.
@@ -307,393 +313,78 @@ fn read_mesh_file(path: &Path, name: &str) -> Result<Vec<u8>> {
     std::fs::read(path).map_err(|e| mesh_error(name, format!("cannot be read ({e})")))
 }
 
-/// One primitive placed in the scene: its mesh index, primitive index and world transform.
-struct Placed<'a> {
-    primitive: gltf::Primitive<'a>,
-    mesh: usize,
-    world: Mat4,
-}
-
-/// Reads the glTF (JSON or GLB) in `bytes`; external buffers are looked up in `dir`. Errors are the problem
-/// text of an [`Error::Mesh`].
-fn parse_gltf(name: &str, bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
-    let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice(bytes).map_err(|e| format!("not a readable glTF file ({e})"))?;
-    let (placed, scene) = placed_triangle_primitives(&document)?;
-    if placed.is_empty() {
-        return Err(match scene {
-            Some(s) => format!("has no triangle primitives in scene {s}"),
-            None => "has no triangle primitives".to_string(),
-        });
-    }
-    let mut needed = vec![false; document.buffers().len()];
-    for p in &placed {
-        let accessors = [
-            p.primitive.get(&gltf::Semantic::Positions),
-            float_normals(&p.primitive),
-            p.primitive.indices(),
-        ];
-        for view in accessors.iter().flatten().filter_map(|a| a.view()) {
-            if let Some(n) = needed.get_mut(view.buffer().index()) {
-                *n = true;
-            }
-        }
-    }
-    let buffers = load_buffers(&document, blob.as_deref(), &needed, dir)?;
-    merge_primitives(name, &placed, &buffers)
-}
-
-/// The triangle-mode primitives of the scene's node trees with their world transforms, in document order,
-/// and the scene's index (`None` when the file has no scenes and every mesh is taken untransformed).
-fn placed_triangle_primitives(
-    document: &gltf::Document,
-) -> Result<(Vec<Placed<'_>>, Option<usize>), String> {
-    fn add<'a>(placed: &mut Vec<Placed<'a>>, mesh: gltf::Mesh<'a>, world: Mat4) {
-        use gltf::mesh::Mode;
-        for primitive in mesh.primitives() {
-            if matches!(
-                primitive.mode(),
-                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-            ) {
-                placed.push(Placed {
-                    primitive,
-                    mesh: mesh.index(),
-                    world,
-                });
-            }
-        }
-    }
-    let mut placed = Vec::new();
-    let Some(scene) = document
-        .default_scene()
-        .or_else(|| document.scenes().next())
-    else {
-        for mesh in document.meshes() {
-            add(&mut placed, mesh, Mat4::IDENTITY);
-        }
-        return Ok((placed, None));
-    };
-    // Depth first with an explicit stack (no recursion depth limit); a node reached twice would mean a cycle
-    // or a shared child, which glTF forbids, and is refused so a bad file cannot loop.
-    let mut seen = vec![false; document.nodes().len()];
-    let mut stack: Vec<(gltf::Node<'_>, Mat4)> =
-        scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
-    stack.reverse();
-    while let Some((node, parent)) = stack.pop() {
-        match seen.get_mut(node.index()) {
-            Some(s) if !*s => *s = true,
-            _ => {
-                return Err(format!(
-                    "node {} is reached twice from scene {} (glTF node hierarchies must be trees)",
-                    node.index(),
-                    scene.index()
-                ))
-            }
-        }
-        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
-        if let Some(mesh) = node.mesh() {
-            add(&mut placed, mesh, world);
-        }
-        let first_child = stack.len();
-        stack.extend(node.children().map(|c| (c, world)));
-        stack[first_child..].reverse();
-    }
-    Ok((placed, Some(scene.index())))
-}
-
-/// The primitive's NORMAL accessor when it holds float 3-vectors (others are treated as absent).
-fn float_normals<'a>(p: &gltf::Primitive<'a>) -> Option<gltf::Accessor<'a>> {
-    p.get(&gltf::Semantic::Normals).filter(|a| {
-        a.data_type() == gltf::accessor::DataType::F32
-            && a.dimensions() == gltf::accessor::Dimensions::Vec3
-    })
-}
-
-/// The bytes of each buffer marked in `needed` (`None` for the others).
-fn load_buffers<'b>(
-    document: &gltf::Document,
-    blob: Option<&'b [u8]>,
-    needed: &[bool],
-    dir: &Path,
-) -> Result<Vec<Option<Cow<'b, [u8]>>>, String> {
-    let mut out = Vec::new();
-    for buffer in document.buffers() {
-        let i = buffer.index();
-        if !needed.get(i).copied().unwrap_or(false) {
-            out.push(None);
-            continue;
-        }
-        let data: Cow<'b, [u8]> = match buffer.source() {
-            gltf::buffer::Source::Bin => Cow::Borrowed(blob.ok_or_else(|| {
-                format!("buffer {i} refers to the GLB binary chunk, which the file does not have")
-            })?),
-            gltf::buffer::Source::Uri(uri) => Cow::Owned(read_buffer_uri(i, uri, dir)?),
+/// Reads the glTF (JSON or GLB) in `bytes` as one mesh (see [`Mesh::load_gltf`]); external buffers are looked up
+/// in `dir`. Errors are the problem text of an [`Error::Mesh`].
+fn parse_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
+    let mut content = gltf_read::read(bytes, dir)?;
+    if let Some(c) = content.chains.first() {
+        let source = match c.source {
+            gltf_read::ChainSource::MsftLod => "MSFT_lod",
+            gltf_read::ChainSource::LodNames => "nodes named _LOD0, _LOD1, ...",
         };
-        if data.len() < buffer.length() {
-            return Err(format!(
-                "buffer {i} holds {} bytes but declares byteLength {}",
-                data.len(),
-                buffer.length()
-            ));
-        }
-        out.push(Some(data));
-    }
-    Ok(out)
-}
-
-/// A buffer's bytes from a `data:` URI or a file relative to `dir`.
-fn read_buffer_uri(i: usize, uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
-    if let Some(rest) = uri.strip_prefix("data:") {
-        let (header, payload) = rest
-            .split_once(',')
-            .ok_or_else(|| format!("buffer {i} has a data: URI without a ','"))?;
-        let bytes = if header.ends_with(";base64") {
-            decode_base64(payload)
-        } else {
-            percent_decode(payload)
-        };
-        return bytes.ok_or_else(|| format!("buffer {i} has a data: URI that does not decode"));
-    }
-    let scheme = uri.split_once(':').map(|(s, _)| s);
-    if scheme.is_some_and(|s| {
-        s.len() > 1
-            && s.starts_with(|c: char| c.is_ascii_alphabetic())
-            && s.chars()
-                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'))
-    }) {
         return Err(format!(
-            "buffer {i} has URI '{uri}': lodbench reads only data: URIs and relative file paths"
+            "holds an authored LOD chain ('{}': {} levels, {source}); --mesh takes one mesh and builds its own LOD \
+             chain, and merging the levels would draw them over each other: pass a file with LOD0 alone",
+            c.name,
+            c.nodes.len()
         ));
     }
-    let relative = percent_decode(uri)
-        .and_then(|b| String::from_utf8(b).ok())
-        .ok_or_else(|| format!("buffer {i} has URI '{uri}', which is not a valid file path"))?;
-    let file = dir.join(relative);
-    std::fs::read(&file).map_err(|e| {
-        if e.kind() == std::io::ErrorKind::NotFound {
-            format!("buffer {i} file {} not found", file.display())
-        } else {
-            format!("buffer {i} file {} cannot be read ({e})", file.display())
-        }
-    })
-}
-
-/// Standard or URL-safe base64 (the two alphabets may mix), padding optional; `None` for any other character
-/// or a length no base64 text has. Bits left over after the last whole byte are ignored.
-fn decode_base64(text: &str) -> Option<Vec<u8>> {
-    use base64::engine::{general_purpose, DecodePaddingMode, Engine, GeneralPurpose};
-    const ENGINE: GeneralPurpose = GeneralPurpose::new(
-        &base64::alphabet::STANDARD,
-        general_purpose::NO_PAD
-            .with_decode_padding_mode(DecodePaddingMode::RequireNone)
-            .with_decode_allow_trailing_bits(true),
-    );
-    let standard: String = text
-        .trim_end_matches('=')
-        .chars()
-        .map(|c| match c {
-            '-' => '+',
-            '_' => '/',
-            c => c,
-        })
-        .collect();
-    ENGINE.decode(standard).ok()
-}
-
-/// Decodes `%XX` escapes; `None` for a `%` not followed by two hex digits.
-fn percent_decode(text: &str) -> Option<Vec<u8>> {
-    // The crate leaves a malformed escape as it is; a URI with one is refused instead.
-    let b = text.as_bytes();
-    let malformed = b.iter().enumerate().any(|(i, &c)| {
-        c == b'%'
-            && !b
-                .get(i + 1..i + 3)
-                .is_some_and(|hex| hex.iter().all(u8::is_ascii_hexdigit))
-    });
-    (!malformed).then(|| percent_encoding::percent_decode(b).collect())
-}
-
-/// Checks that the crate's accessor reader can read `a` without panicking or coming up short: no sparse
-/// part, a buffer view, a stride that holds an element, and every element inside the view and the view inside
-/// its buffer's bytes.
-fn check_accessor(a: &gltf::Accessor, buffers: &[Option<Cow<[u8]>>]) -> Result<(), String> {
-    let i = a.index();
-    if a.sparse().is_some() {
-        return Err(format!(
-            "accessor {i} is sparse, which lodbench does not read"
-        ));
-    }
-    let view = a
-        .view()
-        .ok_or_else(|| format!("accessor {i} has no buffer view"))?;
-    let elem = a.size();
-    let stride = view.stride().unwrap_or(elem);
-    if stride < elem {
-        return Err(format!(
-            "buffer view {} has stride {stride}, less than accessor {i}'s {elem}-byte elements",
-            view.index()
-        ));
-    }
-    let end = a
-        .count()
-        .checked_sub(1)
-        .and_then(|n| n.checked_mul(stride))
-        .and_then(|n| n.checked_add(elem))
-        .and_then(|n| n.checked_add(a.offset()));
-    if end.is_none_or(|end| end > view.length()) {
-        return Err(format!(
-            "accessor {i} ({} elements) does not fit in buffer view {}",
-            a.count(),
-            view.index()
-        ));
-    }
-    let buffer = view.buffer().index();
-    let have = buffers
-        .get(buffer)
-        .and_then(Option::as_ref)
-        .map_or(0, |d| d.len());
-    if view
-        .offset()
-        .checked_add(view.length())
-        .is_none_or(|end| end > have)
-    {
-        return Err(format!(
-            "buffer view {} reaches past the end of buffer {buffer} ({have} bytes)",
-            view.index()
-        ));
-    }
-    Ok(())
-}
-
-/// Merges the placed primitives into one validated mesh (see [`Mesh::load_gltf`]).
-fn merge_primitives(
-    name: &str,
-    placed: &[Placed<'_>],
-    buffers: &[Option<Cow<[u8]>>],
-) -> Result<Mesh, String> {
-    use gltf::accessor::{DataType, Dimensions};
+    let mut meshes: std::collections::HashMap<usize, Vec<gltf_read::Triangles>> =
+        std::collections::HashMap::new();
     let mut positions: Vec<[f32; 3]> = Vec::new();
     let mut normals: Vec<[f32; 3]> = Vec::new();
     let mut indices: Vec<u32> = Vec::new();
     let mut all_have_normals = true;
-    for p in placed {
-        let prim = &p.primitive;
-        let what = format!("mesh {} primitive {}", p.mesh, prim.index());
-        let pos = prim
-            .get(&gltf::Semantic::Positions)
-            .ok_or_else(|| format!("{what} has no POSITION attribute"))?;
-        if pos.data_type() != DataType::F32 || pos.dimensions() != Dimensions::Vec3 {
-            return Err(format!(
-                "{what} has {:?} {:?} positions; lodbench reads float VEC3 positions only",
-                pos.data_type(),
-                pos.dimensions()
-            ));
+    let placements = std::mem::take(&mut content.placements);
+    for p in &placements {
+        if let std::collections::hash_map::Entry::Vacant(e) = meshes.entry(p.mesh) {
+            e.insert(content.mesh_triangles(p.mesh)?);
         }
-        check_accessor(&pos, buffers)?;
-        let normal_accessor = float_normals(prim);
-        if let Some(n) = &normal_accessor {
-            check_accessor(n, buffers)?;
-            if n.count() != pos.count() {
-                return Err(format!(
-                    "{what} has {} normals for {} positions",
-                    n.count(),
-                    pos.count()
-                ));
-            }
-        }
-        if let Some(ix) = prim.indices() {
-            if !matches!(ix.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
-                || ix.dimensions() != Dimensions::Scalar
-            {
-                return Err(format!(
-                    "{what} has {:?} {:?} indices; glTF indices are unsigned integer scalars",
-                    ix.data_type(),
-                    ix.dimensions()
-                ));
-            }
-            check_accessor(&ix, buffers)?;
-        }
-
-        let reader = prim.reader(|b| buffers.get(b.index()).and_then(|d| d.as_deref()));
-        let unread = || format!("{what}: the accessors cannot be read");
-        let local: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(unread)?
-            .map(Vec3::from)
-            .collect();
-        let count =
-            u32::try_from(local.len()).map_err(|_| format!("{what} has too many vertices"))?;
-        let order: Vec<u32> = match reader.read_indices() {
-            Some(ix) => ix.into_u32().collect(),
-            None if prim.indices().is_some() => return Err(unread()),
-            None => (0..count).collect(),
-        };
-        if let Some(&bad) = order.iter().find(|&&ix| ix >= count) {
-            return Err(format!(
-                "{what} uses vertex index {bad} but has {count} vertices"
-            ));
-        }
-        let mut tris = triangulate(prim.mode(), &order)
-            .ok_or_else(|| format!("{what} has {} indices, not a multiple of 3", order.len()))?;
-
         let linear = Mat3::from_mat4(p.world);
         let det = linear.determinant();
-        if det < 0.0 {
-            for t in tris.chunks_exact_mut(3) {
-                t.swap(1, 2);
-            }
-        }
-        let base = u32::try_from(positions.len())
-            .ok()
-            .filter(|b| b.checked_add(count).is_some())
-            .ok_or_else(|| "has more vertices than 32-bit indices can address".to_string())?;
-        positions.extend(
-            local
-                .iter()
-                .map(|&v| p.world.transform_point3(v).to_array()),
-        );
-        indices.extend(tris.iter().map(|&ix| base + ix));
-
         let normal_matrix = linear.inverse().transpose();
-        match normal_accessor {
-            Some(_) if all_have_normals && det != 0.0 && normal_matrix.is_finite() => {
-                let read: Vec<[f32; 3]> = reader.read_normals().ok_or_else(unread)?.collect();
-                normals.extend(read.into_iter().map(|n| {
-                    let n = normal_matrix * Vec3::from(n);
-                    n.try_normalize().unwrap_or(n).to_array()
-                }));
+        for prim in &meshes[&p.mesh] {
+            let count = prim.positions.len() as u32;
+            let base = u32::try_from(positions.len())
+                .ok()
+                .filter(|b| b.checked_add(count).is_some())
+                .ok_or_else(|| "has more vertices than 32-bit indices can address".to_string())?;
+            positions.extend(
+                prim.positions
+                    .iter()
+                    .map(|&v| p.world.transform_point3(Vec3::from(v)).to_array()),
+            );
+            for t in prim.indices.chunks_exact(3) {
+                // A mirroring transform (negative determinant) reverses the winding, as glTF specifies.
+                let t = if det < 0.0 {
+                    [t[0], t[2], t[1]]
+                } else {
+                    [t[0], t[1], t[2]]
+                };
+                indices.extend(t.iter().map(|&ix| base + ix));
             }
-            _ => all_have_normals = false,
+            match &prim.normals {
+                Some(n) if all_have_normals && det != 0.0 && normal_matrix.is_finite() => {
+                    normals.extend(n.iter().map(|&n| {
+                        let n = normal_matrix * Vec3::from(n);
+                        n.try_normalize().unwrap_or(n).to_array()
+                    }));
+                }
+                _ => all_have_normals = false,
+            }
         }
     }
+    if indices.is_empty() {
+        return Err(match content.scene {
+            Some(s) => format!("has no triangle primitives in scene {s}"),
+            None => "has no triangle primitives".to_string(),
+        });
+    }
     let normals = all_have_normals.then_some(normals);
-    Mesh::new(name, positions, normals, indices).map_err(|e| match e {
+    Mesh::new("", positions, normals, indices).map_err(|e| match e {
         Error::Mesh { problem, .. } => problem,
         other => other.to_string(),
     })
-}
-
-/// The triangle list of a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN primitive's vertex order (glTF 2.0
-/// section 3.7.2.1); `None` for a TRIANGLES list whose length is not a multiple of 3.
-fn triangulate(mode: gltf::mesh::Mode, order: &[u32]) -> Option<Vec<u32>> {
-    use gltf::mesh::Mode;
-    let n = order.len();
-    match mode {
-        Mode::TriangleStrip => Some(
-            (0..n.saturating_sub(2))
-                .flat_map(|i| {
-                    let odd = i % 2;
-                    [order[i], order[i + 1 + odd], order[i + 2 - odd]]
-                })
-                .collect(),
-        ),
-        Mode::TriangleFan => Some(
-            (1..n.saturating_sub(1))
-                .flat_map(|i| [order[i], order[i + 1], order[0]])
-                .collect(),
-        ),
-        _ => n.is_multiple_of(3).then(|| order.to_vec()),
-    }
 }
 
 /// Area-weighted vertex normals; a vertex with no non-degenerate face gets +Y.
@@ -719,6 +410,7 @@ pub fn vertex_normals(positions: &[[f32; 3]], indices: &[u32]) -> Vec<[f32; 3]> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::gltf_read::{decode_base64, percent_decode};
 
     fn tri() -> (Vec<[f32; 3]>, Vec<u32>) {
         (

@@ -3,6 +3,7 @@
 
 pub mod blocks;
 pub mod cluster_dag;
+pub mod gltf_read;
 pub mod lod;
 pub mod mesh;
 pub mod morph;

@@ -70,9 +70,7 @@ impl BunnyPath {
         fov_y: f32,
     ) -> Self {
         let (b, h) = (schedule.band, schedule.hysteresis);
-        let aspect = width as f32 / height as f32;
-        let half_fov = (fov_y * 0.5).min(((fov_y * 0.5).tan() * aspect).atan());
-        let fit = m.radius / half_fov.sin();
+        let fit = fit_distance(m.radius, width, height, fov_y);
         let first_band = m.switches.first().map(|s| s * (1.0 - h) * (1.0 - b));
         let (near, unreached) = match (start, first_band) {
             (SweepStart::CloseUp, Some(fb)) if fit >= fb * 0.95 => (fb * 0.9, 0),
@@ -136,6 +134,22 @@ impl BunnyPath {
     }
 }
 
+/// Nearest distance from the camera at which a bounding sphere of `radius` fits the view (the narrower of the
+/// two fovs).
+pub fn fit_distance(radius: f32, width: u32, height: u32, fov_y: f32) -> f32 {
+    let aspect = width as f32 / height as f32;
+    let half_fov = (fov_y * 0.5).min(((fov_y * 0.5).tan() * aspect).atan());
+    radius / half_fov.sin()
+}
+
+/// Where a user's mesh (`--mesh`) switches to LOD1, LOD2 and LOD3, as multiples of the distance at which it fits
+/// the view: its LOD chain is built by error ([`LodChain::build_by_error`]), LOD i the coarsest simplification
+/// whose error projects to the pixel error no nearer than `USER_SWITCH_FIT_MULTIPLES[i - 1]` x that distance.
+/// A chain by triangle fraction puts a dense scan's switches nearer than the view fits it (its LODs lose almost
+/// nothing), and a sweep from the fit distance then shows no transition; these put every switch on the path
+/// (the first one past the transition band at the default --band and --hysteresis), an octave apart.
+pub const USER_SWITCH_FIT_MULTIPLES: [f32; 3] = [1.6, 3.2, 6.4];
+
 /// What a bunny scene has beyond its models: the path, and the ground with `--shadows on`.
 #[derive(Debug, Clone, Copy)]
 pub struct BunnyParts {
@@ -164,7 +178,7 @@ pub fn def(
             BUILT_IN.to_string(),
         ),
     };
-    let model = bunny_model(kind, &file, &mesh, cfg, pv.height, fov_y)?;
+    let model = bunny_model(kind, &file, &mesh, cfg, pv, fov_y)?;
     let path = BunnyPath::new(
         &model,
         &cfg.schedule,
@@ -198,18 +212,30 @@ fn bunny_model(
     file: &str,
     mesh: &Mesh,
     cfg: &SceneConfig,
-    height: u32,
+    pv: &ProfileValues,
     fov_y: f32,
 ) -> Result<Model> {
+    let height = pv.height;
     mesh.check_area(file)?;
-    let chain = LodChain::build(file, mesh, &DEFAULT_TARGETS)?;
-    let (center, radius) = chain.lods[0].mesh.bounding_sphere();
+    let (center, radius) = mesh.bounding_sphere();
     if !(radius.is_finite() && radius > 0.0) {
         return Err(Error::Mesh {
             path: file.to_string(),
             problem: "has zero extent".into(),
         });
     }
+    let chain = match cfg.mesh {
+        None => LodChain::build(file, mesh, &DEFAULT_TARGETS)?,
+        Some(_) => {
+            let fit = fit_distance(radius, pv.width, height, fov_y);
+            let pixel_error = cfg.pixel_error(kind, height);
+            let errors: Vec<f32> = USER_SWITCH_FIT_MULTIPLES
+                .iter()
+                .map(|m| lod::error_at_distance(m * fit, 1.0, pixel_error, height, fov_y))
+                .collect();
+            LodChain::build_by_error(file, mesh, &errors)?
+        }
+    };
     let scale = 1.0;
     let (switches, switch_source) = match cfg.switch_override("the bunny", chain.lods.len())? {
         Some(s) => (s, "override"),

@@ -82,6 +82,40 @@ fn bad_meshes_name_the_file_and_the_problem() {
     let text = write(dir.path(), "mesh.ply", "ply\n");
     let out = lodbench(&["run", "--scene", "bunny-sweep", "--mesh", &text], &[]);
     fails_with(&out, &["mesh.ply", "unsupported extension '.ply'"]);
+
+    // Files real tools write that --mesh cannot take: Draco (the remedy names the command that rewrites it) and
+    // an authored LOD chain (never merged into one mesh).
+    let tools = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/tools");
+    let draco = tools.join("bunny-gt-draco.glb");
+    let out = lodbench(
+        &[
+            "describe",
+            "--scene",
+            "bunny-sweep",
+            "--mesh",
+            draco.to_str().unwrap(),
+        ],
+        &[],
+    );
+    fails_with(
+        &out,
+        &["bunny-gt-draco.glb", "Draco", "gltf-transform/cli meshopt"],
+    );
+    let chain = tools.join("bunny-msft-lod.glb");
+    let out = lodbench(
+        &[
+            "describe",
+            "--scene",
+            "bunny-sweep",
+            "--mesh",
+            chain.to_str().unwrap(),
+        ],
+        &[],
+    );
+    fails_with(
+        &out,
+        &["bunny-msft-lod.glb", "authored LOD chain", "MSFT_lod"],
+    );
 }
 
 /// The built-in bunny written as a binary glTF (one mesh, one node translated by (5, 0, 0), positions and
@@ -131,8 +165,8 @@ fn bunny_glb() -> Vec<u8> {
     glb
 }
 
-/// `--mesh` takes glTF: the bunny as a .glb gives the scene the OBJ gives (same LODs, switch distances and
-/// path; the node's translation moves the mesh, not its bounding sphere's size), and the committed fixtures of
+/// `--mesh` takes glTF: the bunny as a .glb gives the scene the same bunny as an OBJ gives (same LODs, switch
+/// distances and path; the node's translation moves the mesh, not its bounding sphere's size), and the committed fixtures of
 /// tests/data/ load.
 #[test]
 fn gltf_mesh_gives_the_scene_the_obj_gives() {
@@ -159,9 +193,18 @@ fn gltf_mesh_gives_the_scene_the_obj_gives() {
         );
         serde_json::from_slice(&out.stdout).unwrap()
     };
-    let (from_glb, built_in) = (describe(Some(glb.to_str().unwrap())), describe(None));
-    assert_eq!(from_glb["models"], built_in["models"]);
-    assert_eq!(from_glb["path"], built_in["path"]);
+    let obj = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bunny.obj");
+    let (from_glb, from_obj) = (
+        describe(Some(glb.to_str().unwrap())),
+        describe(Some(obj.to_str().unwrap())),
+    );
+    assert_eq!(from_glb["models"], from_obj["models"]);
+    assert_eq!(from_glb["path"], from_obj["path"]);
+    // A user's mesh gets a chain chosen by error (its switches on the path), the built-in bunny the paper's
+    // triangle fractions: the same mesh, other LODs.
+    let built_in = describe(None);
+    assert_eq!(built_in["models"][0]["lods"][1]["triangles"], 1836);
+    assert_ne!(from_obj["models"][0]["lods"][1]["triangles"], 1836);
     assert!(from_glb["mesh"].as_str().unwrap().ends_with("bunny.glb"));
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
     for f in ["tetra.gltf", "tetra.glb"] {

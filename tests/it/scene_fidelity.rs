@@ -6,17 +6,19 @@ use crate::common::{
 };
 use lodbench::scene::{SceneDef, SceneKind, NOT_REACHED};
 
-/// The bunny split to 14,696 triangles with a scan's fine noise: its LODs lose so little that the switch to
-/// LOD1 lies nearer than where the whole bunny fits the view (as for a 27,864-triangle scan).
-/// The sweep must start outside the model, say which switch it never reaches, and FSI's first transition
-/// (LOD1 to LOD2) must stay within twice discrete's largest rmse. Started inside the bounding sphere, FSI would
-/// show background for the bunny's inside on that transition. At 160x120 and the quick profile's 600 frames fsi's is 1.4 times discrete's (lavapipe: 0.0177 against 0.0126); with
-/// fewer frames the bunny moves faster and FSI's one-frame lag of the moving bunny grows.
+/// The bunny split to 58,784 triangles with a scan's fine noise (as a dense scan brought with `--mesh`): its LOD
+/// chain is built by error (`USER_SWITCH_FIT_MULTIPLES`), so every switch lies on the sweep, which starts
+/// where the model fits the view (outside it) and shows a transition at every LOD, out and back. Built by
+/// triangle fraction, as before, its LODs lost so little that the switch to LOD1 lay nearer than the sweep's
+/// start and the sweep never reached it. FSI's first transition must stay within twice discrete's largest rmse:
+/// started inside the bounding sphere, FSI would show background for the bunny's inside. At 160x120 and the quick
+/// profile's 600 frames; with fewer frames the bunny moves faster and FSI's one-frame lag of the moving bunny
+/// grows (at 100 frames its rmse was three times discrete's).
 #[test]
-fn dense_mesh_sweep_starts_outside_the_model() {
+fn dense_mesh_sweeps_through_every_lod() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = dir.path().join("dense.obj");
-    std::fs::write(&mesh, subdivided_bunny_obj(1, 0.05)).unwrap();
+    std::fs::write(&mesh, subdivided_bunny_obj(2, 0.05)).unwrap();
     let mesh = mesh.to_str().unwrap();
     let flags = [
         "--mesh",
@@ -32,13 +34,11 @@ fn dense_mesh_sweep_starts_outside_the_model() {
     let def = SceneDef::new(SceneKind::BunnySweep, &cfg).unwrap();
     let path = def.path().unwrap();
     let m = &def.models[0];
+    assert_eq!(m.chain.lods[0].mesh.triangle_count(), 58_784);
+    assert_eq!(m.chain.lods.len(), 4, "{:?}", m.chain.info());
     assert!(path.near >= path.fit && path.fit > m.radius, "{path:?}");
-    assert!(path.unreached >= 1, "{path:?} {:?}", m.switches);
-    let notes = def.notes();
-    assert_eq!(notes.len(), 1, "{notes:?}");
-    assert!(notes[0].contains(NOT_REACHED) && notes[0].contains("LOD1 at"));
-    let d = def.describe(&cfg);
-    assert_eq!(d.models[0].lods[1].note, Some(NOT_REACHED));
+    assert_eq!(path.unreached, 0, "{path:?} {:?}", m.switches);
+    assert!(def.notes().is_empty(), "{:?}", def.notes());
     let scene = def.instantiate(1);
     let far_enough = (0..scene.frames).all(|f| scene.instance_distance(0, f) >= path.fit * 0.999);
     assert!(far_enough, "the camera comes inside the bounding sphere");
@@ -51,11 +51,19 @@ fn dense_mesh_sweep_starts_outside_the_model() {
         "reference,discrete,fsi",
     ];
     args.extend_from_slice(&flags);
-    // The quick profile's frames: FSI's error grows with the camera's motion per frame (at 100 frames its
-    // first transition's rmse is three times discrete's).
     args.extend_from_slice(&["--rounds", "1", "--warmup", "1"]);
     run_into(&out, &args);
     let rows = read_csv(&out.join("transitions.csv"));
+    let lods: Vec<&str> = rows
+        .iter()
+        .filter(|r| r["method"] == "discrete")
+        .map(|r| r["lods"].as_str())
+        .collect();
+    assert_eq!(
+        lods,
+        ["0->1", "1->2", "2->3", "2->3", "1->2", "0->1"],
+        "discrete's transitions"
+    );
     let first = |method: &str| -> f64 {
         rows.iter()
             .find(|r| r["method"] == method && r["transition"] == "0")
@@ -64,11 +72,42 @@ fn dense_mesh_sweep_starts_outside_the_model() {
             .unwrap()
     };
     let (fsi, discrete) = (first("fsi"), first("discrete"));
-    eprintln!("first transition's largest rmse: fsi {fsi}, discrete {discrete}; path {path:?}");
+    eprintln!(
+        "first transition's largest rmse: fsi {fsi}, discrete {discrete}; path {path:?}; switches {:?}; LODs {:?}",
+        m.switches,
+        m.chain
+            .info()
+            .iter()
+            .map(|l| (l.triangles, l.error_abs))
+            .collect::<Vec<_>>()
+    );
     assert!(
         fsi <= 2.0 * discrete,
         "first transition: fsi's rmse {fsi} against discrete's {discrete}"
     );
+}
+
+/// A switch nearer than where the model fits the view is not reached by a sweep that starts there: the run
+/// says which (a note, and describe's LOD), and the sweep starts past that switch's band.
+#[test]
+fn a_switch_nearer_than_the_fit_is_named_as_not_reached() {
+    let probe = SceneDef::new(SceneKind::BunnySweep, &scene_config("bunny-sweep", &[])).unwrap();
+    let fit = probe.path().unwrap().fit;
+    let switches = format!("{},{},{}", fit * 0.5, fit * 2.0, fit * 4.0);
+    let cfg = scene_config("bunny-sweep", &["--switch-distances", &switches]);
+    let def = SceneDef::new(SceneKind::BunnySweep, &cfg).unwrap();
+    let path = def.path().unwrap();
+    assert_eq!(path.unreached, 1, "{path:?}");
+    assert!(path.near > fit * 0.5 * 1.05, "{path:?}");
+    let notes = def.notes();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(
+        notes[0].contains(NOT_REACHED) && notes[0].contains("LOD1 at"),
+        "{notes:?}"
+    );
+    let d = def.describe(&cfg);
+    assert_eq!(d.models[0].lods[1].note, Some(NOT_REACHED));
+    assert_eq!(d.models[0].lods[2].note, None);
 }
 
 /// With the camera inside the bunny (at 2 % of its radius from the bounding-sphere centre, which lies inside
