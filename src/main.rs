@@ -2,7 +2,9 @@
 
 use clap::Parser;
 use lodbench::cli::{Cli, Command};
-use lodbench::commands::{clips, compare, describe, experiment, list, merge, perceptual, run};
+use lodbench::commands::{
+    clips, compare, describe, experiment, export, list, merge, perceptual, run,
+};
 use lodbench::Error;
 use std::process::ExitCode;
 
@@ -13,6 +15,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run::execute(&args),
         Command::List => list::execute(),
         Command::Describe(args) => describe::execute(&args),
+        Command::Export(args) => export::execute(&args),
         Command::Experiment(args) => experiment::execute(&args),
         Command::Merge(args) => merge::execute(&args),
         Command::Compare(args) => compare::execute(&args),

@@ -70,12 +70,22 @@ impl SceneConfig {
             hysteresis: a.hysteresis,
         };
         schedule.validate()?;
+        let camera_path = match &a.camera_path {
+            Some(p) => Some(crate::scene::camera_path::CameraPath::load(p)?),
+            None => None,
+        };
+        // A path's own field of view replaces --fov (the switch distances are computed for it).
+        let fov_deg = camera_path
+            .as_ref()
+            .and_then(|p| p.fov_deg)
+            .unwrap_or(a.fov);
         Ok(SceneConfig {
             profile: a.profile,
             width: a.width,
             height: a.height,
             frames: a.frames,
             mesh: a.mesh.clone(),
+            camera_path,
             pixel_error: a.pixel_error,
             sweep_start: a.sweep_start,
             switch_distances: a.switch_distances.clone(),
@@ -86,7 +96,7 @@ impl SceneConfig {
             } else {
                 Some(a.count.clone())
             },
-            fov_deg: a.fov,
+            fov_deg,
             schedule,
             camera: a.camera,
             taa: a.taa.resolve()?,
@@ -166,10 +176,7 @@ impl RunConfig {
 
     /// The flags checked against `registry`'s methods.
     pub fn from_args_in(a: &RunArgs, registry: &Registry) -> Result<RunConfig> {
-        let scenes = resolve_names("scene", &a.scene, &SceneKind::names())?
-            .iter()
-            .map(|n| SceneKind::from_name(n))
-            .collect::<Result<Vec<_>>>()?;
+        let scenes = SceneKind::resolve(&a.scene)?;
         let methods = resolve_methods(&a.method, &registry.names())?;
         if a.rounds == 0 {
             return Err(Error::Config("--rounds must be at least 1".into()));

@@ -37,6 +37,9 @@ pub enum Command {
     List,
     /// Show a scene's models, LOD chains, switch distances, instance and frame counts.
     Describe(DescribeArgs),
+    /// Write a built-in scene as glTF 2.0 (.glb): its LOD chains (MSFT_lod, with the exact switch distances),
+    /// its instances and its camera path as a camera animation; `run --scene FILE.glb` reads it back.
+    Export(ExportArgs),
     /// Run a sweep described in a TOML file (scenes/experiments/) into one results folder.
     Experiment(ExperimentArgs),
     /// Merge the folders of an experiment's shards (`experiment --shard`) into one results folder.
@@ -188,6 +191,10 @@ pub struct SceneArgs {
     /// Mesh file (.obj, .gltf or .glb) that replaces the Stanford bunny in the bunny scenes.
     #[arg(long)]
     pub mesh: Option<PathBuf>,
+    /// A camera path, CSV (time or frame; x, y, z; target_x, target_y, target_z or qx, qy, qz, qw; optional
+    /// fov_deg), resampled to --frames: it replaces every scene's own camera (docs/methods.md, "Camera paths").
+    #[arg(long)]
+    pub camera_path: Option<PathBuf>,
     /// Screen-space error, in pixels at the viewport's height, at which each LOD is switched in. A smaller value
     /// moves every switch farther from the camera, a larger one nearer. Default: for the bunny scenes one pixel
     /// at the paper's 600-pixel height (height / 600), so every profile has the paper's switch distances and
@@ -377,6 +384,18 @@ pub struct DescribeArgs {
     /// Machine-readable output.
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct ExportArgs {
+    /// The built-in scene to export (the unified scenes are not exported).
+    #[arg(long)]
+    pub scene: String,
+    /// The .glb file to write.
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub scene_args: SceneArgs,
 }
 
 /// Whether to write MP4s with ffmpeg.

@@ -127,6 +127,23 @@ fn print_path(d: &SceneDescription) -> Result<()> {
             p.fit
         );
     }
+    if let Some(u) = &d.user {
+        outln!(
+            "instances: {} of {} models; camera: {}",
+            u.instance_count,
+            d.models.len(),
+            u.camera_source
+        );
+        for c in &u.chains {
+            outln!(
+                "authored LOD chain {} ({}, {} levels): switch distances from {}",
+                c.model,
+                c.source,
+                c.levels,
+                c.thresholds
+            );
+        }
+    }
     outln!("motion: {}", serde_json::to_string(&d.motion)?);
     for n in &d.notes {
         outln!("note: {n}");

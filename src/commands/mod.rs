@@ -1,5 +1,5 @@
-//! One file per subcommand: what `lodbench run`, `experiment`, `merge`, `compare`, `clips`, `perceptual`, `list`
-//! and `describe` do, from the parsed flags to a results folder or a printed report. Each file's `execute` is what
+//! One file per subcommand: what `lodbench run`, `experiment`, `merge`, `compare`, `clips`, `perceptual`, `list`,
+//! `describe` and `export` do, from the parsed flags to a results folder or a printed report. Each file's `execute` is what
 //! the binary calls.
 
 /// `print!` / `println!` to stdout that give up quietly when stdout is gone (`lodbench describe ... | head`):
@@ -22,6 +22,7 @@ pub mod clips;
 pub mod compare;
 pub mod describe;
 pub mod experiment;
+pub mod export;
 pub mod list;
 pub mod merge;
 pub mod perceptual;

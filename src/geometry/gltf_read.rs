@@ -65,6 +65,11 @@ pub struct AuthoredChain {
     pub nodes: Vec<usize>,
     /// MSFT_lod's `extras.MSFT_screencoverage` on the LOD0 node, when present.
     pub screen_coverage: Option<Vec<f64>>,
+    /// `extras.lodbench_switch_distances` on the LOD0 node (what `lodbench export` writes): exact switch
+    /// distances, preferred to the screen coverage.
+    pub switch_distances: Option<Vec<f32>>,
+    /// `extras.lodbench_spin_per_frame` (windmill blades' turn per frame, radians), 0 without it.
+    pub spin_per_frame: f32,
 }
 
 /// What a glTF file places in its scene.
@@ -76,6 +81,20 @@ pub struct Content<'a> {
     pub chains: Vec<AuthoredChain>,
     /// The scene read (None: the file has no scenes and every mesh is placed untransformed).
     pub scene: Option<usize>,
+    /// The scene's nodes: (node, parent's world matrix, world matrix).
+    nodes: SceneNodes,
+}
+
+/// A camera node's animation (the first animated camera of the scene): keys in world space.
+#[derive(Debug, Clone)]
+pub struct AnimatedCamera {
+    pub node: usize,
+    /// The camera's vertical field of view, radians, and its clip planes (perspective cameras).
+    pub yfov: Option<f32>,
+    pub znear: Option<f32>,
+    pub zfar: Option<f32>,
+    /// (time s, eye, orientation): the camera looks along its local -z.
+    pub keys: Vec<(f64, Vec3, Quat)>,
 }
 
 /// A primitive's triangles in mesh space, with its normals when the file has usable ones.
@@ -83,6 +102,8 @@ pub struct Triangles {
     pub positions: Vec<[f32; 3]>,
     pub normals: Option<Vec<[f32; 3]>>,
     pub indices: Vec<u32>,
+    /// lodbench's own per-vertex shading extras (`_LODBENCH_AUX`, written by `lodbench export`).
+    pub aux: Option<Vec<[f32; 4]>>,
 }
 
 /// The scene's nodes, depth first: (node, parent's world matrix, the node's world matrix).
@@ -153,10 +174,139 @@ pub fn read<'a>(bytes: &'a [u8], dir: &'a Path) -> Result<Content<'a>, String> {
         placements,
         chains,
         scene,
+        nodes: nodes.unwrap_or_default(),
     })
 }
 
 impl Content<'_> {
+    /// The base colour factor (linear RGB) of the material of mesh `mesh`'s first primitive, if it has one.
+    pub fn mesh_color(&self, mesh: usize) -> Option<[f32; 3]> {
+        let json = &self.doc.json;
+        let material = json["meshes"][mesh]["primitives"][0]["material"].as_u64()? as usize;
+        let f = floats::<4>(
+            &json["materials"][material]["pbrMetallicRoughness"]["baseColorFactor"],
+            "baseColorFactor",
+        )
+        .ok()??;
+        Some([f[0], f[1], f[2]].map(|c| c.clamp(0.0, 1.0)))
+    }
+
+    /// Mesh `mesh`'s name ("" when it has none).
+    pub fn mesh_name(&self, mesh: usize) -> &str {
+        self.doc.json["meshes"][mesh]["name"].as_str().unwrap_or("")
+    }
+
+    /// The first camera node of the scene whose translation or rotation is animated, its keys resampled at the
+    /// union of its channels' key times (LINEAR and STEP as glTF defines them; CUBICSPLINE's values are taken at
+    /// its keys and joined linearly). The node's parents are taken at rest. None when no camera is animated.
+    pub fn animated_camera(&mut self) -> Result<Option<AnimatedCamera>, String> {
+        let json = self.doc.json.clone();
+        let Some(&(node, parent, _)) = self
+            .nodes
+            .iter()
+            .find(|(n, _, _)| json["nodes"][*n].get("camera").is_some() && animated(&json, *n))
+        else {
+            return Ok(None);
+        };
+        let what = format!("the animation of camera node {node}");
+        let rest = &json["nodes"][node];
+        let t0 = floats::<3>(&rest["translation"], "translation")?.unwrap_or([0.0; 3]);
+        let r0 = floats::<4>(&rest["rotation"], "rotation")?.unwrap_or([0.0, 0.0, 0.0, 1.0]);
+        let mut translation: Option<Track> = None;
+        let mut rotation: Option<Track> = None;
+        for anim in array(&json, "animations") {
+            for ch in array(anim, "channels") {
+                if ch["target"]["node"].as_u64() != Some(node as u64) {
+                    continue;
+                }
+                let (slot, width) = match ch["target"]["path"].as_str() {
+                    Some("translation") => (&mut translation, 3),
+                    Some("rotation") => (&mut rotation, 4),
+                    _ => continue,
+                };
+                let sampler = ch["sampler"]
+                    .as_u64()
+                    .and_then(|i| array(anim, "samplers").get(i as usize));
+                let sampler =
+                    sampler.ok_or_else(|| format!("{what}: a channel names no sampler"))?;
+                let input = sampler["input"]
+                    .as_u64()
+                    .ok_or_else(|| format!("{what}: a sampler has no input"))?;
+                let output = sampler["output"]
+                    .as_u64()
+                    .ok_or_else(|| format!("{what}: a sampler has no output"))?;
+                let (times, _) = self.doc.read_floats(input as usize)?;
+                let (values, c) = self.doc.read_floats(output as usize)?;
+                let mode = sampler["interpolation"].as_str().unwrap_or("LINEAR");
+                let per_key = if mode == "CUBICSPLINE" { 3 } else { 1 };
+                if c != width || values.len() != times.len() * width * per_key {
+                    return Err(format!(
+                        "{what}: a sampler's output does not match its {} keys",
+                        times.len()
+                    ));
+                }
+                if times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| w[1] <= w[0]) {
+                    return Err(format!("{what}: key times must increase"));
+                }
+                let values: Vec<f32> = values
+                    .chunks_exact(width * per_key)
+                    .flat_map(|k| k[(per_key / 2) * width..(per_key / 2 + 1) * width].to_vec())
+                    .collect();
+                *slot = Some(Track {
+                    times,
+                    values,
+                    width,
+                    step: mode == "STEP",
+                });
+            }
+        }
+        let mut times: Vec<f32> = translation
+            .iter()
+            .chain(rotation.iter())
+            .flat_map(|t| t.times.iter().copied())
+            .collect();
+        times.sort_by(f32::total_cmp);
+        times.dedup();
+        if times.len() < 2 {
+            return Err(format!(
+                "{what} has {} key time(s); a path needs at least two",
+                times.len()
+            ));
+        }
+        let (_, parent_rotation, _) = parent.to_scale_rotation_translation();
+        let keys = times
+            .iter()
+            .map(|&t| {
+                let tr = translation
+                    .as_ref()
+                    .map_or(Vec3::from(t0), |k| Vec3::from_slice(&k.at(t)));
+                let ro = rotation
+                    .as_ref()
+                    .map_or(Quat::from_array(r0), |k| Quat::from_slice(&k.at(t)))
+                    .normalize();
+                (
+                    f64::from(t),
+                    parent.transform_point3(tr),
+                    (parent_rotation * ro).normalize(),
+                )
+            })
+            .collect();
+        let perspective = |key: &str| {
+            rest["camera"]
+                .as_u64()
+                .and_then(|c| json["cameras"][c as usize]["perspective"][key].as_f64())
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .map(|f| f as f32)
+        };
+        Ok(Some(AnimatedCamera {
+            node,
+            yfov: perspective("yfov"),
+            znear: perspective("znear"),
+            zfar: perspective("zfar"),
+            keys,
+        }))
+    }
+
     /// Whether `node` is a level of an authored chain.
     pub fn in_chain(&self, node: usize) -> bool {
         self.chains.iter().any(|c| c.nodes.contains(&node))
@@ -199,6 +349,20 @@ impl Content<'_> {
                 }
                 None => None,
             };
+            let aux = match attrs.get("_LODBENCH_AUX").and_then(Value::as_u64) {
+                Some(a) => {
+                    let (v, c) = self.doc.read_floats(a as usize)?;
+                    if c != 4 || v.len() != positions.len() * 4 {
+                        return Err(format!("{what}: _LODBENCH_AUX is not one VEC4 per vertex"));
+                    }
+                    Some(
+                        v.chunks_exact(4)
+                            .map(|a| [a[0], a[1], a[2], a[3]])
+                            .collect(),
+                    )
+                }
+                None => None,
+            };
             let count = u32::try_from(positions.len())
                 .map_err(|_| format!("{what} has too many vertices"))?;
             let order: Vec<u32> = match prim.get("indices").and_then(Value::as_u64) {
@@ -217,9 +381,65 @@ impl Content<'_> {
                 positions,
                 normals,
                 indices,
+                aux,
             });
         }
         Ok(out)
+    }
+}
+
+/// Whether some animation channel moves `node` (translation or rotation).
+fn animated(json: &Value, node: usize) -> bool {
+    array(json, "animations").iter().any(|a| {
+        array(a, "channels").iter().any(|c| {
+            c["target"]["node"].as_u64() == Some(node as u64)
+                && matches!(
+                    c["target"]["path"].as_str(),
+                    Some("translation" | "rotation")
+                )
+        })
+    })
+}
+
+/// One animation channel's keys (values `width` wide).
+struct Track {
+    times: Vec<f32>,
+    values: Vec<f32>,
+    width: usize,
+    step: bool,
+}
+
+impl Track {
+    /// The value at time `t`: held before the first key and after the last, linear between keys (slerp for
+    /// rotations, `width` 4), the earlier key's with STEP.
+    fn at(&self, t: f32) -> Vec<f32> {
+        let w = self.width;
+        let key = |i: usize| &self.values[i * w..(i + 1) * w];
+        let n = self.times.len();
+        if t <= self.times[0] {
+            return key(0).to_vec();
+        }
+        if t >= self.times[n - 1] {
+            return key(n - 1).to_vec();
+        }
+        let i = self
+            .times
+            .windows(2)
+            .position(|p| t < p[1])
+            .unwrap_or(n - 2);
+        if self.step {
+            return key(i).to_vec();
+        }
+        let s = (t - self.times[i]) / (self.times[i + 1] - self.times[i]);
+        if w == 4 {
+            let (a, b) = (Quat::from_slice(key(i)), Quat::from_slice(key(i + 1)));
+            return a.normalize().slerp(b.normalize(), s).to_array().to_vec();
+        }
+        key(i)
+            .iter()
+            .zip(key(i + 1))
+            .map(|(a, b)| a + (b - a) * s)
+            .collect()
     }
 }
 
@@ -409,11 +629,25 @@ fn chains(json: &Value, nodes: &Option<SceneNodes>) -> Result<Vec<AuthoredChain>
             .pointer("/extras/MSFT_screencoverage")
             .and_then(Value::as_array)
             .map(|a| a.iter().filter_map(Value::as_f64).collect());
+        let switch_distances = node
+            .pointer("/extras/lodbench_switch_distances")
+            .and_then(Value::as_array)
+            .map(|a| {
+                a.iter()
+                    .filter_map(Value::as_f64)
+                    .map(|d| d as f32)
+                    .collect()
+            });
         out.push(AuthoredChain {
             source: ChainSource::MsftLod,
             name: node["name"].as_str().unwrap_or("").to_string(),
             nodes: chain,
             screen_coverage,
+            switch_distances,
+            spin_per_frame: node
+                .pointer("/extras/lodbench_spin_per_frame")
+                .and_then(Value::as_f64)
+                .unwrap_or(0.0) as f32,
         });
     }
     // `NAME_LODn` siblings: group the scene's nodes by parent and stem.
@@ -462,6 +696,8 @@ fn chains(json: &Value, nodes: &Option<SceneNodes>) -> Result<Vec<AuthoredChain>
             name: stem,
             nodes: levels.into_iter().map(|l| l.1).collect(),
             screen_coverage: None,
+            switch_distances: None,
+            spin_per_frame: 0.0,
         });
     }
     Ok(out)

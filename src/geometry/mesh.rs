@@ -308,7 +308,8 @@ fn check_mesh_file(path: &Path, name: &str) -> Result<()> {
     }
 }
 
-fn read_mesh_file(path: &Path, name: &str) -> Result<Vec<u8>> {
+/// The bytes of the mesh or scene file at `path` (`name` in errors).
+pub(crate) fn read_mesh_file(path: &Path, name: &str) -> Result<Vec<u8>> {
     check_mesh_file(path, name)?;
     std::fs::read(path).map_err(|e| mesh_error(name, format!("cannot be read ({e})")))
 }

@@ -196,6 +196,7 @@ pub fn def(
             model: 1,
             position,
             yaw: 0.0,
+            rotation: glam::Quat::IDENTITY,
         }
     });
     let set = ModelSet {
@@ -321,6 +322,7 @@ pub fn layout(kind: SceneKind, m: &Model, path: &BunnyPath, count: u32) -> Layou
                     model: 0,
                     position: Vec3::new(camera_x + near_d + i as f32 * dx, 0.0, 0.0),
                     yaw,
+                    rotation: glam::Quat::IDENTITY,
                 })
                 .collect();
             (inst, Motion::Static, near_d + w + 2.0 * m.radius)
@@ -330,6 +332,7 @@ pub fn layout(kind: SceneKind, m: &Model, path: &BunnyPath, count: u32) -> Layou
                 model: 0,
                 position: Vec3::new(near_d, 0.0, 0.0),
                 yaw,
+                rotation: glam::Quat::IDENTITY,
             }],
             Motion::SweepX {
                 near: near_d,

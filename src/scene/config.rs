@@ -15,6 +15,8 @@ pub struct SceneConfig {
     pub height: Option<u32>,
     pub frames: Option<u32>,
     pub mesh: Option<std::path::PathBuf>,
+    /// `--camera-path`, read: replaces every scene's camera.
+    pub camera_path: Option<crate::scene::camera_path::CameraPath>,
     /// `--pixel-error`; None = the scene's default ([`SceneConfig::pixel_error`]).
     pub pixel_error: Option<f32>,
     /// `--sweep-start`; None = the profile's.

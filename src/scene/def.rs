@@ -5,10 +5,11 @@ use crate::error::Result;
 use crate::scene::bunny::{self, BunnyParts, BunnyPath};
 use crate::scene::config::SceneConfig;
 use crate::scene::kind::{CameraMode, SceneKind};
-use crate::scene::model::{Layout, Model, Scene};
+use crate::scene::model::{CameraTrack, Layout, Model, Scene};
 use crate::scene::procedural;
 use crate::scene::schedule::ScheduleParams;
 use crate::scene::unified::{self, UnifiedParts};
+use crate::scene::user::{self, UserParts};
 use std::sync::Arc;
 
 /// Scene-level facts that do not depend on the instance count: built once per scene name.
@@ -31,6 +32,8 @@ pub struct SceneDef {
     pub family: Family,
     pub taa: Option<crate::effects::taa::Taa>,
     pub shadows: Option<crate::effects::shadow::Shadows>,
+    /// `--camera-path`: replaces the family's camera.
+    pub camera_path: Option<Arc<crate::scene::camera_path::CameraPath>>,
 }
 
 /// The scene families and what each has beyond its models.
@@ -42,15 +45,21 @@ pub enum Family {
     Bunny(BunnyParts),
     /// bunny-halves, terrain: the blocks, camera and frustum (`unified.rs`).
     Unified(Arc<UnifiedParts>),
+    /// A user's glTF scene: its instances and camera flight (`user.rs`).
+    User(Arc<UserParts>),
 }
 
 impl SceneDef {
     pub fn new(kind: SceneKind, cfg: &SceneConfig) -> Result<SceneDef> {
         let pv = cfg.resolved(kind);
-        let fov_y = cfg.fov_deg.to_radians();
+        let mut fov_y = cfg.fov_deg.to_radians();
         let (set, family) = if kind.is_unified() {
             let (set, parts) = unified::def(kind, cfg, &pv, fov_y)?;
             (set, Family::Unified(Arc::new(parts)))
+        } else if kind.is_user() {
+            let (set, parts) = user::def(kind, cfg, &pv, fov_y)?;
+            fov_y = parts.fov_y.unwrap_or(fov_y);
+            (set, Family::User(Arc::new(parts)))
         } else if kind.is_bunny() {
             let (set, parts) = bunny::def(kind, cfg, &pv, fov_y)?;
             (set, Family::Bunny(parts))
@@ -75,6 +84,7 @@ impl SceneDef {
             family,
             taa: cfg.taa,
             shadows: cfg.shadows,
+            camera_path: cfg.camera_path.clone().map(Arc::new),
         })
     }
 
@@ -87,6 +97,14 @@ impl SceneDef {
     pub fn path(&self) -> Option<BunnyPath> {
         match &self.family {
             Family::Bunny(b) => Some(b.path),
+            _ => None,
+        }
+    }
+
+    /// A user scene's instances and flight; None for the built-in scenes.
+    pub fn user(&self) -> Option<&UserParts> {
+        match &self.family {
+            Family::User(u) => Some(u),
             _ => None,
         }
     }
@@ -104,6 +122,31 @@ impl SceneDef {
     pub fn notes(&self) -> Vec<String> {
         match (&self.family, self.models.first()) {
             (Family::Bunny(b), Some(m)) => b.path.notes(self.kind, m),
+            (Family::User(u), _) => {
+                let Some(inst) = u.instances.get(u.followed) else {
+                    return Vec::new();
+                };
+                let m = &self.models[inst.model as usize];
+                let (b, h) = (self.schedule.band, self.schedule.hysteresis);
+                let lods: Vec<String> = m
+                    .switches
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, s)| *s * (1.0 - h) * (1.0 - b) < u.start)
+                    .map(|(j, s)| format!("LOD{} at {s:.4}", j + 1))
+                    .collect();
+                if lods.is_empty() {
+                    return Vec::new();
+                }
+                vec![format!(
+                    "{}: the switch to {} of model {} lies nearer than the flight's start ({:.4}, 1.1 times \
+                     its bounding sphere's radius): not reached",
+                    self.kind.name(),
+                    lods.join(", "),
+                    m.name,
+                    u.start
+                )]
+            }
             _ => Vec::new(),
         }
     }
@@ -114,7 +157,30 @@ impl SceneDef {
             Family::Procedural => procedural::layout(&self.models[0], count),
             Family::Bunny(b) => bunny::layout(self.kind, &self.models[0], &b.path, count),
             Family::Unified(u) => unified::layout(u),
+            Family::User(u) => user::layout(u),
         };
+        let mut layout = layout;
+        if let Some(path) = &self.camera_path {
+            // Far enough for every instance seen from every key.
+            let reach = layout
+                .instances
+                .iter()
+                .map(|i| {
+                    let r = self.models[i.model as usize].radius;
+                    path.eyes()
+                        .map(|e| e.distance(i.position) + r)
+                        .fold(0.0f32, f32::max)
+                })
+                .fold(0.0f32, f32::max);
+            layout.far = layout.far.max(reach * 1.5);
+            layout.near = layout.near.min(
+                self.models
+                    .iter()
+                    .map(|m| m.radius * 0.02)
+                    .fold(f32::INFINITY, f32::min),
+            );
+            layout.track = Some(CameraTrack::Path(path.clone()));
+        }
         let mut scene = self.scene(count, layout);
         if let Family::Bunny(BunnyParts {
             ground: Some(ground),

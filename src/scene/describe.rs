@@ -39,6 +39,9 @@ pub struct SceneDescription {
     /// The unified scenes' preprocessing: blocks, seams, cluster DAG, with times and sizes.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub unified: Option<Preprocessing>,
+    /// A user scene's instances, authored chains and camera flight.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub user: Option<crate::scene::user::UserParts>,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -73,7 +76,7 @@ impl SceneDef {
             profile: format!("{:?}", cfg.profile).to_lowercase(),
             width: self.width,
             height: self.height,
-            fov_y_deg: cfg.fov_deg,
+            fov_y_deg: self.fov_y.to_degrees(),
             frames: self.frames,
             instance_counts: self.counts.clone(),
             mesh: self.mesh_source.clone(),
@@ -87,6 +90,7 @@ impl SceneDef {
             path: self.path(),
             notes: self.notes(),
             unified: self.unified().map(|u| u.data.preprocessing.clone()),
+            user: self.user().cloned(),
         }
     }
 

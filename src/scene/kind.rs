@@ -66,9 +66,8 @@ pub struct ProfileValues {
 /// The paper's counts for bunny-grid (Sheliemietiev et al. 2023, section 6).
 pub const PAPER_COUNTS: [u32; 5] = [50, 250, 500, 1000, 2000];
 
-/// A scene `--scene` accepts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "kebab-case")]
+/// A scene `--scene` accepts: a built-in name, or a glTF file's path (a user scene, `scene/user.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum SceneKind {
     /// The popping experiment of Sheliemietiev et al. 2023, section 6: one bunny moved along the line of
     /// sight and back.
@@ -86,6 +85,27 @@ pub enum SceneKind {
     BunnyHalves,
     /// One large procedural heightfield (`geometry/terrain.rs`) in blocks, flown over low.
     Terrain,
+    /// The user's glTF scene (`--scene PATH.gltf|PATH.glb`): every node with a mesh an instance, authored LOD
+    /// chains kept (`scene/user.rs`). `name` (the CSVs' `scene` column, file names of dumps) is the file's name
+    /// with every character but letters, digits, '.' and '-' made '-'. Both are interned for the run's
+    /// lifetime, so the kind stays `Copy`.
+    User {
+        path: &'static str,
+        name: &'static str,
+    },
+}
+
+impl Serialize for SceneKind {
+    /// As its name (the CSVs' `scene` column).
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// Whether `name` names a glTF file (`.gltf` or `.glb`, any case): a user scene.
+pub fn is_gltf_path(name: &str) -> bool {
+    let lower = name.to_ascii_lowercase();
+    lower.ends_with(".gltf") || lower.ends_with(".glb")
 }
 
 impl SceneKind {
@@ -110,6 +130,7 @@ impl SceneKind {
             SceneKind::Trees => "trees",
             SceneKind::BunnyHalves => "bunny-halves",
             SceneKind::Terrain => "terrain",
+            SceneKind::User { name, .. } => name,
         }
     }
 
@@ -118,12 +139,72 @@ impl SceneKind {
         Self::ALL.iter().map(|k| k.name()).collect()
     }
 
-    /// The scene called `name`, or an error listing the valid names.
+    /// The scene called `name` (a glTF file's path is a user scene), or an error listing the valid names.
     pub fn from_name(name: &str) -> Result<SceneKind> {
+        if is_gltf_path(name) {
+            // Interned once per distinct path: a run names a handful of scenes.
+            type Interned = Vec<(&'static str, &'static str)>;
+            static PATHS: std::sync::Mutex<Interned> = std::sync::Mutex::new(Vec::new());
+            let mut paths = PATHS.lock().unwrap_or_else(|e| e.into_inner());
+            let (path, short) = match paths.iter().find(|p| p.0 == name) {
+                Some(p) => *p,
+                None => {
+                    let file = std::path::Path::new(name)
+                        .file_name()
+                        .map_or(name.into(), |f| f.to_string_lossy());
+                    let short: String = file
+                        .chars()
+                        .map(|c| match c {
+                            'a'..='z' | 'A'..='Z' | '0'..='9' | '.' | '-' => c,
+                            _ => '-',
+                        })
+                        .collect();
+                    let p: (&'static str, &'static str) = (
+                        Box::leak(name.to_string().into_boxed_str()),
+                        Box::leak(short.into_boxed_str()),
+                    );
+                    paths.push(p);
+                    p
+                }
+            };
+            return Ok(SceneKind::User { path, name: short });
+        }
         Self::ALL
             .into_iter()
             .find(|k| k.name() == name)
-            .ok_or_else(|| Error::unknown("scene", name, &Self::names()))
+            .ok_or_else(|| {
+                let mut valid = Self::names();
+                valid.push("or a glTF file (PATH.gltf, PATH.glb)");
+                Error::unknown("scene", name, &valid)
+            })
+    }
+
+    /// `--scene`'s values, in the user's order without repeats (every built-in scene when empty).
+    pub fn resolve(given: &[String]) -> Result<Vec<SceneKind>> {
+        if given.is_empty() {
+            return Ok(Self::ALL.to_vec());
+        }
+        let mut out: Vec<SceneKind> = Vec::new();
+        for name in given {
+            let k = Self::from_name(name.trim())?;
+            if !out.contains(&k) {
+                out.push(k);
+            }
+        }
+        Ok(out)
+    }
+
+    /// A user's glTF scene.
+    pub fn is_user(self) -> bool {
+        matches!(self, SceneKind::User { .. })
+    }
+
+    /// A user scene's file path (None for the built-in scenes).
+    pub fn user_path(self) -> Option<&'static str> {
+        match self {
+            SceneKind::User { path, .. } => Some(path),
+            _ => None,
+        }
     }
 
     /// The Stanford-bunny scenes of Sheliemietiev et al. 2023 (the others are Scherzer & Wimmer 2008's
@@ -143,7 +224,10 @@ impl SceneKind {
     pub fn single_count(self) -> bool {
         matches!(
             self,
-            SceneKind::BunnySweep | SceneKind::BunnyHalves | SceneKind::Terrain
+            SceneKind::BunnySweep
+                | SceneKind::BunnyHalves
+                | SceneKind::Terrain
+                | SceneKind::User { .. }
         )
     }
 
@@ -223,7 +307,7 @@ impl SceneKind {
         use Profile::*;
         use SceneKind::*;
         match (self, profile) {
-            (BunnySweep | BunnyHalves | Terrain, _) => vec![1],
+            (BunnySweep | BunnyHalves | Terrain | User { .. }, _) => vec![1],
             (BunnyGrid, Quick) => vec![50],
             (BunnyGrid, Ci) => vec![50, 250],
             (BunnyGrid, Regress) => vec![50],
@@ -255,6 +339,22 @@ mod tests {
         }
         let msg = SceneKind::from_name("bunny-swep").unwrap_err().to_string();
         assert!(msg.contains("bunny-swep") && msg.contains("trees"), "{msg}");
+    }
+
+    #[test]
+    fn a_gltf_path_is_a_user_scene_named_by_its_file() {
+        let k = SceneKind::from_name("some dir/My_Scene.GLB").unwrap();
+        assert_eq!(k.name(), "My-Scene.GLB");
+        assert_eq!(k.user_path(), Some("some dir/My_Scene.GLB"));
+        assert!(k.is_user() && k.single_count() && !k.is_bunny() && !k.is_unified());
+        assert_eq!(SceneKind::from_name("some dir/My_Scene.GLB").unwrap(), k);
+        assert_eq!(serde_json::to_string(&k).unwrap(), "\"My-Scene.GLB\"");
+        assert_eq!(
+            serde_json::to_string(&SceneKind::BunnySweep).unwrap(),
+            "\"bunny-sweep\""
+        );
+        let r = SceneKind::resolve(&["simple".into(), "a.gltf".into(), "simple".into()]).unwrap();
+        assert_eq!(r.len(), 2);
     }
 
     #[test]

@@ -5,18 +5,22 @@
 //! - `def.rs`: [`SceneDef`], a scene built once from its name and the flags, and the [`Scene`] of each
 //!   instance count, from one builder per scene family: `procedural.rs` (simple, windmills, trees),
 //!   `bunny.rs` (bunny-sweep, bunny-grid) and `unified.rs` (bunny-halves, terrain).
+//!   A glTF file's path is a user scene (`user.rs`).
 //! - `model.rs`: the data model (models, instances, motion, the camera, the unified scenes' seams and DAG).
 //! - `describe.rs`: what `lodbench describe` prints; `schedule.rs`: the LOD schedule every method shares.
 
 pub mod bunny;
+pub mod camera_path;
 pub mod config;
 pub mod def;
 pub mod describe;
+pub mod export;
 pub mod kind;
 pub mod model;
 pub mod procedural;
 pub mod schedule;
 pub mod unified;
+pub mod user;
 
 pub use bunny::{BunnyPath, BUNNY_OBJ, BUNNY_YAW};
 pub use config::{SceneConfig, PAPER_HEIGHT};

@@ -70,6 +70,8 @@ pub struct Instance {
     pub position: Vec3,
     /// Rotation about +y, radians.
     pub yaw: f32,
+    /// A rotation applied before the yaw (a user scene's node rotation; identity elsewhere).
+    pub rotation: glam::Quat,
 }
 
 /// How instances move over the frames.
@@ -110,9 +112,12 @@ impl Camera {
     }
 }
 
-/// A camera that follows a track of its own whatever `--camera` says (the procedural and unified scenes).
-#[derive(Debug, Clone, Copy)]
+/// A camera that follows a track of its own whatever `--camera` says (the procedural, unified and user scenes,
+/// and every scene with `--camera-path`).
+#[derive(Debug, Clone)]
 pub enum CameraTrack {
+    /// `--camera-path`: the user's keys resampled to the frames.
+    Path(Arc<crate::scene::camera_path::CameraPath>),
     /// A flight from `.0` to `.1` at constant speed over the frames, looking along the scene's `forward`.
     Flight(Vec3, Vec3),
     /// Once around `center` at `distance` over the frames, `elevation` radians above it, looking at it.
@@ -216,6 +221,7 @@ impl Scene {
         let m = &self.models[inst.model as usize];
         Mat4::from_translation(self.instance_position(i, frame))
             * Mat4::from_rotation_y(inst.yaw)
+            * Mat4::from_quat(inst.rotation)
             * Mat4::from_scale(Vec3::splat(m.scale))
             * Mat4::from_translation(-m.center)
     }
@@ -227,7 +233,7 @@ impl Scene {
     }
 
     pub fn camera(&self, frame: u32) -> Camera {
-        let (eye, view) = match self.track {
+        let (eye, view) = match &self.track {
             Some(track) => self.track_view(track, frame),
             None => self.mode_view(frame),
         };
@@ -245,8 +251,9 @@ impl Scene {
     }
 
     /// The eye and view matrix on `frame` of a camera on `track`.
-    fn track_view(&self, track: CameraTrack, frame: u32) -> (Vec3, Mat4) {
-        match track {
+    fn track_view(&self, track: &CameraTrack, frame: u32) -> (Vec3, Mat4) {
+        match *track {
+            CameraTrack::Path(ref p) => p.view(frame, self.frames),
             CameraTrack::Turntable {
                 center,
                 distance,

@@ -98,6 +98,7 @@ pub fn layout(m: &Model, count: u32) -> Layout {
                     gz * spacing - half + jz,
                 ),
                 yaw: rng.next_f32() * std::f32::consts::TAU,
+                rotation: glam::Quat::IDENTITY,
             }
         })
         .collect();

@@ -133,9 +133,10 @@ fn load_mesh(kind: SceneKind, cfg: &SceneConfig) -> Result<(Mesh, String)> {
 
 /// A unified scene's block instances for any count: one per block, the camera on its track.
 pub fn layout(u: &UnifiedParts) -> Layout {
-    let eye = match u.camera {
-        CameraTrack::Flight(from, _) => from,
-        CameraTrack::Turntable {
+    let eye = match &u.camera {
+        CameraTrack::Path(p) => p.view(0, 1).0,
+        &CameraTrack::Flight(from, _) => from,
+        &CameraTrack::Turntable {
             center,
             distance,
             elevation,
@@ -148,7 +149,7 @@ pub fn layout(u: &UnifiedParts) -> Layout {
         far: u.far,
         eye,
         forward: u.forward,
-        track: Some(u.camera),
+        track: Some(u.camera.clone()),
         unified: Some(u.data.clone()),
     }
 }
@@ -500,6 +501,7 @@ fn finish(
             model: i as u32,
             position: m.center,
             yaw: 0.0,
+            rotation: glam::Quat::IDENTITY,
         })
         .collect();
     let data = Unified {

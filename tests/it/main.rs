@@ -34,6 +34,7 @@ mod methods_variants;
 // src/scene: the scenes' paths and the unified scenes.
 mod scene_fidelity;
 mod scene_unified;
+mod scene_user;
 // src/effects: TAA and shadows.
 mod effects_shadows;
 mod effects_taa;

@@ -51,6 +51,7 @@ base=bunny-obj2gltf.glb
 "$bin/gltf-transform" meshopt "$base" bunny-gt-meshopt.glb
 "$bin/gltf-transform" draco "$base" bunny-gt-draco.glb
 node six.mjs nodes "$base" bunny-six-nodes.glb
+node camera.mjs bunny-six-nodes.glb bunny-six-camera.glb
 "$bin/gltf-transform" instance bunny-six-nodes.glb "$tmp/instanced.glb"
 node six.mjs required "$tmp/instanced.glb" bunny-six-instanced-required.glb
 node six.mjs optional "$tmp/instanced.glb" bunny-six-instanced-optional.glb

@@ -1,0 +1,281 @@
+//! `lodbench export`: a built-in scene as a glTF 2.0 binary (GLB), so that it opens in Blender or an engine and
+//! so that the user-scene import (`user.rs`) is tested end to end.
+//!
+//! What the file holds, for the instance count exported:
+//! - per model and LOD, a mesh (float positions and normals, 32-bit indices) with a material whose base colour is
+//!   the LOD's colour; the per-vertex shading extras that the procedural models need (windmill blades, leaf
+//!   cards) as the application-specific attribute `_LODBENCH_AUX` (glTF 2.0 section 3.7.2.1 allows attributes
+//!   starting with `_`);
+//! - per instance, a node placing the model's LOD0 at the instance's frame-0 transform, with MSFT_lod naming the
+//!   coarser LODs' nodes (outside the scene, as the extension's example has them), `extras.MSFT_screencoverage`
+//!   (lodbench's switch distances as screen sizes, `user::coverage_distance`'s inverse, then 0) and lodbench's
+//!   exact switch distances in `extras.lodbench_switch_distances` (which the import prefers), and the blades'
+//!   turn per frame in `extras.lodbench_spin_per_frame`;
+//! - the camera as a node with a perspective camera (the scene's vertical fov) and a LINEAR animation of its
+//!   translation and rotation, one key per frame at 1/60 s apart. Where the instances move (bunny-sweep), the
+//!   motion is given to the camera instead (the instances stay at their frame-0 place and the camera moves by the
+//!   opposite): the same relative geometry, and the light is directional, so the same pictures.
+//!
+//! Not exported: the unified scenes (their blocks and seams have no glTF form), the ground of `--shadows on`.
+
+use crate::error::{Error, Result};
+use crate::geometry::mesh::{Mesh, AUX_SOLID};
+use crate::scene::model::Scene;
+use glam::Vec3;
+use serde_json::{json, Value};
+
+/// Seconds between the camera animation's keys.
+pub const FRAME_SECONDS: f64 = 1.0 / 60.0;
+
+/// The GLB of `scene` (one instance count of a built-in scene).
+pub fn glb(scene: &Scene) -> Result<Vec<u8>> {
+    if scene.unified.is_some() {
+        return Err(Error::Config(format!(
+            "export: {} is a unified scene; its blocks and seams have no glTF form, so it is not exported",
+            scene.name()
+        )));
+    }
+    let mut w = Writer::default();
+    // Meshes and materials, per model and LOD.
+    let mut lod_meshes: Vec<Vec<usize>> = Vec::new();
+    for m in scene.models.iter() {
+        let mut ids = Vec::new();
+        for (l, lod) in m.chain.lods.iter().enumerate() {
+            let material = w.material(m.color_of(l as u32));
+            ids.push(w.mesh(&format!("{}_LOD{l}", m.name), &lod.mesh, material));
+        }
+        lod_meshes.push(ids);
+    }
+    // Instances: LOD0 in the scene, the coarser LODs outside it.
+    let mut roots = Vec::new();
+    for (i, inst) in scene.instances.iter().enumerate() {
+        if scene.ground == Some(i) {
+            continue;
+        }
+        let m = &scene.models[inst.model as usize];
+        let (s, r, t) = scene.instance_matrix(i, 0).to_scale_rotation_translation();
+        let place = |mesh: usize, name: String| {
+            json!({
+                "name": name,
+                "mesh": mesh,
+                "translation": t.to_array(),
+                "rotation": r.to_array(),
+                "scale": s.to_array(),
+            })
+        };
+        let ids = &lod_meshes[inst.model as usize];
+        let coarser: Vec<usize> = ids[1..]
+            .iter()
+            .enumerate()
+            .map(|(l, &mesh)| w.node(place(mesh, format!("{}_{i}_LOD{}", m.name, l + 1))))
+            .collect();
+        let mut node = place(ids[0], format!("{}_{i}_LOD0", m.name));
+        if !coarser.is_empty() {
+            let tan = (scene.fov_y * 0.5).tan();
+            let mut coverage: Vec<f64> = m
+                .switches
+                .iter()
+                .map(|&d| f64::from(m.radius / (d * tan)))
+                .collect();
+            coverage.push(0.0);
+            node["extensions"] = json!({"MSFT_lod": {"ids": coarser}});
+            node["extras"] = json!({
+                "MSFT_screencoverage": coverage,
+                "lodbench_switch_distances": m.switches,
+            });
+        }
+        if m.spin_per_frame != 0.0 {
+            let extras = node
+                .as_object_mut()
+                .map(|o| o.entry("extras").or_insert_with(|| json!({})));
+            if let Some(e) = extras {
+                e["lodbench_spin_per_frame"] = json!(m.spin_per_frame);
+            }
+        }
+        roots.push(w.node(node));
+    }
+    if scene.models.iter().any(|m| m.chain.lods.len() > 1) {
+        w.used.push("MSFT_lod");
+    }
+    // The camera, one key per frame; the instances' motion given to it.
+    let frames = scene.frames.max(2);
+    let mut times = Vec::new();
+    let mut eyes = Vec::new();
+    let mut rotations = Vec::new();
+    // Every moving instance moves alike (bunny-sweep's one bunny, `Motion::SweepX`); the ground comes last.
+    let moving = !scene.instances.is_empty() && scene.ground != Some(0);
+    for f in 0..frames {
+        let c = scene.camera(f.min(scene.frames - 1));
+        let shift = match moving {
+            true => scene.instance_position(0, f) - scene.instance_position(0, 0),
+            false => Vec3::ZERO,
+        };
+        let (_, rot, eye) = c.view.inverse().to_scale_rotation_translation();
+        times.push(f as f32 * FRAME_SECONDS as f32);
+        eyes.extend((eye - shift).to_array());
+        rotations.extend(rot.normalize().to_array());
+    }
+    let camera = w.camera(
+        scene.fov_y,
+        scene.near,
+        scene.far,
+        scene.width,
+        scene.height,
+    );
+    let cam_node = w.node(json!({"name": "lodbench_camera", "camera": camera}));
+    roots.push(cam_node);
+    let input = w.floats(&times, "SCALAR", None);
+    let t_out = w.floats(&eyes, "VEC3", None);
+    let r_out = w.floats(&rotations, "VEC4", None);
+    w.animations.push(json!({
+        "name": "lodbench camera path",
+        "samplers": [
+            {"input": input, "output": t_out, "interpolation": "LINEAR"},
+            {"input": input, "output": r_out, "interpolation": "LINEAR"},
+        ],
+        "channels": [
+            {"sampler": 0, "target": {"node": cam_node, "path": "translation"}},
+            {"sampler": 1, "target": {"node": cam_node, "path": "rotation"}},
+        ],
+    }));
+    Ok(w.finish(scene, roots))
+}
+
+/// A GLB being written: the JSON's arrays and the binary chunk.
+#[derive(Default)]
+struct Writer {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+    meshes: Vec<Value>,
+    materials: Vec<Value>,
+    nodes: Vec<Value>,
+    cameras: Vec<Value>,
+    animations: Vec<Value>,
+    used: Vec<&'static str>,
+}
+
+impl Writer {
+    /// A buffer view of `bytes` (4-byte aligned) and its index.
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
+        if let Some(t) = target {
+            v["target"] = json!(t);
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(v);
+        self.views.len() - 1
+    }
+
+    /// A float accessor of `values` (`kind` VEC3, VEC4, SCALAR) with min/max, and its index.
+    fn floats(&mut self, values: &[f32], kind: &str, target: Option<u32>) -> usize {
+        let n = match kind {
+            "SCALAR" => 1,
+            "VEC3" => 3,
+            _ => 4,
+        };
+        let view = self.view(bytemuck::cast_slice(values), target);
+        let mut min = vec![f32::INFINITY; n];
+        let mut max = vec![f32::NEG_INFINITY; n];
+        for v in values.chunks_exact(n) {
+            for c in 0..n {
+                min[c] = min[c].min(v[c]);
+                max[c] = max[c].max(v[c]);
+            }
+        }
+        self.accessors.push(json!({
+            "bufferView": view, "componentType": 5126, "count": values.len() / n, "type": kind,
+            "min": min, "max": max,
+        }));
+        self.accessors.len() - 1
+    }
+
+    fn material(&mut self, color: [f32; 3]) -> usize {
+        let m = json!({"pbrMetallicRoughness": {
+            "baseColorFactor": [color[0], color[1], color[2], 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0
+        }});
+        match self.materials.iter().position(|x| *x == m) {
+            Some(i) => i,
+            None => {
+                self.materials.push(m);
+                self.materials.len() - 1
+            }
+        }
+    }
+
+    fn mesh(&mut self, name: &str, mesh: &Mesh, material: usize) -> usize {
+        let positions: Vec<f32> = mesh.positions.iter().flatten().copied().collect();
+        let normals: Vec<f32> = mesh.normals.iter().flatten().copied().collect();
+        let position = self.floats(&positions, "VEC3", Some(34962));
+        let normal = self.floats(&normals, "VEC3", Some(34962));
+        let view = self.view(bytemuck::cast_slice(&mesh.indices), Some(34963));
+        self.accessors.push(json!({
+            "bufferView": view, "componentType": 5125, "count": mesh.indices.len(), "type": "SCALAR",
+        }));
+        let indices = self.accessors.len() - 1;
+        let mut attributes = json!({"POSITION": position, "NORMAL": normal});
+        if mesh.aux.iter().any(|a| a[2] != AUX_SOLID) {
+            let aux: Vec<f32> = mesh.aux.iter().flatten().copied().collect();
+            attributes["_LODBENCH_AUX"] = json!(self.floats(&aux, "VEC4", Some(34962)));
+        }
+        self.meshes.push(json!({
+            "name": name,
+            "primitives": [{"attributes": attributes, "indices": indices, "material": material, "mode": 4}],
+        }));
+        self.meshes.len() - 1
+    }
+
+    fn node(&mut self, node: Value) -> usize {
+        self.nodes.push(node);
+        self.nodes.len() - 1
+    }
+
+    fn camera(&mut self, fov_y: f32, near: f32, far: f32, width: u32, height: u32) -> usize {
+        self.cameras.push(json!({"type": "perspective", "perspective": {
+            "yfov": fov_y, "znear": near, "zfar": far, "aspectRatio": width as f32 / height as f32
+        }}));
+        self.cameras.len() - 1
+    }
+
+    fn finish(mut self, scene: &Scene, roots: Vec<usize>) -> Vec<u8> {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let mut doc = json!({
+            "asset": {"version": "2.0", "generator": format!("lodbench {} export", env!("CARGO_PKG_VERSION"))},
+            "scene": 0,
+            "scenes": [{"name": scene.name(), "nodes": roots}],
+            "nodes": self.nodes,
+            "meshes": self.meshes,
+            "materials": self.materials,
+            "cameras": self.cameras,
+            "animations": self.animations,
+            "accessors": self.accessors,
+            "bufferViews": self.views,
+            "buffers": [{"byteLength": self.bin.len()}],
+            "extras": {"lodbench_scene": scene.name(), "lodbench_frames": scene.frames},
+        });
+        if !self.used.is_empty() {
+            doc["extensionsUsed"] = json!(self.used);
+        }
+        let mut text = doc.to_string().into_bytes();
+        while !text.len().is_multiple_of(4) {
+            text.push(b' ');
+        }
+        let total = 12 + 8 + text.len() + 8 + self.bin.len();
+        let mut out = Vec::with_capacity(total);
+        out.extend(b"glTF");
+        out.extend(2u32.to_le_bytes());
+        out.extend((total as u32).to_le_bytes());
+        out.extend((text.len() as u32).to_le_bytes());
+        out.extend(b"JSON");
+        out.extend(text);
+        out.extend((self.bin.len() as u32).to_le_bytes());
+        out.extend(b"BIN\0");
+        out.extend(self.bin);
+        out
+    }
+}
