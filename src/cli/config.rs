@@ -63,6 +63,18 @@ impl SceneConfig {
                 )));
             }
         }
+        if let Some(s) = &a.switch_screen_sizes {
+            if s.is_empty() || s.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+                return Err(Error::Config(format!(
+                    "--switch-screen-sizes {s:?} must be positive numbers"
+                )));
+            }
+            if s.windows(2).any(|w| w[1] >= w[0]) {
+                return Err(Error::Config(format!(
+                    "--switch-screen-sizes {s:?} must decrease (a coarser LOD at a smaller screen size)"
+                )));
+            }
+        }
         let schedule = ScheduleParams {
             fade: a.fade,
             band: a.band,
@@ -89,6 +101,7 @@ impl SceneConfig {
             pixel_error: a.pixel_error,
             sweep_start: a.sweep_start,
             switch_distances: a.switch_distances.clone(),
+            switch_screen_sizes: a.switch_screen_sizes.clone(),
             partition: a.partition,
             blocks: a.blocks,
             counts: if a.count.is_empty() {

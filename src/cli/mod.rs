@@ -210,6 +210,12 @@ pub struct SceneArgs {
     /// Explicit switch distances for LOD1, LOD2, ... (world units), overriding --pixel-error.
     #[arg(long, value_delimiter = ',')]
     pub switch_distances: Option<Vec<f32>>,
+    /// Switches in engine terms: LOD1, LOD2, ... come in where the model's bounding sphere's projected diameter
+    /// over the viewport's height falls below each value (Unreal's screen size, Unity's screen-relative
+    /// transition height, MSFT_screencoverage), decreasing; converted per model to d = radius / (size *
+    /// tan(fov_y / 2)). Overrides --pixel-error; not with --switch-distances.
+    #[arg(long, value_delimiter = ',', conflicts_with = "switch_distances")]
+    pub switch_screen_sizes: Option<Vec<f32>>,
     /// How bunny-halves and terrain divide their mesh into blocks: `clip` (triangles clipped at the block
     /// faces) or `bin` (each triangle whole into the block of its barycentre).
     #[arg(long, value_enum, default_value_t = PartitionMode::Clip)]

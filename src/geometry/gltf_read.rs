@@ -1396,6 +1396,34 @@ mod tests {
         assert_eq!(component(&1.5f32.to_le_bytes(), 5126, true), 1.5);
     }
 
+    /// An MSFT_lod id out of range, and one that loops back into the chain, are refused by node.
+    #[test]
+    fn bad_lod_ids_are_refused() {
+        let doc = |ids: serde_json::Value| {
+            serde_json::json!({
+                "asset": {"version": "2.0"},
+                "scenes": [{"nodes": [0]}],
+                "nodes": [{"extensions": {"MSFT_lod": {"ids": ids}}}, {}],
+            })
+            .to_string()
+        };
+        let err = |ids| {
+            read(doc(ids).as_bytes(), Path::new(""))
+                .err()
+                .unwrap_or_default()
+        };
+        let e = err(serde_json::json!([7]));
+        assert!(
+            e.contains("MSFT_lod id of node 0") && e.contains("not an index below 2"),
+            "{e}"
+        );
+        let e = err(serde_json::json!([1, 0]));
+        assert!(e.contains("cycle"), "{e}");
+        let e = err(serde_json::json!([1, 1]));
+        assert!(e.contains("cycle"), "{e}");
+        assert!(read(doc(serde_json::json!([1])).as_bytes(), Path::new("")).is_ok());
+    }
+
     #[test]
     fn lod_names() {
         assert_eq!(lod_name("Rock_LOD0"), Some(("Rock", 0)));

@@ -238,13 +238,14 @@ fn bunny_model(
         }
     };
     let scale = 1.0;
-    let (switches, switch_source) = match cfg.switch_override("the bunny", chain.lods.len())? {
-        Some(s) => (s, "override"),
-        None => (
-            lod::switch_distances(&chain, scale, cfg.pixel_error(kind, height), height, fov_y),
-            "pixel-error",
-        ),
-    };
+    let (switches, switch_source) =
+        match cfg.switch_override("the bunny", chain.lods.len(), radius, fov_y)? {
+            Some(s) => (s, "override"),
+            None => (
+                lod::switch_distances(&chain, scale, cfg.pixel_error(kind, height), height, fov_y),
+                "pixel-error",
+            ),
+        };
     cfg.schedule.check_switches("bunny", &switches)?;
     Ok(Model {
         name: "bunny".into(),

@@ -22,6 +22,8 @@ pub struct SceneConfig {
     /// `--sweep-start`; None = the profile's.
     pub sweep_start: Option<SweepStart>,
     pub switch_distances: Option<Vec<f32>>,
+    /// `--switch-screen-sizes`: switches as screen sizes, converted per model.
+    pub switch_screen_sizes: Option<Vec<f32>>,
     /// `--partition` (bunny-halves, terrain).
     pub partition: crate::geometry::blocks::PartitionMode,
     /// `--blocks`; None = the profile's.
@@ -73,19 +75,43 @@ impl SceneConfig {
 
     /// `--switch-distances` for model `what` of `lods` LODs: None without the flag, an error unless it gives
     /// one distance for each LOD after LOD0.
-    pub fn switch_override(&self, what: &str, lods: usize) -> Result<Option<Vec<f32>>> {
-        let Some(s) = &self.switch_distances else {
-            return Ok(None);
+    /// With `--switch-screen-sizes`, the distances are `screen_size_distance(radius, size, fov_y)` for the
+    /// model's bounding-sphere `radius` (world units) and the vertical field of view `fov_y` (radians).
+    pub fn switch_override(
+        &self,
+        what: &str,
+        lods: usize,
+        radius: f32,
+        fov_y: f32,
+    ) -> Result<Option<Vec<f32>>> {
+        let (flag, values) = match (&self.switch_distances, &self.switch_screen_sizes) {
+            (Some(d), _) => ("--switch-distances", d),
+            (None, Some(s)) => ("--switch-screen-sizes", s),
+            (None, None) => return Ok(None),
         };
-        if s.len() != lods - 1 {
+        if values.len() != lods - 1 {
             return Err(Error::Config(format!(
-                "--switch-distances has {} values but {what} has {} LODs after LOD0",
-                s.len(),
+                "{flag} has {} values but {what} has {} LODs after LOD0",
+                values.len(),
                 lods - 1
             )));
         }
-        Ok(Some(s.clone()))
+        Ok(Some(match &self.switch_distances {
+            Some(d) => d.clone(),
+            None => values
+                .iter()
+                .map(|&s| screen_size_distance(radius, s, fov_y))
+                .collect(),
+        }))
     }
+}
+
+/// Distance at which a bounding sphere of `radius` has screen size `size`: its projected diameter over the
+/// viewport's height, `size = radius / (d tan(fov_y / 2))` (Unreal's screen size; Unity's screen-relative
+/// transition height for a sphere; the reading lodbench gives MSFT_screencoverage, which its specification
+/// calls a hint): `d = radius / (size tan(fov_y / 2))`.
+pub fn screen_size_distance(radius: f32, size: f32, fov_y: f32) -> f32 {
+    radius / (size * (fov_y * 0.5).tan())
 }
 
 /// Viewport height of Sheliemietiev et al. 2023's experiments (800x600): the bunny scenes' default

@@ -25,7 +25,10 @@ pub fn def(kind: SceneKind, cfg: &SceneConfig, height: u32, fov_y: f32) -> Resul
     let chain = chain.chain;
     let (center, radius) = chain.lods[0].mesh.bounding_sphere();
     let scale = 1.0;
-    let (switches, switch_source) = match (cfg.switch_override(name, chain.lods.len())?, kind) {
+    let (switches, switch_source) = match (
+        cfg.switch_override(name, chain.lods.len(), radius * scale, fov_y)?,
+        kind,
+    ) {
         (Some(s), _) => (s, "override"),
         (None, SceneKind::Simple) => (vec![12.0 * radius], "scene"),
         (None, _) => (

@@ -83,7 +83,7 @@ pub struct ChainDescription {
 /// screen-relative transition height for a sphere, and the reading lodbench gives MSFT_screencoverage, which
 /// its specification calls a hint): `d = radius / (coverage tan(fov_y / 2))`.
 pub fn coverage_distance(radius: f32, coverage: f32, fov_y: f32) -> f32 {
-    radius / (coverage * (fov_y * 0.5).tan())
+    crate::scene::config::screen_size_distance(radius, coverage, fov_y)
 }
 
 /// One model being built, with its key: the glTF meshes of its levels and the scale baked into them.
@@ -554,13 +554,17 @@ fn finish_model(
     source: &'static str,
     color: [f32; 3],
 ) -> Result<Model> {
-    let (switches, switch_source) = match view.cfg.switch_override(&name, chain.lods.len())? {
-        Some(s) => (s, "override"),
-        None => (
-            lod::switch_distances(&chain, 1.0, view.pixel_error, view.pv.height, view.fov_y),
-            source,
-        ),
-    };
+    let (switches, switch_source) =
+        match view
+            .cfg
+            .switch_override(&name, chain.lods.len(), radius, view.fov_y)?
+        {
+            Some(s) => (s, "override"),
+            None => (
+                lod::switch_distances(&chain, 1.0, view.pixel_error, view.pv.height, view.fov_y),
+                source,
+            ),
+        };
     view.cfg.schedule.check_switches(&name, &switches)?;
     Ok(Model {
         color,

@@ -317,3 +317,43 @@ fn export_then_run_gives_the_built_in_schedule() {
         }
     }
 }
+
+/// Switches in engine terms (`--switch-screen-sizes`: the bounding sphere's projected diameter over the
+/// viewport's height, Unreal's screen size) become distances d = radius / (size tan(fov_y / 2)) per model.
+#[test]
+fn switches_in_engine_terms_are_screen_sizes() {
+    let cfg = scene_config("bunny-sweep", &["--switch-screen-sizes", "0.5,0.25,0.1"]);
+    let d = SceneDef::new(SceneKind::BunnySweep, &cfg).unwrap();
+    let m = &d.models[0];
+    let t = (d.fov_y * 0.5).tan();
+    for (s, size) in m.switches.iter().zip([0.5f32, 0.25, 0.1]) {
+        let want = m.radius / (size * t);
+        assert!((s / want - 1.0).abs() < 1e-6, "{s} vs {want}");
+    }
+    assert_eq!(m.switch_source, "override");
+    let out = lodbench(
+        &[
+            "describe",
+            "--scene",
+            "simple",
+            "--switch-screen-sizes",
+            "0.1,0.5",
+        ],
+        &[],
+    );
+    fails_with(&out, &["--switch-screen-sizes", "must decrease"]);
+    let out = lodbench(
+        &[
+            "describe",
+            "--scene",
+            "simple",
+            "--switch-distances",
+            "5",
+            "--switch-screen-sizes",
+            "0.5",
+        ],
+        &[],
+    );
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot be used with"));
+}
