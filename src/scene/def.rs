@@ -120,6 +120,10 @@ impl SceneDef {
     /// What a user should know before trusting the scene: switches the bunny path never reaches. One line each
     /// scene (empty when there is nothing to say).
     pub fn notes(&self) -> Vec<String> {
+        let user_camera = self.user().is_some_and(|u| u.camera.is_some());
+        if self.camera_path.is_some() || user_camera {
+            return self.unreached_on_the_path();
+        }
         match (&self.family, self.models.first()) {
             (Family::Bunny(b), Some(m)) => b.path.notes(self.kind, m),
             (Family::User(u), _) => {
@@ -149,6 +153,43 @@ impl SceneDef {
             }
             _ => Vec::new(),
         }
+    }
+
+    /// A camera path's switches never crossed: per model, the switches that no instance of it crosses on the
+    /// path (its camera distances stay on one side of the switch on every frame), at the first instance count.
+    fn unreached_on_the_path(&self) -> Vec<String> {
+        let scene = self.instantiate(self.counts[0]);
+        let mut range = vec![(f32::INFINITY, f32::NEG_INFINITY); self.models.len()];
+        for (i, inst) in scene.instances.iter().enumerate() {
+            if scene.ground == Some(i) {
+                continue;
+            }
+            let r = &mut range[inst.model as usize];
+            for f in 0..scene.frames {
+                let d = scene.instance_distance(i, f);
+                *r = (r.0.min(d), r.1.max(d));
+            }
+        }
+        let mut notes = Vec::new();
+        for (m, &(lo, hi)) in self.models.iter().zip(&range) {
+            let missed: Vec<String> = m
+                .switches
+                .iter()
+                .enumerate()
+                .filter(|(_, &s)| lo.is_finite() && !(lo <= s && s <= hi))
+                .map(|(j, s)| format!("LOD{} at {s:.4}", j + 1))
+                .collect();
+            if !missed.is_empty() {
+                notes.push(format!(
+                    "{}: on this camera path no instance of model {} crosses the switch to {} (its distances \
+                     stay between {lo:.4} and {hi:.4}): not reached",
+                    self.kind.name(),
+                    m.name,
+                    missed.join(", ")
+                ));
+            }
+        }
+        notes
     }
 
     /// The scene of `count` instances (the bunny scenes' ground with `--shadows on` comes last).
