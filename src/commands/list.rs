@@ -8,7 +8,10 @@ use crate::scene::SceneKind;
 /// Prints the scenes, the methods with what each does, and the adapters found (best first), each after its
 /// index (what `--adapter INDEX` names).
 pub fn execute() -> Result<()> {
-    outln!("scenes:  {}", SceneKind::names().join(", "));
+    outln!(
+        "scenes:  {}, or a glTF file of your own (--scene PATH.gltf or PATH.glb)",
+        SceneKind::names().join(", ")
+    );
     outln!("methods:");
     for m in methods::BUILTIN {
         outln!("  {:<16} {}", m.name, m.about);
