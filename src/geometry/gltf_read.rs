@@ -16,6 +16,9 @@ use serde_json::Value;
 use std::borrow::Cow;
 use std::path::Path;
 
+/// The largest buffer view a meshopt-compressed view may decode to (1 GiB).
+const MAX_VIEW_BYTES: usize = 1 << 30;
+
 /// Extensions that change geometry or placement and that this reader decodes.
 const READ: [&str; 5] = [
     "KHR_mesh_quantization",
@@ -196,9 +199,11 @@ impl Content<'_> {
         self.doc.json["meshes"][mesh]["name"].as_str().unwrap_or("")
     }
 
-    /// The first camera node of the scene whose translation or rotation is animated, its keys resampled at the
-    /// union of its channels' key times (LINEAR and STEP as glTF defines them; CUBICSPLINE's values are taken at
-    /// its keys and joined linearly). The node's parents are taken at rest. None when no camera is animated.
+    /// The first camera node of the scene whose translation or rotation is animated (its channels from the first
+    /// animation that moves it), its keys resampled at the union of its channels' key times: LINEAR as glTF
+    /// defines it; a STEP channel takes its held value at each key time and a CUBICSPLINE its values at its keys,
+    /// and the path then joins the keys linearly (a stepped camera glides between its keys). The node's parents
+    /// are taken at rest. None when no camera is animated.
     pub fn animated_camera(&mut self) -> Result<Option<AnimatedCamera>, String> {
         let json = self.doc.json.clone();
         let Some(&(node, parent, _)) = self
@@ -214,7 +219,14 @@ impl Content<'_> {
         let r0 = floats::<4>(&rest["rotation"], "rotation")?.unwrap_or([0.0, 0.0, 0.0, 1.0]);
         let mut translation: Option<Track> = None;
         let mut rotation: Option<Track> = None;
-        for anim in array(&json, "animations") {
+        // The first animation that moves the camera (a file with several clips, as Blender writes one per
+        // action, would otherwise mix their channels).
+        let first = array(&json, "animations").iter().find(|a| {
+            array(a, "channels")
+                .iter()
+                .any(|c| c["target"]["node"].as_u64() == Some(node as u64))
+        });
+        if let Some(anim) = first {
             for ch in array(anim, "channels") {
                 if ch["target"]["node"].as_u64() != Some(node as u64) {
                     continue;
@@ -245,8 +257,11 @@ impl Content<'_> {
                         times.len()
                     ));
                 }
-                if times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| w[1] <= w[0]) {
-                    return Err(format!("{what}: key times must increase"));
+                if times.is_empty()
+                    || times.iter().any(|t| !t.is_finite())
+                    || times.windows(2).any(|w| w[1] <= w[0])
+                {
+                    return Err(format!("{what}: key times must be given and increase"));
                 }
                 let values: Vec<f32> = values
                     .chunks_exact(width * per_key)
@@ -610,10 +625,18 @@ fn scene_nodes(json: &Value) -> Result<(Option<SceneNodes>, Option<usize>), Stri
 fn chains(json: &Value, nodes: &Option<SceneNodes>) -> Result<Vec<AuthoredChain>, String> {
     let all = array(json, "nodes");
     let mut out = Vec::new();
+    // Without scenes every mesh is placed untransformed and no node is read; otherwise only the scene's nodes
+    // can hold a chain.
+    let Some(nodes) = nodes else {
+        return Ok(out);
+    };
     for (n, node) in all.iter().enumerate() {
         let Some(ids) = node.pointer("/extensions/MSFT_lod/ids") else {
             continue;
         };
+        if !nodes.iter().any(|(m, _, _)| *m == n) {
+            continue;
+        }
         let mut chain = vec![n];
         for id in ids.as_array().map_or(&[][..], Vec::as_slice) {
             let id = index(id, || format!("an MSFT_lod id of node {n}"), all.len())?;
@@ -625,19 +648,19 @@ fn chains(json: &Value, nodes: &Option<SceneNodes>) -> Result<Vec<AuthoredChain>
             }
             chain.push(id);
         }
-        let screen_coverage = node
-            .pointer("/extras/MSFT_screencoverage")
-            .and_then(Value::as_array)
-            .map(|a| a.iter().filter_map(Value::as_f64).collect());
-        let switch_distances = node
-            .pointer("/extras/lodbench_switch_distances")
-            .and_then(Value::as_array)
-            .map(|a| {
-                a.iter()
-                    .filter_map(Value::as_f64)
-                    .map(|d| d as f32)
-                    .collect()
-            });
+        let numbers = |key: &str| -> Result<Option<Vec<f64>>, String> {
+            let Some(v) = node.pointer(&format!("/extras/{key}")) else {
+                return Ok(None);
+            };
+            v.as_array()
+                .and_then(|a| a.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>())
+                .filter(|a| a.iter().all(|x| x.is_finite()))
+                .map(Some)
+                .ok_or_else(|| format!("node {n}'s extras.{key} is not an array of numbers"))
+        };
+        let screen_coverage = numbers("MSFT_screencoverage")?;
+        let switch_distances =
+            numbers("lodbench_switch_distances")?.map(|a| a.iter().map(|&d| d as f32).collect());
         out.push(AuthoredChain {
             source: ChainSource::MsftLod,
             name: node["name"].as_str().unwrap_or("").to_string(),
@@ -650,10 +673,8 @@ fn chains(json: &Value, nodes: &Option<SceneNodes>) -> Result<Vec<AuthoredChain>
                 .unwrap_or(0.0) as f32,
         });
     }
+    refuse_level_children(all, &out)?;
     // `NAME_LODn` siblings: group the scene's nodes by parent and stem.
-    let Some(nodes) = nodes else {
-        return Ok(out);
-    };
     let mut parent = vec![usize::MAX; all.len()];
     for (p, node) in all.iter().enumerate() {
         for c in array(node, "children") {
@@ -700,7 +721,27 @@ fn chains(json: &Value, nodes: &Option<SceneNodes>) -> Result<Vec<AuthoredChain>
             spin_per_frame: 0.0,
         });
     }
+    refuse_level_children(all, &out)?;
     Ok(out)
+}
+
+/// A chain's level is its node's own mesh: a level node with children is refused (their meshes would be drawn
+/// at every distance, or lost with the level).
+fn refuse_level_children(all: &[Value], chains: &[AuthoredChain]) -> Result<(), String> {
+    for c in chains {
+        if let Some(&n) = c
+            .nodes
+            .iter()
+            .find(|&&n| !array(&all[n], "children").is_empty())
+        {
+            return Err(format!(
+                "LOD chain '{}': level node {n} has child nodes; lodbench takes each level's own mesh, so put \
+                 each level's geometry in its node's mesh",
+                c.name
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `NAME_LOD3` (also `_lod3`, `-LOD3`): the stem and the level.
@@ -938,7 +979,8 @@ impl Doc<'_> {
             .cloned();
         if let Some(ext) = compressed {
             if self.views[v].is_none() {
-                let decoded = self.decode_meshopt(v, &ext)?;
+                let view_length = desc["byteLength"].as_u64().unwrap_or(0) as usize;
+                let decoded = self.decode_meshopt(v, &ext, view_length)?;
                 self.views[v] = Some(decoded);
             }
             return Ok((
@@ -965,7 +1007,12 @@ impl Doc<'_> {
     }
 
     /// EXT_ or KHR_meshopt_compression: the view's decoded bytes (count x byteStride).
-    fn decode_meshopt(&mut self, v: usize, ext: &Value) -> Result<Vec<u8>, String> {
+    fn decode_meshopt(
+        &mut self,
+        v: usize,
+        ext: &Value,
+        view_length: usize,
+    ) -> Result<Vec<u8>, String> {
         let what = format!("buffer view {v} (meshopt-compressed)");
         let b = index(
             &ext["buffer"],
@@ -983,6 +1030,34 @@ impl Doc<'_> {
             .checked_add(length)
             .and_then(|end| data.get(offset..end))
             .ok_or_else(|| format!("{what} reaches past the end of buffer {b}"))?;
+        // The decoders allocate count x stride before they look at the data: the size must be the view's
+        // (as the extension requires), and the compressed stream long enough for the count it claims.
+        if count.checked_mul(stride) != Some(view_length) || view_length > MAX_VIEW_BYTES {
+            return Err(format!(
+                "{what}: count {count} x byteStride {stride} is not the view's byteLength {view_length} (or over \
+                 {MAX_VIEW_BYTES} bytes)"
+            ));
+        }
+        let index_mode = matches!(mode, "TRIANGLES" | "INDICES");
+        if index_mode && filter != "NONE" {
+            return Err(format!("{what}: mode {mode} takes no filter ({filter})"));
+        }
+        if mode == "TRIANGLES" && !count.is_multiple_of(3) {
+            return Err(format!(
+                "{what}: TRIANGLES with count {count}, not a multiple of 3"
+            ));
+        }
+        let least = match mode {
+            "TRIANGLES" => 17 + count / 3,
+            "INDICES" => 5 + count,
+            _ => 1,
+        };
+        if src.len() < least {
+            return Err(format!(
+                "{what}: {} compressed bytes cannot hold {count} elements",
+                src.len()
+            ));
+        }
         let fail = |e: meshopt::Error| format!("{what} does not decode ({e})");
         let mut out = match (mode, stride) {
             ("ATTRIBUTES", s) if s > 0 && s % 4 == 0 && s <= 256 => decode_vertices(src, count, s)?,
@@ -1055,8 +1130,32 @@ impl Doc<'_> {
                 l.components
             ));
         }
-        let (v, _) = self.read_floats(i)?;
-        Ok(v.into_iter().map(|x| x as u32).collect())
+        let size = component_size(l.component).unwrap_or(4);
+        let (bytes, stride) = self.view(l.view)?;
+        let stride = stride.unwrap_or(size).max(size);
+        let end = l
+            .count
+            .checked_sub(1)
+            .and_then(|n| n.checked_mul(stride))
+            .and_then(|n| n.checked_add(size))
+            .and_then(|n| n.checked_add(l.offset));
+        if l.count > 0 && end.is_none_or(|end| end > bytes.len()) {
+            return Err(format!(
+                "accessor {i} ({} elements) does not fit in buffer view {}",
+                l.count, l.view
+            ));
+        }
+        // Read as integers: through f32 an index above 2^24 would round.
+        Ok((0..l.count)
+            .map(|e| {
+                let b = &bytes[l.offset + e * stride..];
+                match size {
+                    1 => u32::from(b[0]),
+                    2 => u32::from(u16::from_le_bytes([b[0], b[1]])),
+                    _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+                }
+            })
+            .collect())
     }
 }
 
@@ -1422,6 +1521,86 @@ mod tests {
         let e = err(serde_json::json!([1, 1]));
         assert!(e.contains("cycle"), "{e}");
         assert!(read(doc(serde_json::json!([1])).as_bytes(), Path::new("")).is_ok());
+    }
+
+    /// A document with one mesh whose indices (and POSITION, unless `positions` is null: then 36 zero bytes
+    /// uncompressed) come from meshopt-compressed views described by `positions` and `indices`
+    /// (EXT_meshopt_compression objects over a 48-byte buffer of zeros).
+    fn meshopt_doc(positions: serde_json::Value, indices: serde_json::Value) -> String {
+        let position_view = match positions.is_null() {
+            true => serde_json::json!({"buffer": 0, "byteLength": 36}),
+            false => {
+                serde_json::json!({"buffer": 0, "byteLength": positions["count"].as_u64().unwrap_or(0) * 12,
+                "extensions": {"EXT_meshopt_compression": positions}})
+            }
+        };
+        serde_json::json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["EXT_meshopt_compression"],
+            "buffers": [{"byteLength": 48, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA"}],
+            "bufferViews": [
+                position_view,
+                {"buffer": 0, "byteLength": indices["count"].as_u64().unwrap_or(0) * 2,
+                 "extensions": {"EXT_meshopt_compression": indices}},
+            ],
+            "accessors": [
+                {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+                {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"},
+            ],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0}],
+        })
+        .to_string()
+    }
+
+    /// What the meshopt decoders would allocate or assert on is refused first: a count that does not fit the
+    /// view or the compressed bytes, TRIANGLES not in threes, a filter on indices.
+    #[test]
+    fn meshopt_streams_that_cannot_hold_their_count_are_refused() {
+        let err = |p: serde_json::Value, i: serde_json::Value| {
+            let doc = meshopt_doc(p, i);
+            let mut c = read(doc.as_bytes(), Path::new("")).unwrap_or_else(|e| panic!("{e}"));
+            c.mesh_triangles(0).err().unwrap_or_default()
+        };
+        let ok_pos = serde_json::Value::Null;
+        let tri = |count: u64, filter: &str| {
+            serde_json::json!({"buffer": 0, "byteLength": 8, "byteStride": 2, "mode": "TRIANGLES", "count": count,
+                "filter": filter})
+        };
+        let huge = serde_json::json!({"buffer": 0, "byteLength": 8, "byteStride": 4, "mode": "ATTRIBUTES",
+            "count": 1_000_000_000_000u64});
+        let e = err(huge, tri(3, "NONE"));
+        assert!(e.contains("is not the view's byteLength"), "{e}");
+        let e = err(ok_pos.clone(), tri(4, "NONE"));
+        assert!(e.contains("not a multiple of 3"), "{e}");
+        let e = err(ok_pos.clone(), tri(3, "EXPONENTIAL"));
+        assert!(e.contains("takes no filter"), "{e}");
+        let e = err(ok_pos, tri(300, "NONE"));
+        assert!(e.contains("cannot hold 300 elements"), "{e}");
+    }
+
+    /// A camera channel whose sampler has no keys is refused, not indexed.
+    #[test]
+    fn an_empty_camera_channel_is_refused() {
+        let doc = serde_json::json!({
+            "asset": {"version": "2.0"},
+            "buffers": [{"byteLength": 8, "uri": "data:application/octet-stream;base64,AAAAAAAAAAA="}],
+            "bufferViews": [{"buffer": 0, "byteLength": 8}],
+            "accessors": [
+                {"bufferView": 0, "componentType": 5126, "count": 0, "type": "SCALAR"},
+                {"bufferView": 0, "componentType": 5126, "count": 0, "type": "VEC4"},
+            ],
+            "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"camera": 0}],
+            "animations": [{"samplers": [{"input": 0, "output": 1}],
+                "channels": [{"sampler": 0, "target": {"node": 0, "path": "rotation"}}]}],
+        })
+        .to_string();
+        let mut c = read(doc.as_bytes(), Path::new("")).unwrap_or_else(|e| panic!("{e}"));
+        let e = c.animated_camera().err().unwrap_or_default();
+        assert!(e.contains("key times must be given"), "{e}");
     }
 
     #[test]

@@ -116,9 +116,11 @@ impl CameraPath {
             let record = record.map_err(|e| bad(format!("line {line}: {e}")))?;
             let num = |i: usize| -> Result<f64> {
                 let cell = record.get(i).unwrap_or("");
+                // Finite as the f32 the path is kept in (1e39 is not), and small enough that differences of
+                // times stay finite.
                 cell.parse::<f64>()
                     .ok()
-                    .filter(|v| v.is_finite())
+                    .filter(|v| v.is_finite() && (*v as f32).is_finite() && v.abs() < 1e30)
                     .ok_or_else(|| {
                         bad(format!(
                             "line {line}: {} is '{cell}', not a finite number",
@@ -254,14 +256,14 @@ impl CameraPath {
         let eye = a.eye.lerp(b.eye, s);
         let view = match (a.look, b.look) {
             (Look::Target(p), Look::Target(q)) => {
-                let target = p.lerp(q, s);
-                let dir = (target - eye).normalize_or(Vec3::NEG_Z);
+                // Between two keys the target may pass through the eye: look along -z there.
+                let dir = (p.lerp(q, s) - eye).normalize_or(Vec3::NEG_Z);
                 let up = if dir.cross(Vec3::Y).length() < 1e-4 {
                     Vec3::Z
                 } else {
                     Vec3::Y
                 };
-                Mat4::look_at_rh(eye, target, up)
+                Mat4::look_to_rh(eye, dir, up)
             }
             (Look::Orientation(p), Look::Orientation(q)) => {
                 Mat4::from_rotation_translation(p.slerp(q, s), eye).inverse()
@@ -316,6 +318,18 @@ mod tests {
             ahead.abs_diff_eq(Vec3::new(0.0, 0.0, -1.0), 1e-5),
             "{ahead}"
         );
+    }
+
+    /// Between two keys the target passes through the eye: the view stays finite.
+    #[test]
+    fn a_target_through_the_eye_keeps_a_finite_view() {
+        let p = CameraPath::parse(
+            "p.csv",
+            "time,x,y,z,target_x,target_y,target_z\n0,0,0,0,0,0,1\n1,0,0,1,0,0,0\n",
+        )
+        .unwrap();
+        let (_, v) = p.view(1, 3);
+        assert!(v.is_finite(), "{v}");
     }
 
     #[test]

@@ -159,6 +159,14 @@ impl SceneKind {
                             _ => '-',
                         })
                         .collect();
+                    // Two files of one name (a/scene.glb, b/scene.glb) would share the CSVs' scene column.
+                    if let Some(other) = paths.iter().find(|p| p.1 == short) {
+                        return Err(Error::Config(format!(
+                            "scenes {} and {name} would both be named {short} in the results; copy one to \
+                             another file name",
+                            other.0
+                        )));
+                    }
                     let p: (&'static str, &'static str) = (
                         Box::leak(name.to_string().into_boxed_str()),
                         Box::leak(short.into_boxed_str()),
@@ -355,6 +363,11 @@ mod tests {
         );
         let r = SceneKind::resolve(&["simple".into(), "a.gltf".into(), "simple".into()]).unwrap();
         assert_eq!(r.len(), 2);
+        // Another file of the same name would share the scene column.
+        let msg = SceneKind::from_name("other dir/My_Scene.GLB")
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("would both be named My-Scene.GLB"), "{msg}");
     }
 
     #[test]

@@ -133,6 +133,23 @@ pub fn def(
         None => None,
     };
     let fov_override = animated.as_ref().and_then(|a| a.yfov);
+    if let Some(f) = fov_override {
+        if !(1.0..170.0).contains(&f.to_degrees()) {
+            return Err(bad(format!(
+                "the animated camera's yfov {f} rad ({:.1} deg) is not between 1 and 170 degrees",
+                f.to_degrees()
+            )));
+        }
+    }
+    if let Some(a) = &animated {
+        if let (Some(n), Some(f)) = (a.znear, a.zfar) {
+            if n >= f {
+                return Err(bad(format!(
+                    "the animated camera's znear {n} is not below its zfar {f}"
+                )));
+            }
+        }
+    }
     let fov_y = fov_override.unwrap_or(fov_y);
     let pixel_error = cfg.pixel_error(kind, pv.height);
     let view = View {
@@ -255,8 +272,10 @@ pub fn def(
         if colors.iter().any(|c| *c != color) {
             model.lod_colors = colors;
         }
-        if let Some(d) = exact {
-            // Exact as written: the round trip through the pixel error may move the last bit.
+        if let (Some(d), false) = (exact, model.switch_source == "override") {
+            // Exact as written (the round trip through the pixel error may move the last bit), unless
+            // --switch-distances or --switch-screen-sizes replaced them.
+            cfg.schedule.check_switches(&model_name, d)?;
             model.switches = d.clone();
         }
         model.spin_per_frame = chain.spin_per_frame;

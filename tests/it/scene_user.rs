@@ -179,10 +179,16 @@ fn a_camera_path_replaces_a_built_in_scenes_camera() {
         "time,x,y,z,target_x,target_y,target_z\n0,0,8,-500,0,0,0\n1,0,8,-400,0,0,0\n",
     )
     .unwrap();
-    let cfg = scene_config("windmills", &["--frames", "3", "--camera-path", csv.to_str().unwrap()]);
+    let cfg = scene_config(
+        "windmills",
+        &["--frames", "3", "--camera-path", csv.to_str().unwrap()],
+    );
     let notes = SceneDef::new(SceneKind::Windmills, &cfg).unwrap().notes();
     assert_eq!(notes.len(), 1, "{notes:?}");
-    assert!(notes[0].contains("LOD1 at") && notes[0].contains("not reached"), "{notes:?}");
+    assert!(
+        notes[0].contains("LOD1 at") && notes[0].contains("not reached"),
+        "{notes:?}"
+    );
 }
 
 /// A camera node animated in the file (under a parent at (0, 5, 0); translation keys at 0, 2, 4 s, rotation keys
