@@ -441,6 +441,15 @@ impl TransitionPair {
         }
     }
 
+    /// The pair of a run of frames: this one's joined with a later frame's.
+    pub fn join(self, other: TransitionPair) -> TransitionPair {
+        match other {
+            TransitionPair::None => self,
+            TransitionPair::One(a, b) => self.with(a, b),
+            TransitionPair::Mixed => TransitionPair::Mixed,
+        }
+    }
+
     fn text(self) -> String {
         match self {
             TransitionPair::None => String::new(),
@@ -534,7 +543,14 @@ pub fn transitions(rows: &[FrameRecord], pairs: &[TransitionPair]) -> Vec<Transi
             transition: out.len() as u32,
             first_frame: r0.frame,
             last_frame: rows[last].frame,
-            lods: pairs.get(first).copied().unwrap_or_default().text(),
+            // Over every frame of the transition: instances that start their transitions while others are
+            // still in theirs make one run of frames.
+            lods: pairs
+                .get(first..=last)
+                .unwrap_or_default()
+                .iter()
+                .fold(TransitionPair::None, |acc, &p| acc.join(p))
+                .text(),
             lodpop_max,
             lodpop_max_frame,
             pop_max,
@@ -1087,6 +1103,23 @@ pub(crate) mod tests {
         // The tail is cut at the end of the path.
         assert!((tr[1].rmse_max.unwrap() - 0.07).abs() < 1e-12);
         assert!(transitions(&rows[..1], &pairs[..1]).is_empty());
+    }
+
+    /// A run of transition frames whose first frames hold one pair and later frames another (one instance
+    /// starts its transition while another is in its own) is `mixed`, not its first frame's pair.
+    #[test]
+    fn a_transition_is_labelled_by_all_its_frames() {
+        let rows: Vec<FrameRecord> = (0..4)
+            .map(|f| FrameRecord {
+                t_instances: [0, 1, 1, 1][f],
+                ..row(f as u32, None, 0.0, 0.0)
+            })
+            .collect();
+        let none = TransitionPair::None;
+        let pairs = [none, none.with(2, 3), none.with(2, 3), none.with(1, 2)];
+        assert_eq!(transitions(&rows, &pairs)[0].lods, "mixed");
+        let pairs = [none, none.with(2, 3), none.with(2, 3), none.with(2, 3)];
+        assert_eq!(transitions(&rows, &pairs)[0].lods, "2->3");
     }
 
     #[test]
