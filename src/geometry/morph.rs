@@ -5,6 +5,7 @@
 //!   `|p - q|^2 + (lambda |n_p - n_q|)^2`, lambda the coarse mesh's mean edge length, so a vertex is not pulled to
 //!   a close vertex on the far side of a thin part (an ear) when one a little farther faces the same way.
 //!   Found with a k-d tree over the coarse vertices (the position term alone bounds the search).
+//! - `nearest-position`: the same with lambda = 0, the ablation of the normal term.
 //! - `surface`: the closest point on the coarse surface, the normal interpolated there (barycentric, normalised).
 //!   Found with a bounding-volume hierarchy over the coarse triangles.
 //!
@@ -25,6 +26,9 @@ use std::sync::{Arc, Mutex, OnceLock};
 pub enum Correspondence {
     /// Nearest coarse vertex, normals in the distance (Sheliemietiev et al. 2023 section 11).
     Nearest,
+    /// Nearest coarse vertex by position alone (lambda = 0): the ablation of the normal term, which section 11
+    /// says the metric must have.
+    NearestPosition,
     /// Closest point on the coarse surface.
     Surface,
 }
@@ -48,6 +52,7 @@ pub fn morph_targets(fine: &Mesh, coarse: &Mesh, how: Correspondence) -> Arc<Mor
     }
     let t = Arc::new(match how {
         Correspondence::Nearest => nearest_vertex(fine, coarse),
+        Correspondence::NearestPosition => nearest_vertex_weighted(fine, coarse, 0.0),
         Correspondence::Surface => closest_surface(fine, coarse),
     });
     if let Ok(mut c) = cache.lock() {
@@ -81,7 +86,11 @@ pub fn mean_edge_length(m: &Mesh) -> f32 {
 
 /// The paper's correspondence: nearest coarse vertex under `|p - q|^2 + (lambda |n_p - n_q|)^2`.
 pub fn nearest_vertex(fine: &Mesh, coarse: &Mesh) -> MorphTargets {
-    let lambda = mean_edge_length(coarse);
+    nearest_vertex_weighted(fine, coarse, mean_edge_length(coarse))
+}
+
+/// Nearest coarse vertex under `|p - q|^2 + (lambda |n_p - n_q|)^2` for a given `lambda` (0: position alone).
+pub fn nearest_vertex_weighted(fine: &Mesh, coarse: &Mesh, lambda: f32) -> MorphTargets {
     let pts: Vec<Vec3> = coarse.positions.iter().map(v).collect();
     let nrm: Vec<Vec3> = coarse.normals.iter().map(v).collect();
     let mut idx: Vec<u32> = (0..pts.len() as u32).collect();
@@ -382,7 +391,10 @@ mod tests {
     }
 
     fn brute_nearest(fine: &Mesh, coarse: &Mesh, i: usize) -> [f32; 3] {
-        let lambda = mean_edge_length(coarse);
+        brute_nearest_weighted(fine, coarse, i, mean_edge_length(coarse))
+    }
+
+    fn brute_nearest_weighted(fine: &Mesh, coarse: &Mesh, i: usize, lambda: f32) -> [f32; 3] {
         let (p, n) = (v(&fine.positions[i]), v(&fine.normals[i]));
         let j = (0..coarse.positions.len())
             .min_by(|&a, &b| {
@@ -404,6 +416,27 @@ mod tests {
         for i in (0..fine.positions.len()).step_by(7) {
             assert_eq!(t.positions[i], brute_nearest(fine, coarse, i), "vertex {i}");
         }
+    }
+
+    /// `nearest-position` is the nearest vertex by position alone (lambda = 0), and on the bunny's coarsest
+    /// LOD it pairs some vertices differently from the paper's metric (the normal term moves them).
+    #[test]
+    fn nearest_position_drops_the_normal_term() {
+        let c = chain();
+        let (fine, coarse) = (&c.lods[0].mesh, &c.lods[3].mesh);
+        let t = morph_targets(fine, coarse, Correspondence::NearestPosition);
+        for i in (0..fine.positions.len()).step_by(7) {
+            assert_eq!(
+                t.positions[i],
+                brute_nearest_weighted(fine, coarse, i, 0.0),
+                "vertex {i}"
+            );
+        }
+        let paper = morph_targets(fine, coarse, Correspondence::Nearest);
+        let moved = (0..fine.positions.len())
+            .filter(|&i| t.positions[i] != paper.positions[i])
+            .count();
+        assert!(moved > 0, "the normal term changes no pairing");
     }
 
     #[test]
