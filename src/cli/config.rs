@@ -347,24 +347,6 @@ impl RunConfig {
     }
 }
 
-/// Checks names against the registry (keeping the user's order, dropping repeats); empty = all.
-pub fn resolve_names(kind: &'static str, given: &[String], valid: &[&str]) -> Result<Vec<String>> {
-    if given.is_empty() {
-        return Ok(valid.iter().map(|s| s.to_string()).collect());
-    }
-    let mut out: Vec<String> = Vec::new();
-    for name in given {
-        let name = name.trim();
-        if !valid.contains(&name) {
-            return Err(Error::unknown(kind, name, valid));
-        }
-        if !out.iter().any(|n| n == name) {
-            out.push(name.to_string());
-        }
-    }
-    Ok(out)
-}
-
 /// The methods' labels: checked against the registry in the user's order; a name given again runs again as
 /// `NAME#2`, `NAME#3`, ... (an A/A comparison); empty = every method once.
 pub fn resolve_methods(given: &[String], valid: &[&str]) -> Result<Vec<String>> {

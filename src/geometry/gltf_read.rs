@@ -115,6 +115,100 @@ type SceneNodes = Vec<(usize, Mat4, Mat4)>;
 /// `NAME_LODn` nodes grouped by (parent, stem): their (level, node) pairs.
 type NameGroups = Vec<((usize, String), Vec<(u32, usize)>)>;
 
+/// Triangle primitives merged into one vertex and index list, each added under a transform: positions by it,
+/// normals by its inverse transpose (kept while every primitive has normals and every transform is invertible),
+/// the winding reversed under a mirroring transform (negative determinant, as glTF specifies), and lodbench's
+/// shading extras (`_LODBENCH_AUX`, zeros for primitives without them) with the blades' hub height scaled by the
+/// transform's scale along y.
+#[derive(Debug)]
+pub struct Merged {
+    pub positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    all_normals: bool,
+    aux: Option<Vec<[f32; 4]>>,
+    pub indices: Vec<u32>,
+}
+
+impl Default for Merged {
+    fn default() -> Self {
+        Merged {
+            positions: Vec::new(),
+            normals: Vec::new(),
+            all_normals: true,
+            aux: None,
+            indices: Vec::new(),
+        }
+    }
+}
+
+impl Merged {
+    /// Adds `prims` placed by `transform`.
+    pub fn add(&mut self, prims: &[Triangles], transform: Mat4) -> Result<(), String> {
+        let linear = glam::Mat3::from_mat4(transform);
+        let det = linear.determinant();
+        let normal_matrix = linear.inverse().transpose();
+        let y_scale = transform.transform_vector3(Vec3::Y).length();
+        for prim in prims {
+            let base = u32::try_from(self.positions.len())
+                .ok()
+                .zip(u32::try_from(prim.positions.len()).ok())
+                .filter(|(b, n)| b.checked_add(*n).is_some())
+                .map(|(b, _)| b)
+                .ok_or_else(|| "has more vertices than 32-bit indices can address".to_string())?;
+            self.positions.extend(
+                prim.positions
+                    .iter()
+                    .map(|&v| transform.transform_point3(Vec3::from(v)).to_array()),
+            );
+            for t in prim.indices.chunks_exact(3) {
+                let t = if det < 0.0 {
+                    [t[0], t[2], t[1]]
+                } else {
+                    [t[0], t[1], t[2]]
+                };
+                self.indices.extend(t.iter().map(|&ix| base + ix));
+            }
+            match &prim.normals {
+                Some(n) if self.all_normals && det != 0.0 && normal_matrix.is_finite() => {
+                    self.normals.extend(n.iter().map(|&n| {
+                        let n = normal_matrix * Vec3::from(n);
+                        n.try_normalize().unwrap_or(n).to_array()
+                    }));
+                }
+                _ => self.all_normals = false,
+            }
+            let scaled = |a: &[[f32; 4]]| -> Vec<[f32; 4]> {
+                a.iter()
+                    .map(|&[u, v, kind, hub]| [u, v, kind, hub * y_scale])
+                    .collect()
+            };
+            match (&prim.aux, &mut self.aux) {
+                (Some(a), Some(all)) => all.extend(scaled(a)),
+                (Some(a), None) => {
+                    let mut all = vec![[0.0; 4]; base as usize];
+                    all.extend(scaled(a));
+                    self.aux = Some(all);
+                }
+                (None, Some(all)) => {
+                    all.extend(std::iter::repeat_n([0.0; 4], prim.positions.len()))
+                }
+                (None, None) => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// The normals, when every primitive had them under an invertible transform.
+    pub fn normals(&mut self) -> Option<Vec<[f32; 3]>> {
+        self.all_normals.then(|| std::mem::take(&mut self.normals))
+    }
+
+    /// The shading extras, when some primitive had them.
+    pub fn aux(&mut self) -> Option<Vec<[f32; 4]>> {
+        self.aux.take()
+    }
+}
+
 /// The parsed document and its buffers.
 struct Doc<'a> {
     json: Value,
@@ -1071,12 +1165,10 @@ impl Doc<'_> {
         Ok(out)
     }
 
-    /// Accessor `i`'s elements as floats (integers dequantised: normalised ones to [-1, 1] or [0, 1], others
-    /// as their value).
-    fn read_floats(&mut self, i: usize) -> Result<(Vec<f32>, usize), String> {
-        let l = self.layout(i)?;
-        let size = component_size(l.component).unwrap_or(4);
-        let elem = size * l.components;
+    /// The bytes of accessor `i`'s buffer view (laid out as `l`) and its stride, checked to hold every element:
+    /// a stride that holds an element, and the last element inside the view.
+    fn elements(&mut self, i: usize, l: &Layout) -> Result<(Cow<'_, [u8]>, usize), String> {
+        let elem = component_size(l.component).unwrap_or(4) * l.components;
         let (bytes, stride) = self.view(l.view)?;
         let stride = stride.unwrap_or(elem);
         if stride < elem {
@@ -1097,6 +1189,15 @@ impl Doc<'_> {
                 l.count, l.view
             ));
         }
+        Ok((bytes, stride))
+    }
+
+    /// Accessor `i`'s elements as floats (integers dequantised: normalised ones to [-1, 1] or [0, 1], others
+    /// as their value).
+    fn read_floats(&mut self, i: usize) -> Result<(Vec<f32>, usize), String> {
+        let l = self.layout(i)?;
+        let size = component_size(l.component).unwrap_or(4);
+        let (bytes, stride) = self.elements(i, &l)?;
         let mut out = Vec::with_capacity(l.count * l.components);
         for e in 0..l.count {
             let at = l.offset + e * stride;
@@ -1131,20 +1232,7 @@ impl Doc<'_> {
             ));
         }
         let size = component_size(l.component).unwrap_or(4);
-        let (bytes, stride) = self.view(l.view)?;
-        let stride = stride.unwrap_or(size).max(size);
-        let end = l
-            .count
-            .checked_sub(1)
-            .and_then(|n| n.checked_mul(stride))
-            .and_then(|n| n.checked_add(size))
-            .and_then(|n| n.checked_add(l.offset));
-        if l.count > 0 && end.is_none_or(|end| end > bytes.len()) {
-            return Err(format!(
-                "accessor {i} ({} elements) does not fit in buffer view {}",
-                l.count, l.view
-            ));
-        }
+        let (bytes, stride) = self.elements(i, &l)?;
         // Read as integers: through f32 an index above 2^24 would round.
         Ok((0..l.count)
             .map(|e| {

@@ -2,7 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::geometry::gltf_read;
-use glam::{Mat3, Vec3};
+use glam::Vec3;
 use std::path::Path;
 
 /// The mesh file formats [`Mesh::load`] reads, as its error messages list them.
@@ -332,57 +332,23 @@ fn parse_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
     }
     let mut meshes: std::collections::HashMap<usize, Vec<gltf_read::Triangles>> =
         std::collections::HashMap::new();
-    let mut positions: Vec<[f32; 3]> = Vec::new();
-    let mut normals: Vec<[f32; 3]> = Vec::new();
-    let mut indices: Vec<u32> = Vec::new();
-    let mut all_have_normals = true;
+    let mut merged = gltf_read::Merged::default();
     let placements = std::mem::take(&mut content.placements);
     for p in &placements {
         if let std::collections::hash_map::Entry::Vacant(e) = meshes.entry(p.mesh) {
             e.insert(content.mesh_triangles(p.mesh)?);
         }
-        let linear = Mat3::from_mat4(p.world);
-        let det = linear.determinant();
-        let normal_matrix = linear.inverse().transpose();
-        for prim in &meshes[&p.mesh] {
-            let count = prim.positions.len() as u32;
-            let base = u32::try_from(positions.len())
-                .ok()
-                .filter(|b| b.checked_add(count).is_some())
-                .ok_or_else(|| "has more vertices than 32-bit indices can address".to_string())?;
-            positions.extend(
-                prim.positions
-                    .iter()
-                    .map(|&v| p.world.transform_point3(Vec3::from(v)).to_array()),
-            );
-            for t in prim.indices.chunks_exact(3) {
-                // A mirroring transform (negative determinant) reverses the winding, as glTF specifies.
-                let t = if det < 0.0 {
-                    [t[0], t[2], t[1]]
-                } else {
-                    [t[0], t[1], t[2]]
-                };
-                indices.extend(t.iter().map(|&ix| base + ix));
-            }
-            match &prim.normals {
-                Some(n) if all_have_normals && det != 0.0 && normal_matrix.is_finite() => {
-                    normals.extend(n.iter().map(|&n| {
-                        let n = normal_matrix * Vec3::from(n);
-                        n.try_normalize().unwrap_or(n).to_array()
-                    }));
-                }
-                _ => all_have_normals = false,
-            }
-        }
+        merged.add(&meshes[&p.mesh], p.world)?;
     }
-    if indices.is_empty() {
+    if merged.indices.is_empty() {
         return Err(match content.scene {
             Some(s) => format!("has no triangle primitives in scene {s}"),
             None => "has no triangle primitives".to_string(),
         });
     }
-    let normals = all_have_normals.then_some(normals);
-    Mesh::new("", positions, normals, indices).map_err(|e| match e {
+    // lodbench's own shading extras are not read here: --mesh takes the shape alone.
+    let normals = merged.normals();
+    Mesh::new("", merged.positions, normals, merged.indices).map_err(|e| match e {
         Error::Mesh { problem, .. } => problem,
         other => other.to_string(),
     })

@@ -8,7 +8,7 @@
 //!   starting with `_`);
 //! - per instance, a node placing the model's LOD0 at the instance's frame-0 transform, with MSFT_lod naming the
 //!   coarser LODs' nodes (outside the scene, as the extension's example has them), `extras.MSFT_screencoverage`
-//!   (lodbench's switch distances as screen sizes, `user::coverage_distance`'s inverse, then 0) and lodbench's
+//!   (lodbench's switch distances as screen sizes, `config::screen_size_distance`'s inverse, then 0) and lodbench's
 //!   exact switch distances in `extras.lodbench_switch_distances` (which the import prefers), and the blades'
 //!   turn per frame in `extras.lodbench_spin_per_frame`;
 //! - the camera as a node with a perspective camera (the scene's vertical fov) and a LINEAR animation of its

@@ -5,7 +5,7 @@
 //! place the instance, its scale is baked into the model (so the LOD errors and switch distances, which are
 //! per model, hold for every instance of it). An authored LOD chain (MSFT_lod, or `NAME_LODn` siblings) is one
 //! model whose levels are the chain's meshes, never merged; its switch distances come from MSFT_screencoverage
-//! when the file has it (engine screen size, converted by [`coverage_distance`]), else from the pixel error of
+//! when the file has it (engine screen size, converted by [`screen_size_distance`]), else from the pixel error of
 //! an error estimated for each level (meshopt's error when it simplifies LOD0 to that level's triangle count).
 //! A mesh without a chain gets meshopt's chain by error, as `--mesh` does (`bunny::USER_SWITCH_FIT_MULTIPLES`).
 //!
@@ -22,7 +22,7 @@ use crate::geometry::lod::{self, LodChain};
 use crate::geometry::mesh::{read_mesh_file, Mesh};
 use crate::scene::bunny::{fit_distance, USER_SWITCH_FIT_MULTIPLES};
 use crate::scene::camera_path::CameraPath;
-use crate::scene::config::SceneConfig;
+use crate::scene::config::{screen_size_distance, SceneConfig};
 use crate::scene::kind::{ProfileValues, SceneKind};
 use crate::scene::model::{CameraTrack, Instance, Layout, Model, ModelSet, Motion};
 use glam::{Mat4, Quat, Vec3};
@@ -76,14 +76,6 @@ pub struct ChainDescription {
     pub levels: usize,
     /// Where the switch distances came from.
     pub thresholds: String,
-}
-
-/// Distance at which a bounding sphere of `radius` has screen size `coverage`: the projected sphere's diameter
-/// over the viewport's height, `coverage = radius / (d tan(fov_y / 2))` (Unreal's screen size, Unity's
-/// screen-relative transition height for a sphere, and the reading lodbench gives MSFT_screencoverage, which
-/// its specification calls a hint): `d = radius / (coverage tan(fov_y / 2))`.
-pub fn coverage_distance(radius: f32, coverage: f32, fov_y: f32) -> f32 {
-    crate::scene::config::screen_size_distance(radius, coverage, fov_y)
 }
 
 /// One model being built, with its key: the glTF meshes of its levels and the scale baked into them.
@@ -229,7 +221,7 @@ pub fn def(
             (Some(c), None) if c.len() + 1 >= meshes.len() && meshes.len() > 1 => {
                 let d: Vec<f32> = c[..meshes.len() - 1]
                     .iter()
-                    .map(|&c| coverage_distance(radius, c as f32, fov_y))
+                    .map(|&c| screen_size_distance(radius, c as f32, fov_y))
                     .collect();
                 let mut e = vec![0.0];
                 e.extend(
@@ -480,9 +472,7 @@ fn decompose(name: &str, p: &gltf_read::Placement) -> Result<(Vec3, Quat, Vec3)>
     Ok((s, r, t))
 }
 
-/// Mesh `mesh`'s triangle primitives merged, with `transform` applied: positions by it, normals (kept when
-/// every primitive has them) by its inverse transpose, lodbench's shading extras (`_LODBENCH_AUX`: the blades'
-/// hub height) by its scale along y.
+/// Mesh `mesh`'s triangle primitives merged under `transform` ([`gltf_read::Merged`]).
 fn placed_mesh(
     content: &mut gltf_read::Content<'_>,
     name: &str,
@@ -494,41 +484,14 @@ fn placed_mesh(
         problem,
     };
     let prims = content.mesh_triangles(mesh).map_err(bad)?;
-    let normal_matrix = glam::Mat3::from_mat4(transform).inverse().transpose();
-    let y_scale = transform.transform_vector3(Vec3::Y).length();
-    let keep_normals = prims.iter().all(|p| p.normals.is_some()) && normal_matrix.is_finite();
-    let keep_aux = prims.iter().any(|p| p.aux.is_some());
-    let (mut positions, mut normals, mut aux, mut indices) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for prim in prims {
-        let base = positions.len() as u32;
-        positions.extend(
-            prim.positions
-                .iter()
-                .map(|&p| transform.transform_point3(Vec3::from(p)).to_array()),
-        );
-        if let (true, Some(n)) = (keep_normals, &prim.normals) {
-            normals.extend(n.iter().map(|&n| {
-                let n = normal_matrix * Vec3::from(n);
-                n.try_normalize().unwrap_or(n).to_array()
-            }));
-        }
-        if keep_aux {
-            match &prim.aux {
-                Some(a) => aux.extend(
-                    a.iter()
-                        .map(|&[u, v, kind, hub]| [u, v, kind, hub * y_scale]),
-                ),
-                None => aux.extend(std::iter::repeat_n([0.0; 4], prim.positions.len())),
-            }
-        }
-        indices.extend(prim.indices.iter().map(|&i| base + i));
-    }
-    if indices.is_empty() {
+    let mut merged = gltf_read::Merged::default();
+    merged.add(&prims, transform).map_err(bad)?;
+    if merged.indices.is_empty() {
         return Err(bad(format!("mesh {mesh} has no triangle primitives")));
     }
-    let mut m = Mesh::new(name, positions, keep_normals.then_some(normals), indices)?;
-    if keep_aux {
+    let (normals, aux) = (merged.normals(), merged.aux());
+    let mut m = Mesh::new(name, merged.positions, normals, merged.indices)?;
+    if let Some(aux) = aux {
         m = m.with_aux(name, aux)?;
     }
     m.check_area(name)?;
