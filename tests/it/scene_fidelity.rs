@@ -13,7 +13,8 @@ use lodbench::scene::{SceneDef, SceneKind, NOT_REACHED};
 /// start and the sweep never reached it. FSI's first transition must stay within twice discrete's largest rmse:
 /// started inside the bounding sphere, FSI would show background for the bunny's inside. At 160x120 and the quick
 /// profile's 600 frames; with fewer frames the bunny moves faster and FSI's one-frame lag of the moving bunny
-/// grows (at 100 frames its rmse was three times discrete's).
+/// grows (at 100 frames its rmse was three times discrete's, at 300 frames 2.2 times). The reference is not a
+/// method of the run (the quality pass draws it anyway): listed, its own quality pass would add a third.
 #[test]
 fn dense_mesh_sweeps_through_every_lod() {
     let dir = tempfile::tempdir().unwrap();
@@ -48,7 +49,7 @@ fn dense_mesh_sweeps_through_every_lod() {
         "--scene",
         "bunny-sweep",
         "--method",
-        "reference,discrete,fsi",
+        "discrete,fsi",
     ];
     args.extend_from_slice(&flags);
     args.extend_from_slice(&["--rounds", "1", "--warmup", "1"]);
