@@ -231,7 +231,10 @@ def manifest_html(m) -> str:
     out = []
     e = m["experiment"]
     if e is not None:
-        rows = [(k, e.get(k)) for k in ("name", "description", "file", "variable")]
+        rows = [(k, e.get(k)) for k in ("name", "description", "file")]
+        # "variables" (one per sweep); folders of older builds wrote one "variable".
+        swept = e.get("variables") or ([e["variable"]] if e.get("variable") else [])
+        rows.append(("swept", " x ".join(swept) if swept else None))
         rows.append(("runs", len(e.get("runs") or [])))
         out.append("<h3>experiment.json</h3>" + key_values(rows) + details("experiment.json", e))
     if not m["runs"]:

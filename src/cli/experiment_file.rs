@@ -11,6 +11,8 @@
 //! variable = "viewport"     # a [run] key, or "viewport" for [width, height] pairs
 //! values = [[256, 256], [512, 512]]
 //! ```
+//! Several variables are crossed with `[[sweep]]` tables instead of the one `[sweep]`: one run per combination
+//! of their values, the first table's variable varying slowest.
 //! The `[run]` table deserialises straight into `RunArgs` (the same struct clap fills from the command line,
 //! so a key takes exactly the values its flag takes, and a key left out takes the flag's default), and is then
 //! validated by `RunConfig::from_args` as on the command line. An unknown key, or a value of the wrong type, is
@@ -30,7 +32,8 @@ struct ExperimentFile {
     #[serde(default)]
     description: String,
     run: toml::Table,
-    sweep: Option<SweepKeys>,
+    /// `[sweep]` (a table) or `[[sweep]]` (tables, crossed): read by [`sweeps`].
+    sweep: Option<toml::Value>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -46,8 +49,53 @@ const VIEWPORT: &str = "viewport";
 impl SweepKeys {
     /// Whether the sweep sets `key` in every run.
     fn varies(&self, key: &str) -> bool {
-        self.variable == key || (self.variable == VIEWPORT && (key == "width" || key == "height"))
+        self.sets().contains(&key)
     }
+
+    /// The `[run]` keys the sweep sets.
+    fn sets(&self) -> Vec<&str> {
+        match self.variable.as_str() {
+            VIEWPORT => vec!["width", "height"],
+            v => vec![v],
+        }
+    }
+}
+
+/// The file's sweeps: none, the one `[sweep]` table, or the `[[sweep]]` tables in their order. Two sweeps of
+/// one key (the viewport counting as width and height) are an error.
+fn sweeps(source: &Source, file: &ExperimentFile) -> Result<Vec<SweepKeys>> {
+    let tables = match &file.sweep {
+        None => return Ok(Vec::new()),
+        Some(t @ toml::Value::Table(_)) => vec![t.clone()],
+        Some(toml::Value::Array(a)) => a.clone(),
+        Some(other) => {
+            return Err(source.bad(format!(
+                "sweep = {other}: expected a [sweep] table or [[sweep]] tables"
+            )))
+        }
+    };
+    let many = tables.len() > 1;
+    let mut out: Vec<SweepKeys> = Vec::new();
+    for (i, t) in tables.into_iter().enumerate() {
+        let at = if many {
+            format!("[[sweep]] {}", i + 1)
+        } else {
+            "[sweep]".to_string()
+        };
+        let keys = SweepKeys::deserialize(t)
+            .map_err(|e| source.bad(format!("{at}: {}", e.message().trim())))?;
+        if let Some(earlier) = out.iter().find(|o| keys.sets().iter().any(|k| o.varies(k))) {
+            return Err(source.bad(format!(
+                "{at}: variable '{}' is swept already (as '{}')",
+                keys.variable, earlier.variable
+            )));
+        }
+        out.push(keys);
+    }
+    if out.is_empty() {
+        return Err(source.bad("[[sweep]] has no table".into()));
+    }
+    Ok(out)
 }
 
 /// The keys `[run]` takes: every `lodbench run` flag without its dashes, except `out` (the experiment decides
@@ -148,11 +196,22 @@ impl Shard {
     }
 }
 
-/// One run of the experiment: the swept value (as written in the column) and its validated configuration.
+/// One run of the experiment: the swept values, one per sweep (as written in their columns), and its validated
+/// configuration.
 #[derive(Debug, Clone, Serialize)]
 pub struct PlannedRun {
-    pub value: Option<String>,
+    pub values: Vec<String>,
     pub config: RunConfig,
+}
+
+/// `variable=value` of each sweep, joined by `+` (how messages and run folders name a planned run).
+pub fn sweep_label(variables: &[String], values: &[String]) -> String {
+    variables
+        .iter()
+        .zip(values)
+        .map(|(var, v)| format!("{var}={v}"))
+        .collect::<Vec<_>>()
+        .join("+")
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -160,8 +219,8 @@ pub struct Experiment {
     pub name: String,
     pub description: String,
     pub file: PathBuf,
-    /// The swept variable (the extra CSV column), if any.
-    pub variable: Option<String>,
+    /// The swept variables (an extra CSV column each, in this order), none without a sweep.
+    pub variables: Vec<String>,
     pub runs: Vec<PlannedRun>,
 }
 
@@ -206,9 +265,9 @@ impl Source {
     }
 }
 
-/// One run's `[run]` table, before it is checked: the swept value (None without a sweep) and the keys.
+/// One run's `[run]` table, before it is checked: the swept values (one per sweep, none without) and the keys.
 struct Variant {
-    value: Option<String>,
+    values: Vec<String>,
     table: toml::Table,
 }
 
@@ -229,20 +288,22 @@ impl Experiment {
         let mut file: ExperimentFile =
             toml::from_str(&source.text).map_err(|e| source.bad(source.at(&e)))?;
         let keys = run_keys();
+        let sweeps = sweeps(&source, &file)?;
         for o in overrides {
-            apply_override(&source, &mut file, &keys, o)?;
+            apply_override(&source, &mut file, (&keys, &sweeps), o)?;
         }
         check_run_keys(&source, &file, &keys)?;
-        let (variable, variants) = variants(&source, &file, &keys)?;
+        let variants = variants(&source, &file, &keys, &sweeps)?;
+        let variables: Vec<String> = sweeps.into_iter().map(|s| s.variable).collect();
         let runs = variants
             .into_iter()
-            .map(|v| plan_run(&source, variable.as_deref(), v))
+            .map(|v| plan_run(&source, &variables, v))
             .collect::<Result<Vec<_>>>()?;
         Ok(Experiment {
             name: file.name,
             description: file.description,
             file: path.to_path_buf(),
-            variable,
+            variables,
             runs,
         })
     }
@@ -252,7 +313,7 @@ impl Experiment {
 fn apply_override(
     source: &Source,
     file: &mut ExperimentFile,
-    keys: &[String],
+    (keys, sweeps): (&[String], &[SweepKeys]),
     o: &str,
 ) -> Result<()> {
     let Some((key, value)) = o.split_once('=') else {
@@ -265,7 +326,7 @@ fn apply_override(
             keys.join(", ")
         )));
     }
-    if file.sweep.as_ref().is_some_and(|sw| sw.varies(key)) {
+    if sweeps.iter().any(|sw| sw.varies(key)) {
         return Err(source.bad(format!("--set {o}: '{key}' is the swept variable")));
     }
     let value = value.trim();
@@ -290,61 +351,72 @@ fn check_run_keys(source: &Source, file: &ExperimentFile, keys: &[String]) -> Re
     }
 }
 
-/// The swept variable, if any, and the `[run]` table of each planned run: one without a sweep, else one per
-/// swept value.
+/// The `[run]` table of each planned run: one without a sweep, else one per combination of the sweeps' values
+/// (the first sweep's varying slowest).
 fn variants(
     source: &Source,
     file: &ExperimentFile,
     keys: &[String],
-) -> Result<(Option<String>, Vec<Variant>)> {
-    let Some(sweep) = &file.sweep else {
-        let only = Variant {
-            value: None,
-            table: file.run.clone(),
-        };
-        return Ok((None, vec![only]));
-    };
-    let var = sweep.variable.as_str();
-    if var != VIEWPORT && !keys.iter().any(|k| k == var) {
-        return Err(source.bad(format!(
-            "[sweep] variable '{var}' is not a [run] key or viewport (the keys: {})",
-            keys.join(", ")
-        )));
-    }
-    if sweep.values.is_empty() {
-        return Err(source.bad("[sweep] values is empty".into()));
-    }
-    let mut variants = Vec::new();
-    for v in &sweep.values {
-        let mut table = file.run.clone();
-        if var == VIEWPORT {
-            let pair = v.as_array().filter(|a| a.len() == 2);
-            let Some(pair) = pair else {
-                return Err(
-                    source.bad(format!("[sweep] viewport value {v} is not [width, height]"))
-                );
-            };
-            table.insert("width".into(), pair[0].clone());
-            table.insert("height".into(), pair[1].clone());
-        } else {
-            table.insert(var.to_string(), v.clone());
+    sweeps: &[SweepKeys],
+) -> Result<Vec<Variant>> {
+    let mut variants = vec![Variant {
+        values: Vec::new(),
+        table: file.run.clone(),
+    }];
+    for sweep in sweeps {
+        let var = sweep.variable.as_str();
+        if var != VIEWPORT && !keys.iter().any(|k| k == var) {
+            return Err(source.bad(format!(
+                "[sweep] variable '{var}' is not a [run] key or viewport (the keys: {})",
+                keys.join(", ")
+            )));
         }
-        variants.push(Variant {
-            value: Some(value_text(v)),
-            table,
-        });
+        if sweep.values.is_empty() {
+            return Err(source.bad(format!("[sweep] {var}: values is empty")));
+        }
+        let mut crossed = Vec::new();
+        for base in &variants {
+            for v in &sweep.values {
+                let mut table = base.table.clone();
+                if var == VIEWPORT {
+                    let pair = v.as_array().filter(|a| a.len() == 2);
+                    let Some(pair) = pair else {
+                        return Err(source
+                            .bad(format!("[sweep] viewport value {v} is not [width, height]")));
+                    };
+                    table.insert("width".into(), pair[0].clone());
+                    table.insert("height".into(), pair[1].clone());
+                } else {
+                    table.insert(var.to_string(), v.clone());
+                }
+                let mut values = base.values.clone();
+                values.push(value_text(v));
+                crossed.push(Variant { values, table });
+            }
+        }
+        variants = crossed;
     }
-    Ok((Some(var.to_string()), variants))
+    Ok(variants)
 }
 
 /// One planned run: its table read as `lodbench run`'s flags and validated as on the command line.
-fn plan_run(source: &Source, variable: Option<&str>, v: Variant) -> Result<PlannedRun> {
-    let args = run_args(&v.table).map_err(|e| match &v.value {
-        Some(value) if Some(e.key.as_str()) == variable || e.key.is_empty() => source.bad(format!(
-            "[sweep] variable '{}' with value {value}: {}",
-            e.key, e.message
+fn plan_run(source: &Source, variables: &[String], v: Variant) -> Result<PlannedRun> {
+    let swept = |key: &str| {
+        variables.iter().zip(&v.values).find(|(var, _)| {
+            var.as_str() == key || (var.as_str() == VIEWPORT && (key == "width" || key == "height"))
+        })
+    };
+    let args = run_args(&v.table).map_err(|e| match swept(&e.key) {
+        Some((var, value)) => source.bad(format!(
+            "[sweep] variable '{var}' with value {value}: {}",
+            e.message
         )),
-        _ => source.bad(format!(
+        None if e.key.is_empty() && !v.values.is_empty() => source.bad(format!(
+            "[sweep] values {}: {}",
+            sweep_label(variables, &v.values),
+            e.message
+        )),
+        None => source.bad(format!(
             "{}[run] {}: {}",
             source.where_is(&e.key),
             e.key,
@@ -353,7 +425,7 @@ fn plan_run(source: &Source, variable: Option<&str>, v: Variant) -> Result<Plann
     })?;
     let config = RunConfig::from_args(&args).map_err(|e| source.bad(e.to_string()))?;
     Ok(PlannedRun {
-        value: v.value,
+        values: v.values,
         config,
     })
 }
@@ -532,13 +604,75 @@ mod tests {
              [sweep]\nvariable = \"viewport\"\nvalues = [[64, 48], [96, 72]]\n",
         );
         let e = Experiment::load(&p).unwrap();
-        assert_eq!(e.variable.as_deref(), Some("viewport"));
+        assert_eq!(e.variables, ["viewport"]);
         let sizes: Vec<_> = e
             .runs
             .iter()
             .map(|r| (r.config.scene.width, r.config.scene.height))
             .collect();
         assert_eq!(sizes, vec![(Some(64), Some(48)), (Some(96), Some(72))]);
-        assert_eq!(e.runs[1].value.as_deref(), Some("96,72"));
+        assert_eq!(e.runs[1].values, ["96,72"]);
+    }
+
+    /// `[[sweep]]` tables cross: one run per combination, the first table's variable varying slowest, each run
+    /// with both values; a variable swept twice, or set with `--set`, is refused.
+    #[test]
+    fn two_sweeps_cross() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "name = \"x\"\n[run]\nscene = [\"bunny-sweep\"]\nframes = 4\n\
+             [[sweep]]\nvariable = \"pixel-error\"\nvalues = [1, 2]\n\
+             [[sweep]]\nvariable = \"band\"\nvalues = [0.02, 0.05, 0.1]\n",
+        );
+        let e = Experiment::load(&p).unwrap();
+        assert_eq!(e.variables, ["pixel-error", "band"]);
+        let planned: Vec<(Vec<String>, Option<f32>, f32)> = e
+            .runs
+            .iter()
+            .map(|r| {
+                (
+                    r.values.clone(),
+                    r.config.scene.pixel_error,
+                    r.config.scene.schedule.band,
+                )
+            })
+            .collect();
+        let want = [
+            (1.0, 0.02),
+            (1.0, 0.05),
+            (1.0, 0.1),
+            (2.0, 0.02),
+            (2.0, 0.05),
+            (2.0, 0.1),
+        ];
+        assert_eq!(planned.len(), want.len());
+        for ((values, pe, band), (want_pe, want_band)) in planned.iter().zip(want) {
+            assert_eq!(*pe, Some(want_pe), "{values:?}");
+            assert_eq!(*band, want_band, "{values:?}");
+            assert_eq!(values, &[format!("{want_pe}"), format!("{want_band}")]);
+        }
+        assert_eq!(
+            sweep_label(&e.variables, &e.runs[4].values),
+            "pixel-error=2+band=0.05"
+        );
+        let msg = Experiment::load_with(&p, &["band=0.3".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("swept"), "{msg}");
+        for (text, needle) in [
+            ("[[sweep]]\nvariable = \"band\"\nvalues = [0.1]\n[[sweep]]\nvariable = \"band\"\nvalues = [0.2]\n", "swept already"),
+            ("[[sweep]]\nvariable = \"viewport\"\nvalues = [[64, 48]]\n[[sweep]]\nvariable = \"width\"\nvalues = [32]\n", "swept already"),
+            ("[[sweep]]\nvariable = \"band\"\nvalues = []\n", "empty"),
+            ("[[sweep]]\nvariable = \"band\"\nvalus = [1]\n", "valus"),
+            ("[[sweep]]\nvariable = \"band\"\nvalues = [0.1]\n[[sweep]]\nvariable = \"pixel-error\"\nvalues = [\"big\"]\n", "pixel-error"),
+        ] {
+            let p = write(
+                dir.path(),
+                &format!("name = \"x\"\n[run]\nscene = [\"bunny-sweep\"]\n{text}"),
+            );
+            let msg = Experiment::load(&p).unwrap_err().to_string();
+            assert!(msg.contains(needle), "{text}: {msg}");
+        }
     }
 }

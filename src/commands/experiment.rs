@@ -37,9 +37,10 @@ pub fn execute(args: &ExperimentArgs) -> Result<()> {
         e.name,
         e.runs.len(),
         if e.runs.len() == 1 { "" } else { "s" },
-        e.variable
-            .as_deref()
-            .map_or(String::new(), |v| format!(", sweeping {v}")),
+        match e.variables.is_empty() {
+            true => String::new(),
+            false => format!(", sweeping {}", e.variables.join(" x ")),
+        },
         e.description
     );
     let shard = args.shard.as_deref().map(Shard::parse).transpose()?;
@@ -77,17 +78,17 @@ fn print_plan(e: &Experiment, shard: Option<Shard>, list: bool) {
             .iter()
             .map(|&k| format!("{}: {}", k.name(), r.config.methods_for(k).join(", ")))
             .collect();
-        outln!(
-            "  {}{part} {}",
-            r.value.as_deref().unwrap_or("-"),
-            per_scene.join("; ")
-        );
+        let label = match r.values.is_empty() {
+            true => "-".to_string(),
+            false => crate::cli::experiment_file::sweep_label(&e.variables, &r.values),
+        };
+        outln!("  {label}{part} {}", per_scene.join("; "));
     }
 }
 
 impl Experiment {
     /// Runs every planned run into `out/runs/<variable>=<value>/` (or `out/` without a sweep), then writes
-    /// `out/frames.csv` and `out/summary.csv` with the swept variable as the first column, and
+    /// `out/frames.csv` and `out/summary.csv` with the swept variables as the first columns, and
     /// `out/experiment.json`.
     pub fn run(&self, out: &Path) -> Result<Vec<PathBuf>> {
         self.run_with(out, &RunOptions::default())
@@ -95,7 +96,7 @@ impl Experiment {
 
     /// The folder planned run `k` writes to under `out`.
     pub fn run_folder(&self, out: &Path, k: usize) -> PathBuf {
-        run_folder_of(out, self.variable.as_deref(), self.runs[k].value.as_deref())
+        run_folder_of(out, &self.variables, &self.runs[k].values)
     }
 
     /// The planned runs' indices `shard` holds (all without one).
@@ -136,17 +137,18 @@ impl Experiment {
             }
             folders.push(folder);
         }
-        if let Some(var) = &self.variable {
+        if !self.variables.is_empty() {
+            let header: Vec<&str> = self.variables.iter().map(String::as_str).collect();
             for file in RUN_CSVS {
                 let parts: Vec<CsvPart> = mine
                     .iter()
                     .zip(&folders)
                     .map(|(&k, f)| CsvPart {
-                        lead: vec![self.runs[k].value.clone().unwrap_or_default()],
+                        lead: self.runs[k].values.clone(),
                         source: f.join(file),
                     })
                     .collect();
-                concat_csv(&out.join(file), &[var.as_str()], &parts)?;
+                concat_csv(&out.join(file), &header, &parts)?;
             }
         }
         Ok(folders)

@@ -86,22 +86,17 @@ struct MergedRun<'a> {
 
 /// The experiment's plan, as the first input records it.
 struct Plan<'a> {
-    variable: Option<&'a str>,
+    variables: &'a [String],
     runs: &'a [PlannedRunRecord],
 }
 
 impl Plan<'_> {
-    /// How messages name planned run `k`: `variable=value`.
+    /// How messages name planned run `k`: `variable=value` (joined by `+` for several sweeps).
     fn label(&self, k: usize) -> String {
-        match (self.variable, self.runs[k].value.as_deref()) {
-            (Some(var), Some(v)) => format!("{var}={v}"),
-            _ => "the experiment's run".to_string(),
+        match self.variables.is_empty() {
+            true => "the experiment's run".to_string(),
+            false => crate::cli::experiment_file::sweep_label(self.variables, &self.runs[k].values),
         }
-    }
-
-    /// The swept value of planned run `k` as its CSV column writes it.
-    fn value_of(&self, k: usize) -> String {
-        self.runs[k].value.clone().unwrap_or_default()
     }
 }
 
@@ -154,7 +149,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path, options: &MergeOptions) -> Result<M
     check_one_experiment(inputs, &experiments)?;
     let first = &experiments[0];
     let plan = Plan {
-        variable: first.variable.as_deref(),
+        variables: &first.variables,
         runs: &first.runs,
     };
     let census = find_runs(inputs, &plan)?;
@@ -227,8 +222,8 @@ fn check_one_experiment(inputs: &[PathBuf], experiments: &[Record]) -> Result<()
                     json_text(&first.name)
                 ),
             ))
-        } else if e.variable != first.variable {
-            Some(("variable", String::new()))
+        } else if e.variables != first.variables {
+            Some(("variables", String::new()))
         } else if comparable(&e.runs) != first_runs {
             Some(("runs", String::new()))
         } else {
@@ -253,7 +248,7 @@ fn find_runs(inputs: &[PathBuf], plan: &Plan<'_>) -> Result<Census> {
     };
     for (at, dir) in inputs.iter().enumerate() {
         for (k, p) in plan.runs.iter().enumerate() {
-            let folder = run_folder_of(dir, plan.variable, p.value.as_deref());
+            let folder = run_folder_of(dir, plan.variables, &p.values);
             let run_json = folder.join(RUN_JSON);
             if !run_json.is_file() {
                 continue;
@@ -451,10 +446,10 @@ fn csv_parts(plan: &Plan<'_>, runs: &[MergedRun<'_>], file: &str) -> Vec<CsvPart
         .map(|r| {
             let adapter = r.found.run.adapter.as_ref().and_then(|a| a.name.as_deref());
             CsvPart {
-                lead: plan
-                    .variable
-                    .map(|_| plan.value_of(r.k))
-                    .into_iter()
+                lead: plan.runs[r.k]
+                    .values
+                    .iter()
+                    .cloned()
                     .chain([adapter.unwrap_or("unknown").to_string()])
                     .collect(),
                 source: r.found.folder.join(file),
@@ -476,7 +471,7 @@ fn write_merged(
     for r in runs {
         copy_run(&r.found.folder, &destination(out, r.found))?;
     }
-    let mut lead_header: Vec<&str> = plan.variable.into_iter().collect();
+    let mut lead_header: Vec<&str> = plan.variables.iter().map(String::as_str).collect();
     lead_header.push("adapter");
     for file in RUN_CSVS {
         concat_csv(&out.join(file), &lead_header, &csv_parts(plan, runs, file))?;

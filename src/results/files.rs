@@ -66,15 +66,16 @@ pub fn stale_run_files() -> [String; 6] {
     ]
 }
 
-/// The folder of the run with swept `value` of `variable` under `out`: `runs/<variable>=<value>/` (a comma of a
-/// value as `x`), or `out` itself without a sweep.
-pub fn run_folder_of(out: &Path, variable: Option<&str>, value: Option<&str>) -> PathBuf {
-    match (variable, value) {
-        (Some(var), Some(v)) => out
-            .join(RUNS_DIR)
-            .join(format!("{var}={}", v.replace(',', "x"))),
-        _ => out.to_path_buf(),
+/// The folder of the run with swept `values` of `variables` under `out`: `runs/<variable>=<value>/`, for several
+/// sweeps `runs/<variable>=<value>+<variable>=<value>/` (a comma of a value as `x`), or `out` itself without a
+/// sweep.
+pub fn run_folder_of(out: &Path, variables: &[String], values: &[String]) -> PathBuf {
+    if variables.is_empty() {
+        return out.to_path_buf();
     }
+    let values: Vec<String> = values.iter().map(|v| v.replace(',', "x")).collect();
+    out.join(RUNS_DIR)
+        .join(crate::cli::experiment_file::sweep_label(variables, &values))
 }
 
 /// The kinds of image `--dump-frames` writes per frame (defined where the images are made).
@@ -152,10 +153,18 @@ mod tests {
     fn folder_names() {
         assert_eq!(partial(FRAMES_CSV), "frames.csv.partial");
         assert_eq!(
-            run_folder_of(Path::new("o"), Some("viewport"), Some("64,48")),
+            run_folder_of(Path::new("o"), &["viewport".into()], &["64,48".into()]),
             Path::new("o/runs/viewport=64x48")
         );
-        assert_eq!(run_folder_of(Path::new("o"), None, None), Path::new("o"));
+        assert_eq!(
+            run_folder_of(
+                Path::new("o"),
+                &["band".into(), "viewport".into()],
+                &["0.1".into(), "64,48".into()]
+            ),
+            Path::new("o/runs/band=0.1+viewport=64x48")
+        );
+        assert_eq!(run_folder_of(Path::new("o"), &[], &[]), Path::new("o"));
         let c = ClipFiles::new("s", 2, 3);
         assert_eq!(c.frame_image(7), "s_c2_t03/frame_00007.png");
         assert_eq!(c.animation("gif"), "s_c2_t03.gif");

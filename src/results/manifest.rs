@@ -250,11 +250,12 @@ pub fn read_json<T: DeserializeOwned>(path: &Path) -> Result<serde_json::Result<
     Ok(serde_json::from_str(&text))
 }
 
-/// One planned run as experiment.json records it: the swept value and the configuration as written.
+/// One planned run as experiment.json records it: the swept values (one per sweep) and the configuration as
+/// written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlannedRunRecord {
     #[serde(default)]
-    pub value: Option<String>,
+    pub values: Vec<String>,
     #[serde(default)]
     pub config: serde_json::Value,
 }
@@ -270,7 +271,7 @@ pub struct ExperimentRecord<R> {
     #[serde(default)]
     pub file: PathBuf,
     #[serde(default)]
-    pub variable: Option<String>,
+    pub variables: Vec<String>,
     pub runs: Vec<R>,
     #[serde(default)]
     pub shard: Option<Shard>,
@@ -293,7 +294,7 @@ impl<'e> ExperimentRecord<&'e PlannedRun> {
             name: experiment.name.clone(),
             description: experiment.description.clone(),
             file: experiment.file.clone(),
-            variable: experiment.variable.clone(),
+            variables: experiment.variables.clone(),
             runs: experiment.runs.iter().collect(),
             shard,
             lodbench_version: Some(env!("CARGO_PKG_VERSION").to_string()),

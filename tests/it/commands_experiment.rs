@@ -73,7 +73,7 @@ fn three_shards_merged_equal_one_unsharded_run() {
     let text = String::from_utf8_lossy(&list.stdout);
     for (value, shard) in [("0.02", 1), ("0.05", 2), ("0.1", 3), ("0.15", 1)] {
         assert!(
-            text.contains(&format!("  {value} shard {shard}/3 ")),
+            text.contains(&format!("  band={value} shard {shard}/3 ")),
             "{text}"
         );
     }
@@ -842,4 +842,107 @@ fn the_slurm_recipe_merges_to_the_unsharded_run() {
         read_csv(&whole.join("summary.csv")).len()
     );
     assert!(out.join("shard-3/runs/band=0.1/run.json").is_file());
+}
+
+/// Two `[[sweep]]` tables cross into four runs, each in `runs/pixel-error=P+band=B/`, with a column per swept
+/// variable (pixel-error, then band) in the joined CSVs; two shards merged give the unsharded rows.
+#[test]
+fn two_variable_sweep_shards_merge_to_the_unsharded_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("two.toml");
+    std::fs::write(
+        &file,
+        "name = \"two\"\n[run]\nscene = [\"bunny-sweep\"]\nmethod = [\"discrete\", \"dither\"]\n\
+         width = 160\nheight = 120\nframes = 12\nwarmup = 0\nrounds = 2\n\
+         [[sweep]]\nvariable = \"pixel-error\"\nvalues = [0.25, 2]\n\
+         [[sweep]]\nvariable = \"band\"\nvalues = [0.05, 0.15]\n",
+    )
+    .unwrap();
+    let whole = dir.path().join("whole");
+    ok(lodbench(&["experiment", s(&file), "--out", s(&whole)], &[]));
+    assert!(whole
+        .join("runs/pixel-error=2+band=0.05/run.json")
+        .is_file());
+    let header = |p: &Path| -> Vec<String> {
+        let text = std::fs::read_to_string(p).unwrap();
+        let first = text.lines().next().unwrap_or("");
+        first.split(',').take(3).map(str::to_string).collect()
+    };
+    assert_eq!(
+        header(&whole.join("summary.csv")),
+        ["pixel-error", "band", "scene"]
+    );
+    let rows = read_csv(&whole.join("summary.csv"));
+    let runs: Vec<(String, String)> = rows
+        .iter()
+        .filter(|r| r["method"] == "discrete")
+        .map(|r| (r["pixel-error"].clone(), r["band"].clone()))
+        .collect();
+    let want = [
+        ("0.25", "0.05"),
+        ("0.25", "0.15"),
+        ("2", "0.05"),
+        ("2", "0.15"),
+    ];
+    assert_eq!(
+        runs,
+        want.map(|(a, b)| (a.to_string(), b.to_string())).to_vec()
+    );
+    // Each variable reaches its runs: the pixel error moves the switches (fewer triangles at 2), the band
+    // widens the transitions (an instance in transition only at the wider band, in these 12 frames).
+    let figure = |pe: &str, band: &str, column: &str| -> f64 {
+        rows.iter()
+            .find(|r| r["method"] == "discrete" && r["pixel-error"] == pe && r["band"] == band)
+            .unwrap()[column]
+            .parse()
+            .unwrap()
+    };
+    assert!(figure("2", "0.05", "triangles_mean") < figure("0.25", "0.05", "triangles_mean"));
+    assert!(
+        figure("0.25", "0.15", "t_instances_mean") > figure("0.25", "0.05", "t_instances_mean")
+    );
+    let mut shards = Vec::new();
+    for i in 1..=2 {
+        let out = dir.path().join(format!("shard-{i}"));
+        let shard = format!("{i}/2");
+        ok(lodbench(
+            &["experiment", s(&file), "--shard", &shard, "--out", s(&out)],
+            &[],
+        ));
+        shards.push(out);
+    }
+    let merged = dir.path().join("merged");
+    ok(lodbench(
+        &["merge", s(&shards[0]), s(&shards[1]), "--out", s(&merged)],
+        &[],
+    ));
+    let (a, b) = (
+        read_csv(&whole.join("frames.csv")),
+        read_csv(&merged.join("frames.csv")),
+    );
+    assert_eq!(a.len(), b.len());
+    let key = |rows: &Rows| -> Vec<Vec<String>> {
+        rows.iter()
+            .map(|r| {
+                [
+                    "pixel-error",
+                    "band",
+                    "method",
+                    "frame",
+                    "triangles",
+                    "lod_mean",
+                    "rmse",
+                    "lodpop",
+                ]
+                .iter()
+                .map(|c| r[*c].clone())
+                .collect()
+            })
+            .collect()
+    };
+    assert_eq!(key(&a), key(&b));
+    assert_eq!(
+        header(&merged.join("summary.csv")),
+        ["pixel-error", "band", "adapter"]
+    );
 }

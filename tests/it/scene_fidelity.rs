@@ -45,12 +45,7 @@ fn dense_mesh_sweeps_through_every_lod() {
     assert!(far_enough, "the camera comes inside the bounding sphere");
 
     let out = dir.path().join("run");
-    let mut args = vec![
-        "--scene",
-        "bunny-sweep",
-        "--method",
-        "discrete,fsi",
-    ];
+    let mut args = vec!["--scene", "bunny-sweep", "--method", "discrete,fsi"];
     args.extend_from_slice(&flags);
     args.extend_from_slice(&["--rounds", "1", "--warmup", "1"]);
     run_into(&out, &args);
