@@ -27,9 +27,15 @@ nothing but the folder's own files, see scripts/report_html.py):
   - unified_<scene>.png     unified LOD (experiment folders sweeping `pixel-error`, e.g.
                             scenes/experiments/unified-lod.toml): mean triangles, largest lodpop and mean crack pixels
                             against the pixel error, per method.
-Experiment folders carry the swept variable as the first CSV column. A `viewport` sweep gets fig8 and a `pixel-error`
-sweep the unified figure, and their first value in the other figures; any other swept variable (`fsi-check`, `noise`, ...) makes each (method, value) pair its own
-series, labelled `method (variable value)`. A merged folder (`lodbench merge`) has an `adapter` column after it:
+  - frontier_<scene>.png    experiment folders sweeping anything but the viewport (e.g.
+                            scenes/experiments/cpu/frontier-ci.toml, a band sweep): each method's cost (paired ratio to
+                            the baseline on transition frames) against its largest lodpop, the perceptual popping
+                            figure where `lodbench perceptual` ran, and mean rmse, one curve across the last swept
+                            variable; with the table "cheapest at or below a popping" (scripts/frontier.py).
+Experiment folders carry the swept variables as the first CSV columns, one per sweep. A lone `viewport` sweep gets
+fig8 and a lone `pixel-error` sweep the unified figure, and their first value in the other figures; any other sweep
+(`fsi-check`, `noise`, ..., or several crossed) makes each (method, values) combination its own series, labelled
+`method (variable value, ...)`. A merged folder (`lodbench merge`) has an `adapter` column after it:
 with more than one adapter (`merge --allow-adapters`) each (method, adapter) pair is its own series, labelled
 `method [adapter]`, so no curve mixes two GPUs.
 """
@@ -47,6 +53,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 import numpy as np  # noqa: E402
 from PIL import Image  # noqa: E402
 
+import frontier  # noqa: E402  (scripts/frontier.py, beside this file)
 import report_html  # noqa: E402  (scripts/report_html.py, beside this file)
 
 # Eleven methods and more: matplotlib's ten default colours would give two methods one colour.
@@ -153,7 +160,9 @@ def transition_pops(by_method, window=TRANSITION_WINDOW):
 
 def transition_table(rows, scene):
     """Per transition from transitions.csv (one scene, the first count): [(first, last, lods, {method: (max lodpop,
-    max pop)})], the reference left out."""
+    max pop)})], the reference left out. A transition is its frames as well as its index: runs of a sweep whose
+    schedules differ (band, pixel error) have different transitions under one index, and each is its own entry,
+    the methods of the other runs missing from it."""
     rows = [r for r in rows if r["scene"] == scene]
     if not rows:
         return []
@@ -162,17 +171,29 @@ def transition_table(rows, scene):
     for r in rows:
         if r["count"] != first_count or r["method"].startswith("reference"):
             continue
-        key = int(r["transition"])
+        key = (int(r["transition"]), int(r["first_frame"]), int(r["last_frame"]), r["lods"])
         entry = out.setdefault(key, (int(r["first_frame"]), int(r["last_frame"]), r["lods"], OrderedDict()))
         entry[3][r["method"]] = (num(r["lodpop_max"]), num(r["pop_max"]))
-    return list(out.values())
+    return [out[k] for k in sorted(out, key=lambda k: (k[1], k[0], k[2], k[3]))]
+
+
+def k_none(per_transition):
+    """Whether the entries are (first, last, {method: pop}) (older folders), not (..., lods, {method: (lodpop,
+    pop)})."""
+    return len(per_transition[0]) != 4
+
+
+def transition_methods(per_transition):
+    """Every method of the per-transition entries, in order of first appearance."""
+    return list(OrderedDict.fromkeys(m for p in per_transition for m in p[-1]))
 
 
 def transitions_figure(scene, per_transition, path):
     """Bars per transition and method: lodpop (top) and pop (bottom) from transitions.csv, or pop alone from the
     frames (older folders: `per_transition` entries are (first, last, {method: pop}))."""
     with_lodpop = len(per_transition[0]) == 4
-    methods = list(per_transition[0][-1])
+    methods = transition_methods(per_transition)
+    missing = float("nan") if k_none(per_transition) else (float("nan"), float("nan"))
     x = np.arange(len(per_transition))
     width = 0.8 / len(methods)
     panels = [("max lodpop (pose held)", 0), ("max pop (motion included)", 1)] if with_lodpop else \
@@ -181,7 +202,7 @@ def transitions_figure(scene, per_transition, path):
                              squeeze=False)
     for ax, (label, k) in zip(axes[:, 0], panels):
         for i, m in enumerate(methods):
-            vals = [p[-1][m] if k is None else p[-1][m][k] for p in per_transition]
+            vals = [p[-1].get(m, missing) if k is None else p[-1].get(m, missing)[k] for p in per_transition]
             ax.bar(x - 0.4 + (i + 0.5) * width, vals, width, label=m)
         ticks = [f"frames {p[0]}-{p[1]}" + (f"\n{p[2]}" if with_lodpop else "") for p in per_transition]
         ax.set_xticks(x, ticks, rotation=20, fontsize=8)
@@ -474,15 +495,30 @@ def report(folder: Path, transition: str = "worst") -> list:
     figs.mkdir(exist_ok=True)
     made = []
     tables = []
-    first_column = next(iter(summary[0]), None) if summary else None
-    # A merged folder's `adapter` column is no swept variable (it follows the variable, or leads without one).
-    variable = first_column if first_column not in (None, "scene", "adapter") else None
+    header = list(summary[0]) if summary else []
+    # The swept variables lead the columns, one per sweep; a merged folder's `adapter` column follows them.
+    variables = [c for c in header[:header.index("scene")] if c != "adapter"] if "scene" in header else []
+    variable = variables[0] if len(variables) == 1 else None
     swept = variable in ("viewport", "pixel-error")
     first_viewport = summary[0][variable] if swept else None
-    if variable and not swept:
-        # Each value of the swept variable is its own series, in the figures and the tables.
+    frontier_tables = []
+    if variables and variable != "viewport" and any(r.get("lodpop_max") for r in summary):
+        # Before the methods are relabelled below: pairs.csv names them as the runs do.
+        pairs = read_csv(folder / "pairs.csv") if (folder / "pairs.csv").is_file() else []
+        pts = frontier.points(folder, summary, variables)
+        for (scene,), scene_pts in group(pts, "scene").items():
+            first_count = scene_pts[0]["count"]
+            scene_pts = [p for p in scene_pts if p["count"] == first_count]
+            frontier.figure(scene, scene_pts, variables[-1], figs / f"frontier_{scene}.png")
+            made.append((f"frontier_{scene}.png", f"{scene}: cost against popping across {variables[-1]}"))
+            rows = frontier.cheapest(scene, scene_pts, pairs, variables, variables[-1])
+            if rows:
+                frontier_tables.append((f"{scene}: cheapest at or below a popping (paired within a run)", rows,
+                                        frontier.COLUMNS))
+    if variables and not swept:
+        # Each combination of swept values is its own series, in the figures and the tables.
         for r in summary + frames + (transitions_csv or []):
-            r["method"] = f"{r['method']} ({variable} {r[variable]})"
+            r["method"] = f"{r['method']} ({', '.join(f'{v} {r[v]}' for v in variables)})"
     adapters = sorted({r["adapter"] for r in summary if "adapter" in r})
     if len(adapters) > 1:
         # Runs on different GPUs (merge --allow-adapters): each (method, adapter) is its own series.
@@ -530,24 +566,24 @@ def report(folder: Path, transition: str = "worst") -> list:
         if any(r["rmse_mean"] != "" for r in scene_summary):
             cost(scene, scene_summary, figs / f"cost_{scene}.png")
             made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
-    columns = ([variable] if variable else []) + (["adapter"] if len(adapters) > 1 else []) + [
+    columns = variables + (["adapter"] if len(adapters) > 1 else []) + [
                "scene", "method", "count", "frames", "gpu_ms_median",
                "gpu_ms_median_transition", "ratio_to_baseline", "ratio_to_baseline_ci95_lo", "ratio_to_baseline_ci95_hi",
                "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
                "de2000_mean"] + (["lodpop_max", "lodpop_sum"] if summary and "lodpop_max" in summary[0] else []) \
         + (["crack_px_mean", "units_drawn_mean"] if summary and "crack_px_mean" in summary[0] else [])
     # The tables once, as (heading, rows, columns): report.md and report.html render the same ones.
-    sections = [("Summary", summary, columns)]
+    sections = [("Summary", summary, columns)] + frontier_tables
     for scene, per_transition in tables:
-        methods = list(per_transition[0][-1])
+        methods = transition_methods(per_transition)
         if len(per_transition[0]) == 4:
             for k, what in ((0, "max lodpop (pose held)"), (1, "max pop (motion included)")):
-                rows = [{"transition": f"frames {a}-{b} ({lods})", **{m: f"{p[m][k]:.4f}" for m in methods}}
+                rows = [{"transition": f"frames {a}-{b} ({lods})", **{m: f"{p[m][k]:.4f}" for m in methods if m in p}}
                         for a, b, lods, p in per_transition]
                 sections.append((f"{scene}: {what} of each transition (its frames and the 2 after)", rows,
                                  ["transition"] + methods))
         else:
-            rows = [{"transition": f"frames {a}-{b}", **{m: f"{p[m]:.4f}" for m in methods}}
+            rows = [{"transition": f"frames {a}-{b}", **{m: f"{p[m]:.4f}" for m in methods if m in p}}
                     for a, b, p in per_transition]
             sections.append((f"{scene}: max pop within {TRANSITION_WINDOW} frames of each transition", rows,
                              ["transition"] + methods))

@@ -75,6 +75,20 @@ def check_experiment(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="session")
+def band_experiment(tmp_path_factory) -> Path:
+    """A two-variable sweep (pixel error x band) of bunny-sweep at 160x120 with transitions in every run."""
+    base = tmp_path_factory.mktemp("experiment")
+    spec = base / "band.toml"
+    spec.write_text('name = "band"\n[run]\nscene = ["bunny-sweep"]\nmethod = ["discrete", "alpha", "dither"]\n'
+                    'width = 160\nheight = 120\nframes = 60\nwarmup = 0\nrounds = 4\n'
+                    '[[sweep]]\nvariable = "pixel-error"\nvalues = [0.25, 0.5]\n'
+                    '[[sweep]]\nvariable = "band"\nvalues = [0.05, 0.15]\n')
+    out = base / "run"
+    lodbench("experiment", str(spec), "--out", str(out))
+    return out
+
+
+@pytest.fixture(scope="session")
 def pixel_error_experiment(tmp_path_factory) -> Path:
     """A two-value pixel-error sweep of the terrain at the regress profile (small), every unified method."""
     base = tmp_path_factory.mktemp("experiment")
