@@ -3,6 +3,11 @@
 //! (`lod_from`) elsewhere. The two tests are complementary, so each pixel of the overlap shows exactly one of
 //! them, and depth writes stay on: no sorting, no translucency. The threshold pattern is `--noise`
 //! (`src/methods/noise.rs`), tiled in screen space.
+//!
+//! `dither-skip` (Sheliemietiev et al. 2023 section 9, Fig. 3: "at certain thresholds only one model needs
+//! drawing") draws a t-instance's LOD only where the pattern can give it a pixel: the incoming LOD keeps a pixel
+//! where k > t, so none while k <= the pattern's smallest threshold; the outgoing keeps one where k <= t, so
+//! none while k > its largest. The image is dither's, byte for byte; only the skipped draws go.
 
 use super::common::{instance_raw, FrameInput, Method};
 use crate::gpu::{DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
@@ -47,10 +52,32 @@ pub struct Dither {
     temporal: Option<u32>,
     /// lodpop's counterfactual: the frame whose pattern phase to draw instead of the input's (t-1).
     pattern_frame: Option<u32>,
+    /// `dither-skip`: the pattern's smallest and largest threshold (a LOD with no pixel at this k is not drawn).
+    skip: Option<(f32, f32)>,
+}
+
+/// The smallest and the largest threshold `fs_dither` can compare k with: the texture's values, or for
+/// interleaved gradient noise (computed in the shader, a `fract`) 0 and the largest f32 below 1.
+fn threshold_bounds(values: Option<&[f32]>) -> (f32, f32) {
+    match values {
+        Some(v) => v
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &t| {
+                (lo.min(t), hi.max(t))
+            }),
+        None => (0.0, 1.0 - f32::EPSILON / 2.0),
+    }
 }
 
 impl Dither {
-    pub fn new(gpu: &SceneGpu, scene: &Scene, options: &DitherOptions, seed: u64) -> Self {
+    /// `skip`: `dither-skip` (the LODs the pattern gives no pixel are not drawn).
+    pub fn new(
+        gpu: &SceneGpu,
+        scene: &Scene,
+        options: &DitherOptions,
+        seed: u64,
+        skip: bool,
+    ) -> Self {
         let device = &gpu.device;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dither noise layout"),
@@ -78,7 +105,9 @@ impl Dither {
             ],
         });
         // Interleaved gradient noise needs no texture: a 1x1 placeholder keeps the layout the same.
-        let (size, values) = threshold_texture(options.noise, seed).unwrap_or((0, vec![0.5]));
+        let pattern = threshold_texture(options.noise, seed);
+        let skip = skip.then(|| threshold_bounds(pattern.as_ref().map(|(_, v)| v.as_slice())));
+        let (size, values) = pattern.unwrap_or((0, vec![0.5]));
         let side = size.max(1);
         let texture = gpu.create_value_texture("dither thresholds", side, &values);
         let params = device.create_buffer(&wgpu::BufferDescriptor {
@@ -128,6 +157,7 @@ impl Dither {
             params,
             temporal,
             pattern_frame: None,
+            skip,
         }
     }
 }
@@ -185,18 +215,28 @@ impl Method for Dither {
         self.list.clear();
         for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
             if s.in_transition() {
-                self.list.push(
-                    DITHERED,
-                    inst.model,
-                    s.lod_to,
-                    instance_raw(input, i, s.k, ROLE_INCOMING, s.lod_to),
-                );
-                self.list.push(
-                    DITHERED,
-                    inst.model,
-                    s.lod_from,
-                    instance_raw(input, i, s.k, ROLE_OUTGOING, s.lod_from),
-                );
+                // Whether the pattern gives the incoming (k > t for some t) and the outgoing (k <= t for some t)
+                // LOD a pixel; without dither-skip both are drawn.
+                let (incoming, outgoing) = match self.skip {
+                    Some((lo, hi)) => (s.k > lo, s.k <= hi),
+                    None => (true, true),
+                };
+                if incoming {
+                    self.list.push(
+                        DITHERED,
+                        inst.model,
+                        s.lod_to,
+                        instance_raw(input, i, s.k, ROLE_INCOMING, s.lod_to),
+                    );
+                }
+                if outgoing {
+                    self.list.push(
+                        DITHERED,
+                        inst.model,
+                        s.lod_from,
+                        instance_raw(input, i, s.k, ROLE_OUTGOING, s.lod_from),
+                    );
+                }
             } else {
                 self.list.push(
                     STEADY,
@@ -224,5 +264,31 @@ impl Method for Dither {
             &self.list,
             &[&self.steady, &self.dithered],
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bounds are the pattern's extreme thresholds, so a k at or below the smallest gives the incoming LOD
+    /// no pixel (k > t fails for every t) and a k above the largest gives the outgoing none.
+    #[test]
+    fn bounds_are_the_patterns_extremes() {
+        let (lo, hi) = threshold_bounds(Some(&[0.5, 0.03125, 0.96875, 0.2]));
+        assert_eq!((lo, hi), (0.03125, 0.96875));
+        let (lo, hi) = threshold_bounds(None);
+        assert_eq!(lo, 0.0);
+        assert!(hi < 1.0 && hi + f32::EPSILON / 2.0 == 1.0);
+        for p in [
+            NoisePattern::White16,
+            NoisePattern::Bayer4,
+            NoisePattern::Blue64,
+        ] {
+            let (_, v) = threshold_texture(p, 3).unwrap();
+            let (lo, hi) = threshold_bounds(Some(&v));
+            assert!(v.iter().all(|&t| lo <= t && t <= hi));
+            assert!(v.contains(&lo) && v.contains(&hi));
+        }
     }
 }

@@ -82,7 +82,8 @@ pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "alpha-2pass", about: "unpopping, double pass: each translucent LOD shows only its nearest surface", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene, alpha_2pass::Weights::Unpop))), options: no_options },
     MethodEntry { name: "alpha-linear", about: "Sheliemietiev et al. 2023's alpha blending: both LODs translucent, 1 - k and k, double pass each", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene, alpha_2pass::Weights::Linear))), options: no_options },
     MethodEntry { name: "alpha-zwrite", about: "Blow's unpopping: translucent with Z-writes, the compare switch", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
-    MethodEntry { name: "dither", about: "noise blending: complementary screen-space discard", create: |b| Ok(Box::new(dither::Dither::new(b.gpu, b.scene, &b.options.dither, b.seed))), options: |o| json(o.dither) },
+    MethodEntry { name: "dither", about: "noise blending: complementary screen-space discard", create: |b| Ok(Box::new(dither::Dither::new(b.gpu, b.scene, &b.options.dither, b.seed, false))), options: |o| json(o.dither) },
+    MethodEntry { name: "dither-skip", about: "dither, a LOD the pattern gives no pixel at this k not drawn (not run by default)", create: |b| Ok(Box::new(dither::Dither::new(b.gpu, b.scene, &b.options.dither, b.seed, true))), options: |o| json(o.dither) },
     MethodEntry { name: "geomorph", about: "geomorphing: the finer LOD's vertices move to their targets on the coarser", create: |b| Ok(Box::new(geomorph::Geomorph::new(b.gpu, b.scene, &b.options.geomorph))), options: |o| json(o.geomorph) },
     MethodEntry { name: "fsi", about: "Frame Sequential Interpolation (Scherzer & Wimmer 2008)", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::Sequential))), options: |o| json(o.fsi) },
     MethodEntry { name: "fsi-noreproject", about: "FSI ablation: the older buffer read at the same pixel", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::NoReproject))), options: |o| json(o.fsi.vis_texture) },
@@ -176,6 +177,10 @@ pub const UNIFIED_DEFAULT: [&str; 5] = [
     "clusterlod",
 ];
 
+/// Built-in methods a run draws only when `--method` names them: variants that test a claim (their image is
+/// another method's, or they ablate one).
+pub const NOT_DEFAULT: [&str; 1] = ["dither-skip"];
+
 /// Whether the method of `label` needs a unified scene.
 pub fn needs_unified(label: &str) -> bool {
     UNIFIED_ONLY.contains(&base_name(label))
@@ -187,7 +192,7 @@ pub fn defaults_for(unified: bool) -> Vec<&'static str> {
         .into_iter()
         .filter(|n| match unified {
             true => UNIFIED_DEFAULT.contains(n),
-            false => !needs_unified(n),
+            false => !needs_unified(n) && !NOT_DEFAULT.contains(n),
         })
         .collect()
 }

@@ -218,3 +218,53 @@ fn alpha_linear_blends_both_lods_with_weights_one_minus_k_and_k() {
         "alpha-2pass matches Sheliemietiev et al. 2023's linear blend on all but {bad} of {both} pixels: the check cannot tell them apart"
     );
 }
+
+/// dither-skip (Sheliemietiev et al. 2023 section 9: "at certain thresholds only one model needs drawing"): on a
+/// bunny sweep with the 4x4 Bayer pattern (thresholds 1/32 to 31/32, so a transition's first and last frames give
+/// one LOD no pixel), every image figure of every frame equals dither's, and the frames at the ends of a
+/// transition draw fewer triangles.
+#[test]
+fn dither_skip_draws_less_for_the_same_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let args = [
+        "--scene",
+        "bunny-sweep",
+        "--method",
+        "dither,dither-skip",
+        "--noise",
+        "bayer4",
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--frames",
+        "90",
+        "--warmup",
+        "0",
+        "--rounds",
+        "1",
+        "--band",
+        "0.15",
+    ];
+    crate::common::run_into(&out, &args);
+    let rows = crate::common::read_csv(&out.join("frames.csv"));
+    let of = |m: &str| -> Vec<&crate::common::Row> {
+        rows.iter().filter(|r| r["method"] == m).collect()
+    };
+    let (full, skip) = (of("dither"), of("dither-skip"));
+    assert_eq!(full.len(), 90);
+    let mut fewer = 0;
+    for (a, b) in full.iter().zip(&skip) {
+        for c in ["rmse", "pop", "lodpop", "t_instances", "k_mean"] {
+            assert_eq!(a[c], b[c], "frame {}: {c}", a["frame"]);
+        }
+        let (ta, tb): (u64, u64) = (
+            a["triangles"].parse().unwrap(),
+            b["triangles"].parse().unwrap(),
+        );
+        assert!(tb <= ta, "frame {}: {tb} > {ta}", a["frame"]);
+        fewer += (tb < ta) as u32;
+    }
+    assert!(fewer >= 2, "dither-skip drew less on {fewer} frames");
+}
