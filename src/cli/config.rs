@@ -80,6 +80,7 @@ impl SceneConfig {
             band: a.band,
             fade_frames: a.fade_frames,
             hysteresis: a.hysteresis,
+            max_transitions: a.max_transitions,
         };
         schedule.validate()?;
         let camera_path = match &a.camera_path {

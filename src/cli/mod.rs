@@ -243,6 +243,10 @@ pub struct SceneArgs {
     /// Hysteresis margin as a fraction of the switch distance.
     #[arg(long, default_value_t = 0.0)]
     pub hysteresis: f32,
+    /// At most this many instances in transition at once (0: no cap; needs --fade time): an instance whose LOD
+    /// should change waits, keeping its LOD, until a fade ends (run.json: wait_instance_frames).
+    #[arg(long, default_value_t = 0)]
+    pub max_transitions: u32,
     /// Camera motion: `fixed` (the scene's own path) or `orbit` (the camera swings around what it looks at,
     /// +-30 degrees over 240 frames, keeping its distance: every pixel moves, which exercises FSI's
     /// reprojection).

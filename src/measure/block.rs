@@ -215,6 +215,8 @@ impl<'a> BlockRunner<'a> {
             }),
             counterfactual_frame_share: quality.map(|q| q.counterfactual_frames as f64 / frames),
             reference_frames_copied: quality.map(|q| q.reference_frames_copied),
+            wait_instance_frames: timed.facts.iter().map(|f| f.t_waiting as u64).sum(),
+            waiting_max: timed.facts.iter().map(|f| f.t_waiting).max().unwrap_or(0),
             metric_gpu_ms_median: quality.and_then(|q| q.metric_gpu_ms_median),
             metric_tile_share: quality.map(|q| q.metric_tile_share),
             counterfactual_pixel_share: quality.and_then(|q| q.counterfactual_pixel_share),

@@ -39,6 +39,8 @@ pub struct FrameFacts {
     pub k_mean: Option<f64>,
     /// The LODs the t-instances go between.
     pub pair: TransitionPair,
+    /// Instances `--max-transitions` held back this frame (their LOD should change, no slot was free).
+    pub t_waiting: u32,
 }
 
 impl<'s> FrameDriver<'s> {
@@ -89,6 +91,7 @@ impl<'s> FrameDriver<'s> {
             t_instances: t,
             k_mean: (t > 0).then(|| k_sum / t as f64),
             pair,
+            t_waiting: self.schedule.take_waiting(),
         }
     }
 

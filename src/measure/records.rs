@@ -601,6 +601,11 @@ pub struct BlockInfo {
     /// reference cache, kept by an earlier method's pass, or in the reference's own pass from its own frame
     /// (0: all drawn; None: no quality pass).
     pub reference_frames_copied: Option<u32>,
+    /// The frames instances waited for a slot under `--max-transitions`, summed over instances (0 without a
+    /// cap): the delay the cap costs.
+    pub wait_instance_frames: u64,
+    /// The most instances waiting on one frame.
+    pub waiting_max: u32,
     /// Median GPU time of the metric kernel alone per quality-pass frame (None without timestamps).
     pub metric_gpu_ms_median: Option<f64>,
     /// The share of the frame's 16 x 16 pixel tiles the metric kernel read, mean over the quality pass's frames (1.0 with

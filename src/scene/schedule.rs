@@ -29,6 +29,11 @@ pub struct ScheduleParams {
     /// Hysteresis margin as a fraction of the switch distance: coarsening happens around s(1+h), refining
     /// around s(1-h). 0 = plain thresholds, as in the papers.
     pub hysteresis: f32,
+    /// `--max-transitions`: at most this many instances in transition at once (0: no cap; time fades only).
+    /// An instance whose LOD should change while the cap is reached keeps its LOD, waiting, until a fade ends
+    /// (Sheliemietiev et al. 2023 section 8: a steadier frame rate at the cost of a delay).
+    #[serde(default)]
+    pub max_transitions: u32,
 }
 
 impl Default for ScheduleParams {
@@ -38,6 +43,7 @@ impl Default for ScheduleParams {
             band: 0.05,
             fade_frames: 30,
             hysteresis: 0.0,
+            max_transitions: 0,
         }
     }
 }
@@ -58,6 +64,13 @@ impl ScheduleParams {
         }
         if self.fade_frames == 0 {
             return Err(Error::Config("--fade-frames must be at least 1".into()));
+        }
+        if self.max_transitions > 0 && self.fade != FadeMode::Time {
+            return Err(Error::Config(format!(
+                "--max-transitions {} needs --fade time: a distance fade's k is the instance's place in its band, \
+                 so holding an instance back would end in a pop",
+                self.max_transitions
+            )));
         }
         Ok(())
     }
@@ -174,6 +187,14 @@ struct Track {
 pub struct LodSchedule {
     params: ScheduleParams,
     tracks: Vec<Option<Track>>,
+    /// Instances fading now, and of this frame's updates so far those held back by `--max-transitions`.
+    slots: Slots,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct Slots {
+    fading: u32,
+    waiting: u32,
 }
 
 impl LodSchedule {
@@ -181,6 +202,7 @@ impl LodSchedule {
         LodSchedule {
             params,
             tracks: vec![None; instances],
+            slots: Slots::default(),
         }
     }
 
@@ -191,6 +213,13 @@ impl LodSchedule {
     /// Forgets all history: the next update is treated as the first frame.
     pub fn reset(&mut self) {
         self.tracks.iter_mut().for_each(|t| *t = None);
+        self.slots = Slots::default();
+    }
+
+    /// How many instances `--max-transitions` held back (their LOD should change, no slot was free) in the
+    /// updates since the last call: called once a frame, after its updates, it is that frame's count.
+    pub fn take_waiting(&mut self) -> u32 {
+        std::mem::take(&mut self.slots.waiting)
     }
 
     /// The state of instance `i` at camera distance `d`, given its model's switch distances (LOD j+1 is
@@ -203,7 +232,7 @@ impl LodSchedule {
         });
         match p.fade {
             FadeMode::Distance => distance_state(&p, track, d, switches),
-            FadeMode::Time => time_state(&p, track, d, switches),
+            FadeMode::Time => time_state(&p, track, d, switches, &mut self.slots),
         }
     }
 }
@@ -242,7 +271,13 @@ fn distance_state(p: &ScheduleParams, t: &mut Track, d: f32, s: &[f32]) -> Insta
     InstanceState::steady(t.sel)
 }
 
-fn time_state(p: &ScheduleParams, t: &mut Track, d: f32, s: &[f32]) -> InstanceState {
+fn time_state(
+    p: &ScheduleParams,
+    t: &mut Track,
+    d: f32,
+    s: &[f32],
+    slots: &mut Slots,
+) -> InstanceState {
     let h = p.hysteresis;
     let n = s.len() as u32;
     let mut target = t.sel;
@@ -258,7 +293,12 @@ fn time_state(p: &ScheduleParams, t: &mut Track, d: f32, s: &[f32]) -> InstanceS
     let step = 1.0 / p.fade_frames as f32;
     let fading = match t.fading {
         Some((to, k)) => Some((to, k + step)),
+        None if target != t.sel && p.max_transitions > 0 && slots.fading >= p.max_transitions => {
+            slots.waiting += 1;
+            None
+        }
         None if target != t.sel => {
+            slots.fading += 1;
             let to = if target > t.sel { t.sel + 1 } else { t.sel - 1 };
             Some((to, step))
         }
@@ -276,6 +316,7 @@ fn time_state(p: &ScheduleParams, t: &mut Track, d: f32, s: &[f32]) -> InstanceS
         Some((to, _)) => {
             t.sel = to;
             t.fading = None;
+            slots.fading -= 1;
             InstanceState::steady(to)
         }
         None => InstanceState::steady(t.sel),
@@ -422,6 +463,54 @@ mod tests {
                 (3, 3),
                 (3, 3)
             ]
+        );
+    }
+
+    /// `--max-transitions 1`: three instances crossing their switch on the same frame fade one after another
+    /// (never two at once), each waiting for the one before, where without the cap all three fade together.
+    #[test]
+    fn a_cap_on_transitions_queues_them() {
+        let run = |cap: u32| {
+            let p = ScheduleParams {
+                fade: FadeMode::Time,
+                fade_frames: 4,
+                max_transitions: cap,
+                ..Default::default()
+            };
+            p.validate().unwrap();
+            let mut sch = LodSchedule::new(p, 3);
+            let mut frames = Vec::new();
+            for f in 0..16 {
+                let d = if f == 0 { 5.0 } else { 15.0 };
+                let states: Vec<InstanceState> = (0..3).map(|i| sch.update(i, d, &S)).collect();
+                frames.push((states, sch.take_waiting()));
+            }
+            frames
+        };
+        let fading = |fr: &[(Vec<InstanceState>, u32)]| -> Vec<usize> {
+            fr.iter()
+                .map(|(s, _)| s.iter().filter(|s| s.in_transition()).count())
+                .collect()
+        };
+        let (free, capped) = (run(0), run(1));
+        assert_eq!(fading(&free)[..5], [0, 3, 3, 3, 0]);
+        assert!(free.iter().all(|(_, w)| *w == 0));
+        let n = fading(&capped);
+        assert!(n.iter().all(|&n| n <= 1), "{n:?}");
+        // Each fade shows k in (0, 1) on 3 frames and ends on the 4th, where the next instance (updated after it)
+        // takes the freed slot at once.
+        assert_eq!(n[..13], [0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0]);
+        let waiting: Vec<u32> = capped.iter().map(|(_, w)| *w).collect();
+        assert_eq!(waiting[..10], [0, 2, 2, 2, 1, 1, 1, 0, 0, 0]);
+        assert!(capped[15].0.iter().all(|s| *s == InstanceState::steady(1)));
+        let distance = ScheduleParams {
+            max_transitions: 2,
+            ..Default::default()
+        };
+        let e = distance.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("--max-transitions 2") && e.contains("--fade time"),
+            "{e}"
         );
     }
 

@@ -598,3 +598,58 @@ fn a_method_listed_twice_runs_twice() {
             > 0.0
     );
 }
+
+/// `--max-transitions` reaches the run: on windmills (ci, timing only) with time fades a cap of 1 holds instances back (run.json's
+/// wait_instance_frames and waiting_max above 0, t_instances never above 1), and without it nothing waits.
+#[test]
+fn max_transitions_caps_t_instances_and_records_the_wait() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |cap: &str| {
+        let out = dir.path().join(format!("cap{cap}"));
+        crate::common::run_into(
+            &out,
+            &[
+                "--scene",
+                "windmills",
+                "--profile",
+                "ci",
+                "--fade",
+                "time",
+                "--fade-frames",
+                "8",
+                "--max-transitions",
+                cap,
+                "--method",
+                "discrete",
+                "--quality",
+                "off",
+                "--rounds",
+                "1",
+                "--warmup",
+                "0",
+            ],
+        );
+        let run: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+        let b = &run["blocks"][0];
+        let t_max = crate::common::read_csv(&out.join("frames.csv"))
+            .iter()
+            .map(|r| r["t_instances"].parse::<u32>().unwrap())
+            .max()
+            .unwrap();
+        (
+            b["wait_instance_frames"].as_u64().unwrap(),
+            b["waiting_max"].as_u64().unwrap(),
+            t_max,
+        )
+    };
+    let (free_wait, _, free_t) = run("0");
+    let (wait, waiting_max, t) = run("1");
+    assert_eq!(free_wait, 0);
+    assert!(
+        free_t > 1,
+        "without a cap several windmills fade at once ({free_t})"
+    );
+    assert_eq!(t, 1);
+    assert!(wait > 0 && waiting_max > 0, "{wait} {waiting_max}");
+}
