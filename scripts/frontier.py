@@ -166,3 +166,4 @@ def cheapest(scene, pts, pairs, variables, curve):
 
 
 COLUMNS = ["lodpop at most", "cheapest", "cost", "next in the same run", "paired"]
+# "cheapest" is the least cost by point estimate, across runs; only the "paired" column tests a difference.
