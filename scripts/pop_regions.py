@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Where a method's pop comes from: the object's silhouette or its interior, from a run's dumped frames.
 
-    python3 scripts/pop_regions.py RUN_DIR [--method fsi,discrete] [--frames 40-50] [--band 2]
+    python3 scripts/pop_regions.py RUN_DIR [--method fsi,discrete] [--frames 40-50] [--band 2] [--border 4]
 
 RUN_DIR is a `lodbench run --dump-frames` folder (frames need their predecessor dumped: `--dump-every 1`, the
 default, with or without `--dump-transitions`). For each dumped frame t of each method, from the PNGs:
@@ -12,7 +12,11 @@ default, with or without `--dump-transitions`). For each dumped frame t of each 
   - interior   the share on the rest of the pixels the object covers in the reference at t or t-1 (the two
                shares need not sum to 1: the remainder lies on background outside the band);
   - extra      pixels where the method shows the object and the reference shows background (at t);
-  - missing    pixels where the reference shows the object and the method shows background (at t).
+  - missing    pixels where the reference shows the object and the method shows background (at t);
+  - border     the share of sum (E_t - E_{t-1})^2 on the pixels within --border pixels of the viewport's edge
+               (where a camera's motion brings in pixels no earlier frame saw: FSI's border artefacts), whatever
+               they show;
+  - border_pop pop over those pixels alone: sqrt(mean over them and the channels of (E_t - E_{t-1})^2).
 "Object" is any pixel whose colour differs from the background, which is the most frequent colour on the
 reference's border (override with --background R,G,B as bytes). Exit 2 with a message on a folder without dumps.
 """
@@ -44,9 +48,9 @@ def border_colour(img: np.ndarray) -> tuple:
     return Counter(map(tuple, border)).most_common(1)[0][0]
 
 
-def regions(method_prev, reference_prev, method, reference, band, background=None) -> dict:
+def regions(method_prev, reference_prev, method, reference, band, background=None, border=4) -> dict:
     """The numbers of one frame t from the method and reference images (H x W x 3, values in [0, 1], as
-    `load_rgb` reads them) at t-1 and t; `background` in the same units."""
+    `load_rgb` reads them) at t-1 and t; `background` in the same units; `border`: the edge strip's width."""
     bg = np.array(background if background is not None else border_colour(reference))
     diff = (method - reference) - (method_prev - reference_prev)
     energy = (diff ** 2).sum(axis=2)
@@ -56,12 +60,17 @@ def regions(method_prev, reference_prev, method, reference, band, background=Non
     silhouette = dilate(obj, band) & dilate(~obj, band)
     interior = (obj | obj_prev) & ~silhouette
     total = energy.sum()
+    edge = np.zeros(energy.shape, dtype=bool)
+    edge[:border] = edge[-border:] = True
+    edge[:, :border] = edge[:, -border:] = True
     return {
         "pop": float(np.sqrt(energy.sum() / diff.size)),
         "silhouette": float(energy[silhouette].sum() / total) if total > 0 else 0.0,
         "interior": float(energy[interior].sum() / total) if total > 0 else 0.0,
         "extra": int((shown & ~obj).sum()),
         "missing": int((obj & ~shown).sum()),
+        "border": float(energy[edge].sum() / total) if total > 0 else 0.0,
+        "border_pop": float(np.sqrt(energy[edge].sum() / (3 * edge.sum()))),
     }
 
 
@@ -90,6 +99,7 @@ def main() -> int:
     ap.add_argument("--frames", help="frames t to report, e.g. 40-50,60 (default: every dumped frame whose "
                                      "predecessor is dumped)")
     ap.add_argument("--band", type=int, default=2, help="silhouette half-width in pixels (default 2)")
+    ap.add_argument("--border", type=int, default=4, help="width in pixels of the viewport's edge strip (default 4)")
     ap.add_argument("--background", help="background colour as R,G,B bytes (default: the reference's most "
                                           "frequent border colour)")
     args = ap.parse_args()
@@ -99,6 +109,9 @@ def main() -> int:
         background = parse_background(args.background) if args.background else None
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
+        return 2
+    if args.border < 1:
+        print(f"error: --border {args.border}: expected 1 or more", file=sys.stderr)
         return 2
     if args.band < 1:
         print(f"error: --band {args.band}: expected 1 or more", file=sys.stderr)
@@ -114,7 +127,7 @@ def main() -> int:
         with open(args.run / "frames.csv", newline="") as f:
             for r in csv.DictReader(f):
                 csv_pop[(r["scene"], r["method"], r["count"], r["frame"])] = r["pop"]
-    print("scene,method,count,frame,pop,pop_csv,silhouette,interior,extra,missing")
+    print("scene,method,count,frame,pop,pop_csv,silhouette,interior,extra,missing,border,border_pop")
     reported = 0
     for key in keys:
         scene, method, count, frame = key
@@ -125,10 +138,11 @@ def main() -> int:
         paths = [Path(f"{stem}{f:05d}_{kind}.png") for f in (t - 1, t) for kind in ("method", "reference")]
         if not all(p.is_file() for p in paths):
             continue
-        r = regions(*(load_rgb(p) for p in paths), band=args.band, background=background)
+        r = regions(*(load_rgb(p) for p in paths), band=args.band, background=background, border=args.border)
         pop_csv = csv_pop.get(key, "")
         print(f"{scene},{method},{count},{t},{r['pop']:.6f},{pop_csv and f'{float(pop_csv):.6f}'},"
-              f"{r['silhouette']:.4f},{r['interior']:.4f},{r['extra']},{r['missing']}")
+              f"{r['silhouette']:.4f},{r['interior']:.4f},{r['extra']},{r['missing']},{r['border']:.4f},"
+              f"{r['border_pop']:.6f}")
         reported += 1
     if reported == 0:
         print("error: no dumped frame matched whose previous frame is dumped too (--method, --frames, "

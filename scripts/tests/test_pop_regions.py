@@ -81,6 +81,27 @@ def test_colour_change_inside_is_all_interior(tmp_path):
     assert float(y["silhouette"]) == 1.0
 
 
+def test_border_strip(tmp_path):
+    # The square sits at columns 8-15, rows 10-17: a change there lies 8 or more pixels from the edge, so none of
+    # it is in a 4-pixel border; a change of the same size in the top-left corner is all border.
+    reference = [square(8), square(8)]
+    inside = square(8)
+    inside[12:14, 10:12] = [c + 20 for c in FG]
+    (x,) = rows(run(write_run(tmp_path / "inside", [square(8), inside], reference)).stdout)
+    assert float(x["border"]) == 0.0 and float(x["border_pop"]) == 0.0
+    corner = square(8)
+    corner[0:2, 0:2] = (30, 30, 30)
+    (y,) = rows(run(write_run(tmp_path / "corner", [square(8), corner], reference)).stdout)
+    assert float(y["border"]) == 1.0
+    # border_pop: the same energy over the 32 x 32 - 24 x 24 = 448 border pixels instead of all 1,024.
+    assert abs(float(y["border_pop"]) - float(y["pop"]) * np.sqrt(1024 / 448)) < 2e-6
+    (z,) = rows(run(tmp_path / "corner", "--border", "1").stdout)
+    # A 1-pixel strip holds three of the four changed pixels: (0, 0), (0, 1) and (1, 0), not (1, 1).
+    assert float(z["border"]) == 0.75
+    r = run(tmp_path / "corner", "--border", "0")
+    assert r.returncode == 2 and "--border" in r.stderr
+
+
 def test_bad_input_is_named(tmp_path):
     r = run(tmp_path)
     assert r.returncode == 2 and "no dumped frames" in r.stderr
