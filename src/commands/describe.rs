@@ -81,6 +81,24 @@ fn print_blocks(d: &SceneDescription) {
         u.cluster_levels,
         u.clusterlod_bytes as f64 / (1 << 20) as f64
     );
+    if let Some(c) = &d.cut {
+        outln!(
+            "clusterlod cut along the path (pixel error {}, {} frames, means): {:.0} triangles; of {:.0} groups with \
+             a coarser version, {:.1} over the threshold, {:.1} of them with the camera inside their bounding sphere \
+             (distance clamped to the near plane), {:.1} of those under it by the distance to the sphere's centre; \
+             most at frame {}: {} of {} over",
+            d.pixel_error,
+            c.frames,
+            c.triangles,
+            c.groups,
+            c.over,
+            c.over_inside_sphere,
+            c.over_only_by_sphere,
+            c.worst_frame,
+            c.worst.over_only_by_sphere,
+            c.worst.over
+        );
+    }
     outln!("(every block's LODs and switch distances: --json)");
 }
 

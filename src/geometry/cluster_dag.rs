@@ -59,6 +59,24 @@ pub struct CutCamera {
     pub pixel_error: f32,
 }
 
+/// Why a frame's cut is as fine as it is (`lodbench describe` on a unified scene, averaged along the path):
+/// of the groups that have a coarser version, how many are over the threshold, and of those how many have the
+/// camera inside their bounding sphere, so that their distance is clamped to the near plane.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct CutDiagnosis {
+    /// Groups with a coarser version (non-terminal).
+    pub groups: u32,
+    /// Of those, over the threshold: drawn finer than their coarser version.
+    pub over: u32,
+    /// Over the threshold with the camera inside the group's sphere (distance to it clamped to the near plane).
+    pub over_inside_sphere: u32,
+    /// Of those, under the threshold when the distance is measured to the sphere's centre instead: the groups
+    /// the sphere bound alone keeps fine (the centre distance is no bound: it is what the cut would give up).
+    pub over_only_by_sphere: u32,
+    /// Triangles of the cut.
+    pub triangles: u64,
+}
+
 impl CutCamera {
     fn over(&self, g: &GroupBounds) -> bool {
         if g.error == f32::MAX {
@@ -158,6 +176,28 @@ impl ClusterDag {
         );
     }
 
+    /// [`CutDiagnosis`] of the cut for `camera`.
+    pub fn diagnose(&self, camera: &CutCamera) -> CutDiagnosis {
+        let mut d = CutDiagnosis::default();
+        for g in self.groups.iter().filter(|g| g.error != f32::MAX) {
+            d.groups += 1;
+            if !camera.over(g) {
+                continue;
+            }
+            d.over += 1;
+            let centre = g.center.distance(camera.eye);
+            if centre - g.radius <= camera.znear {
+                d.over_inside_sphere += 1;
+                let by_centre = g.error / centre.max(camera.znear) * camera.pixels_per_unit;
+                d.over_only_by_sphere += (by_centre <= camera.pixel_error) as u32;
+            }
+        }
+        let mut cut = Vec::new();
+        self.cut(camera, &mut cut);
+        d.triangles = self.triangles(&cut);
+        d
+    }
+
     /// Triangles of the clusters `selected`.
     pub fn triangles(&self, selected: &[u32]) -> u64 {
         selected
@@ -232,5 +272,24 @@ mod tests {
             assert!(t <= last && t >= coarsest, "{t} at height {d}");
             last = t;
         }
+    }
+
+    /// The diagnosis counts what the cut does: a camera far above the terrain has no group's sphere around it;
+    /// one standing on the terrain is inside the spheres of the coarse groups under it, and those are over
+    /// the threshold by the clamp alone where their centre is far enough away.
+    #[test]
+    fn diagnosis_counts_groups_with_the_camera_inside_their_sphere() {
+        let mesh = crate::geometry::terrain::terrain_mesh(3, 64).unwrap();
+        let dag = ClusterDag::build("terrain", &mesh).unwrap();
+        let far = dag.diagnose(&camera(Vec3::new(32.0, 500.0, 32.0), 1.0));
+        assert_eq!(far.over_inside_sphere, 0);
+        assert!(far.over <= far.groups && far.groups > 0);
+        let mut cut = Vec::new();
+        let low = camera(Vec3::new(32.0, 2.0, 32.0), 1.0);
+        dag.cut(&low, &mut cut);
+        let d = dag.diagnose(&low);
+        assert_eq!(d.triangles, dag.triangles(&cut));
+        assert!(d.over_inside_sphere > 0, "{d:?}");
+        assert!(d.over_only_by_sphere <= d.over_inside_sphere && d.over_inside_sphere <= d.over);
     }
 }

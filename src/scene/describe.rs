@@ -1,12 +1,13 @@
 //! What `lodbench describe` prints (and run.json's scene descriptions): a scene's settings, models, LODs and
 //! path, from its [`SceneDef`].
 
+use crate::geometry::cluster_dag::{CutCamera, CutDiagnosis};
 use crate::geometry::lod::LodInfo;
 use crate::scene::bunny::BunnyPath;
 use crate::scene::config::SceneConfig;
 use crate::scene::def::SceneDef;
 use crate::scene::kind::CameraMode;
-use crate::scene::model::{Model, Motion, Preprocessing};
+use crate::scene::model::{Model, Motion, Preprocessing, Scene, Unified};
 use crate::scene::schedule::ScheduleParams;
 use serde::Serialize;
 
@@ -39,6 +40,10 @@ pub struct SceneDescription {
     /// The unified scenes' preprocessing: blocks, seams, cluster DAG, with times and sizes.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub unified: Option<Preprocessing>,
+    /// A unified scene's clusterlod cut along the path at the run's pixel error (means over the frames, and the
+    /// frame with the most groups over the threshold because of their sphere).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut: Option<CutAlongPath>,
     /// A user scene's instances, authored chains and camera flight.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub user: Option<crate::scene::user::UserParts>,
@@ -61,6 +66,51 @@ pub struct LodDescription {
     /// "not reached by the sweep" for a bunny-scene switch nearer than the path's start ([`BunnyPath`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<&'static str>,
+}
+
+/// [`CutDiagnosis`] along a unified scene's path: the means over its frames, and the frame where the most
+/// groups were over the threshold with the camera inside their sphere.
+#[derive(Debug, Clone, Serialize)]
+pub struct CutAlongPath {
+    pub frames: u32,
+    pub groups: f64,
+    pub over: f64,
+    pub over_inside_sphere: f64,
+    pub over_only_by_sphere: f64,
+    pub triangles: f64,
+    pub worst_frame: u32,
+    pub worst: CutDiagnosis,
+}
+
+fn cut_along_path(scene: &Scene, u: &Unified) -> CutAlongPath {
+    let per_frame: Vec<CutDiagnosis> = (0..scene.frames)
+        .map(|f| {
+            u.dag.diagnose(&CutCamera {
+                eye: scene.camera(f).eye,
+                pixels_per_unit: scene.height as f32 / (2.0 * (scene.fov_y * 0.5).tan()),
+                znear: scene.near,
+                pixel_error: u.pixel_error,
+            })
+        })
+        .collect();
+    let n = per_frame.len().max(1) as f64;
+    let mean = |v: fn(&CutDiagnosis) -> f64| per_frame.iter().map(v).sum::<f64>() / n;
+    let (worst_frame, worst) = per_frame
+        .iter()
+        .enumerate()
+        .max_by_key(|(_, d)| d.over_only_by_sphere)
+        .map(|(f, d)| (f as u32, *d))
+        .unwrap_or_default();
+    CutAlongPath {
+        frames: scene.frames,
+        groups: mean(|d| d.groups as f64),
+        over: mean(|d| d.over as f64),
+        over_inside_sphere: mean(|d| d.over_inside_sphere as f64),
+        over_only_by_sphere: mean(|d| d.over_only_by_sphere as f64),
+        triangles: mean(|d| d.triangles as f64),
+        worst_frame,
+        worst,
+    }
 }
 
 /// [`LodDescription::note`] of a switch the bunny path never reaches.
@@ -90,6 +140,7 @@ impl SceneDef {
             path: self.path(),
             notes: self.notes(),
             unified: self.unified().map(|u| u.data.preprocessing.clone()),
+            cut: self.unified().map(|u| cut_along_path(&first, &u.data)),
             user: self.user().cloned(),
         }
     }
