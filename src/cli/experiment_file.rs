@@ -204,7 +204,15 @@ pub struct PlannedRun {
     pub config: RunConfig,
 }
 
-pub use crate::results::files::sweep_label;
+/// `variable=value` of each sweep, joined by `+` (how messages and run folders name a planned run).
+pub fn sweep_label(variables: &[String], values: &[String]) -> String {
+    variables
+        .iter()
+        .zip(values)
+        .map(|(var, v)| format!("{var}={v}"))
+        .collect::<Vec<_>>()
+        .join("+")
+}
 
 #[derive(Debug, Clone, Serialize)]
 pub struct Experiment {

@@ -74,17 +74,8 @@ pub fn run_folder_of(out: &Path, variables: &[String], values: &[String]) -> Pat
         return out.to_path_buf();
     }
     let values: Vec<String> = values.iter().map(|v| v.replace(',', "x")).collect();
-    out.join(RUNS_DIR).join(sweep_label(variables, &values))
-}
-
-/// `variable=value` of each sweep, joined by `+` (how messages and run folders name a planned run).
-pub fn sweep_label(variables: &[String], values: &[String]) -> String {
-    variables
-        .iter()
-        .zip(values)
-        .map(|(var, v)| format!("{var}={v}"))
-        .collect::<Vec<_>>()
-        .join("+")
+    out.join(RUNS_DIR)
+        .join(crate::cli::experiment_file::sweep_label(variables, &values))
 }
 
 /// The kinds of image `--dump-frames` writes per frame (defined where the images are made).
