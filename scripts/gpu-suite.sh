@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The papers' experiments on this machine's GPU, in one command (docs/cluster.md, "The GPU suite"):
 #   scripts/gpu-suite.sh [FRAMES]
-# runs scenes/experiments/{fsi-fig8,sheliemietiev-fig5,sheliemietiev-fig6,trees-sorting,unified-lod}.toml at
+# runs scenes/experiments/{fsi-fig8,sheliemietiev-fig5,sheliemietiev-fig6,trees-sorting,unified-lod,frontier}.toml at
 # the papers' scenes, instance counts and viewports, with FRAMES timed frames (default 150; the papers' 3,600
 # would take hours) and 10 warm-up frames per block, into results/gpu/<adapter>/<experiment>/, draws the
 # figures (scripts/plot.py), writes each experiment's wall time to results/gpu/<adapter>/times.txt and prints
@@ -30,7 +30,7 @@ name=$(printf '%s' "${best%%[*}" | sed 's/^ *//; s/ *$//' | tr -c 'A-Za-z0-9._-'
 out=results/gpu/$name
 mkdir -p "$out"
 echo "adapter: $best" | tee "$out/times.txt"
-for exp in fsi-fig8 sheliemietiev-fig5 sheliemietiev-fig6 trees-sorting unified-lod; do
+for exp in fsi-fig8 sheliemietiev-fig5 sheliemietiev-fig6 trees-sorting unified-lod frontier; do
     extra=()
     if [[ $exp == trees-sorting ]]; then
         extra=(--set dump-every=50)
