@@ -17,11 +17,15 @@ use glam::Vec3;
 /// Triangles per cluster at most (meshoptimizer's default configuration for rasterisation at this size).
 pub const MAX_TRIANGLES: usize = 128;
 
-/// Sphere bounds and error of a group's simplified geometry, in mesh units.
+/// Sphere bounds and error of a group's simplified geometry, in mesh units, and a box bound (`--cluster-bound
+/// box`): the axis-aligned box of the group's own clusters, of the clusters made from it, and of the boxes of
+/// the groups its clusters were made from, so that a group's box holds every finer group's box below it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GroupBounds {
     pub center: Vec3,
     pub radius: f32,
+    pub min: Vec3,
+    pub max: Vec3,
     /// `f32::MAX` for a terminal group (nothing coarser was made from it).
     pub error: f32,
     pub depth: u32,
@@ -50,13 +54,37 @@ pub struct ClusterDag {
 }
 
 /// How the cut projects errors: the camera's position, pixels per unit of error at distance 1
-/// (`height / (2 tan(fov_y / 2))`), the near plane and the threshold in pixels.
+/// (`height / (2 tan(fov_y / 2))`), the near plane, the threshold in pixels and the bound the distance is
+/// measured to.
 #[derive(Debug, Clone, Copy)]
 pub struct CutCamera {
     pub eye: Vec3,
     pub pixels_per_unit: f32,
     pub znear: f32,
     pub pixel_error: f32,
+    pub bound: CutBound,
+}
+
+/// `--cluster-bound`: what a group's distance to the camera is measured to.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum CutBound {
+    /// meshoptimizer's sphere per group (`clodGroup`'s rule): a camera inside it is at the near plane.
+    #[default]
+    Sphere,
+    /// The group's axis-aligned box, unioned up the DAG ([`GroupBounds`]): over a flat patch of terrain the
+    /// camera is its height away, not inside a sphere as wide as the patch.
+    Box,
 }
 
 /// Why a frame's cut is as fine as it is (`lodbench describe` on a unified scene, averaged along the path):
@@ -82,7 +110,11 @@ impl CutCamera {
         if g.error == f32::MAX {
             return true;
         }
-        let d = (g.center.distance(self.eye) - g.radius).max(self.znear);
+        let d = match self.bound {
+            CutBound::Sphere => g.center.distance(self.eye) - g.radius,
+            CutBound::Box => (self.eye - self.eye.clamp(g.min, g.max)).length(),
+        }
+        .max(self.znear);
         g.error / d * self.pixels_per_unit > self.pixel_error
     }
 }
@@ -113,6 +145,8 @@ impl ClusterDag {
                 dag.groups.push(GroupBounds {
                     center: Vec3::from(s.center),
                     radius: s.radius,
+                    min: Vec3::splat(f32::INFINITY),
+                    max: Vec3::splat(f32::NEG_INFINITY),
                     error: s.error,
                     depth: group.depth.max(0) as u32,
                 });
@@ -134,8 +168,47 @@ impl ClusterDag {
                 problem: "cluster LOD built no clusters".into(),
             });
         }
+        dag.boxes(mesh);
         dag.build_ms = started.elapsed().as_secs_f64() * 1e3;
         Ok(dag)
+    }
+
+    /// Each group's box: its own clusters and the clusters made from it, then, in the order the groups were
+    /// made (a cluster's refined group always comes before the group it is in), the boxes of the groups its
+    /// clusters were made from, so a group's projected error is never below a finer one's and the cut stays
+    /// consistent.
+    fn boxes(&mut self, mesh: &Mesh) {
+        let ClusterDag {
+            indices,
+            clusters,
+            groups,
+            ..
+        } = self;
+        for c in clusters.iter() {
+            let range = c.first_index as usize..(c.first_index + c.index_count) as usize;
+            let (lo, hi) = indices[range].iter().fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), &v| {
+                    let p = Vec3::from(mesh.positions[v as usize]);
+                    (lo.min(p), hi.max(p))
+                },
+            );
+            for g in std::iter::once(c.group).chain(c.refined) {
+                let b = &mut groups[g as usize];
+                b.min = b.min.min(lo);
+                b.max = b.max.max(hi);
+            }
+        }
+        let mut order: Vec<&Cluster> = clusters.iter().filter(|c| c.refined.is_some()).collect();
+        order.sort_by_key(|c| c.group);
+        for c in order {
+            if let Some(r) = c.refined {
+                let (lo, hi) = (groups[r as usize].min, groups[r as usize].max);
+                let b = &mut groups[c.group as usize];
+                b.min = b.min.min(lo);
+                b.max = b.max.max(hi);
+            }
+        }
     }
 
     /// Levels of the DAG (the deepest group's depth + 1).
@@ -217,6 +290,7 @@ mod tests {
             pixels_per_unit: 600.0 / (2.0 * 30f32.to_radians().tan()),
             znear: 0.01,
             pixel_error,
+            bound: CutBound::Sphere,
         }
     }
 
@@ -291,5 +365,50 @@ mod tests {
         assert_eq!(d.triangles, dag.triangles(&cut));
         assert!(d.over_inside_sphere > 0, "{d:?}");
         assert!(d.over_only_by_sphere <= d.over_inside_sphere && d.over_inside_sphere <= d.over);
+    }
+
+    /// `--cluster-bound box`: a group's box holds every finer group's below it, so for any camera a group's
+    /// projected error is at least that of each group its clusters were made from (the cut stays consistent,
+    /// as with the spheres); over a low camera the box cut is coarser than the sphere cut.
+    #[test]
+    fn box_bounds_keep_the_cut_consistent_and_coarsen_it_near_the_ground() {
+        let mesh = crate::geometry::terrain::terrain_mesh(3, 64).unwrap();
+        let dag = ClusterDag::build("terrain", &mesh).unwrap();
+        let mut rng = crate::rng::SplitMix64::new(11);
+        let proj = |cam: &CutCamera, g: &GroupBounds| -> f32 {
+            let d = (cam.eye - cam.eye.clamp(g.min, g.max))
+                .length()
+                .max(cam.znear);
+            g.error / d
+        };
+        for _ in 0..200 {
+            let eye = Vec3::new(
+                64.0 * rng.next_f32() - 8.0,
+                30.0 * rng.next_f32(),
+                64.0 * rng.next_f32() - 8.0,
+            );
+            let mut cam = camera(eye, 1.0);
+            cam.bound = CutBound::Box;
+            for c in &dag.clusters {
+                if let Some(r) = c.refined {
+                    let (g, r) = (&dag.groups[c.group as usize], &dag.groups[r as usize]);
+                    if g.error != f32::MAX {
+                        assert!(proj(&cam, g) >= proj(&cam, r), "{eye:?}");
+                    }
+                }
+            }
+        }
+        let coarser = [1.0, 8.0, 64.0, 512.0].into_iter().any(|pixel_error| {
+            let low = camera(Vec3::new(32.0, 2.0, 32.0), pixel_error);
+            let boxed = CutCamera {
+                bound: CutBound::Box,
+                ..low
+            };
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            dag.cut(&low, &mut a);
+            dag.cut(&boxed, &mut b);
+            dag.triangles(&b) < dag.triangles(&a)
+        });
+        assert!(coarser, "the box cut is never coarser than the sphere cut");
     }
 }

@@ -6,7 +6,7 @@
 
 use super::common::{FrameInput, Method};
 use crate::error::{Error, Result};
-use crate::geometry::cluster_dag::CutCamera;
+use crate::geometry::cluster_dag::{CutBound, CutCamera};
 use crate::gpu::{DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu, Vertex};
 use crate::scene::schedule::InstanceState;
 use crate::scene::unified::Unified;
@@ -15,8 +15,25 @@ use glam::Mat4;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
+/// `clusterlod`'s flags.
+#[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
+#[serde(default, rename_all(deserialize = "kebab-case"))]
+pub struct ClusterLodOptions {
+    /// clusterlod: what a group's distance to the camera is measured to: `sphere` (meshoptimizer's rule; a
+    /// camera inside a group's sphere is at the near plane) or `box` (the group's box, unioned up the DAG).
+    #[arg(long, value_enum, default_value_t = CutBound::Sphere)]
+    pub cluster_bound: CutBound,
+}
+
+impl Default for ClusterLodOptions {
+    fn default() -> Self {
+        crate::defaults::clap_defaults()
+    }
+}
+
 pub struct ClusterLod {
     unified: Arc<Unified>,
+    bound: CutBound,
     vertex_buffer: wgpu::Buffer,
     index_buffer: wgpu::Buffer,
     instance: InstanceBuffer,
@@ -27,7 +44,7 @@ pub struct ClusterLod {
 }
 
 impl ClusterLod {
-    pub fn new(gpu: &SceneGpu, scene: &Scene) -> Result<Self> {
+    pub fn new(gpu: &SceneGpu, scene: &Scene, options: &ClusterLodOptions) -> Result<Self> {
         let unified = scene.unified.clone().ok_or_else(|| {
             Error::Config(format!(
                 "clusterlod needs a scene of one large mesh (bunny-halves, terrain), not {}",
@@ -72,6 +89,7 @@ impl ClusterLod {
         gpu.upload(&instance, &instance_list);
         Ok(ClusterLod {
             unified,
+            bound: options.cluster_bound,
             vertex_buffer,
             index_buffer,
             instance,
@@ -126,6 +144,7 @@ impl ClusterLod {
             pixels_per_unit: s.height as f32 / (2.0 * (s.fov_y * 0.5).tan()),
             znear: s.near,
             pixel_error: self.unified.pixel_error,
+            bound: self.bound,
         }
     }
 }

@@ -41,6 +41,9 @@ pub struct MethodOptions {
     #[command(flatten)]
     #[serde(flatten)]
     pub fsi: fsi::FsiOptions,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub clusterlod: clusterlod::ClusterLodOptions,
 }
 
 /// What a method's constructor gets; GPU objects are created there, once per scene block.
@@ -91,7 +94,7 @@ pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "blocks", about: "unified LOD (Blow 2003a, 2003b): per-block alpha-zwrite blending, seams between the blocks", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::with_seams(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-noseams", about: "blocks without the seams (the ablation: cracks show where neighbours differ)", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-discrete", about: "blocks with seams, hard switches per block", create: |b| Ok(Box::new(discrete::Discrete::with_seams(b.gpu, b.scene))), options: no_options },
-    MethodEntry { name: "clusterlod", about: "meshoptimizer's cluster DAG (Nanite-style), the per-frame cut at --pixel-error", create: |b| Ok(Box::new(clusterlod::ClusterLod::new(b.gpu, b.scene)?)), options: no_options },
+    MethodEntry { name: "clusterlod", about: "meshoptimizer's cluster DAG (Nanite-style), the per-frame cut at --pixel-error", create: |b| Ok(Box::new(clusterlod::ClusterLod::new(b.gpu, b.scene, &b.options.clusterlod)?)), options: |o| json(o.clusterlod) },
 ];
 
 /// The methods a run can name: the built-in ones, plus any a caller (a test, a downstream crate) adds.

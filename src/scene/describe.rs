@@ -1,7 +1,7 @@
 //! What `lodbench describe` prints (and run.json's scene descriptions): a scene's settings, models, LODs and
 //! path, from its [`SceneDef`].
 
-use crate::geometry::cluster_dag::{CutCamera, CutDiagnosis};
+use crate::geometry::cluster_dag::{CutBound, CutCamera, CutDiagnosis};
 use crate::geometry::lod::LodInfo;
 use crate::scene::bunny::BunnyPath;
 use crate::scene::config::SceneConfig;
@@ -90,6 +90,7 @@ fn cut_along_path(scene: &Scene, u: &Unified) -> CutAlongPath {
                 pixels_per_unit: scene.height as f32 / (2.0 * (scene.fov_y * 0.5).tan()),
                 znear: scene.near,
                 pixel_error: u.pixel_error,
+                bound: CutBound::Sphere,
             })
         })
         .collect();
