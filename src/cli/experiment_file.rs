@@ -294,10 +294,10 @@ impl Experiment {
         }
         check_run_keys(&source, &file, &keys)?;
         let variants = variants(&source, &file, &keys, &sweeps)?;
-        let variables: Vec<String> = sweeps.into_iter().map(|s| s.variable).collect();
+        let variables: Vec<String> = sweeps.iter().map(|s| s.variable.clone()).collect();
         let runs = variants
             .into_iter()
-            .map(|v| plan_run(&source, &variables, v))
+            .map(|v| plan_run(&source, (&sweeps, &variables), v))
             .collect::<Result<Vec<_>>>()?;
         Ok(Experiment {
             name: file.name,
@@ -400,16 +400,16 @@ fn variants(
 }
 
 /// One planned run: its table read as `lodbench run`'s flags and validated as on the command line.
-fn plan_run(source: &Source, variables: &[String], v: Variant) -> Result<PlannedRun> {
-    let swept = |key: &str| {
-        variables.iter().zip(&v.values).find(|(var, _)| {
-            var.as_str() == key || (var.as_str() == VIEWPORT && (key == "width" || key == "height"))
-        })
-    };
+fn plan_run(
+    source: &Source,
+    (sweeps, variables): (&[SweepKeys], &[String]),
+    v: Variant,
+) -> Result<PlannedRun> {
+    let swept = |key: &str| sweeps.iter().zip(&v.values).find(|(s, _)| s.varies(key));
     let args = run_args(&v.table).map_err(|e| match swept(&e.key) {
-        Some((var, value)) => source.bad(format!(
-            "[sweep] variable '{var}' with value {value}: {}",
-            e.message
+        Some((s, value)) => source.bad(format!(
+            "[sweep] variable '{}' with value {value}: {}",
+            s.variable, e.message
         )),
         None if e.key.is_empty() && !v.values.is_empty() => source.bad(format!(
             "[sweep] values {}: {}",

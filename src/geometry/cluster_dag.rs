@@ -106,16 +106,26 @@ pub struct CutDiagnosis {
 }
 
 impl CutCamera {
-    fn over(&self, g: &GroupBounds) -> bool {
+    /// The error of group `g`'s simplified version in pixels, at its distance to `bound` (clamped to the near
+    /// plane; infinite for a terminal group).
+    pub fn projected_error(&self, g: &GroupBounds) -> f32 {
         if g.error == f32::MAX {
-            return true;
+            return f32::INFINITY;
         }
         let d = match self.bound {
             CutBound::Sphere => g.center.distance(self.eye) - g.radius,
             CutBound::Box => (self.eye - self.eye.clamp(g.min, g.max)).length(),
-        }
-        .max(self.znear);
-        g.error / d * self.pixels_per_unit > self.pixel_error
+        };
+        self.projected(g.error, d)
+    }
+
+    /// `error` in pixels at distance `d` (clamped to the near plane).
+    fn projected(&self, error: f32, d: f32) -> f32 {
+        error / d.max(self.znear) * self.pixels_per_unit
+    }
+
+    fn over(&self, g: &GroupBounds) -> bool {
+        self.projected_error(g) > self.pixel_error
     }
 }
 
@@ -261,7 +271,7 @@ impl ClusterDag {
             let centre = g.center.distance(camera.eye);
             if centre - g.radius <= camera.znear {
                 d.over_inside_sphere += 1;
-                let by_centre = g.error / centre.max(camera.znear) * camera.pixels_per_unit;
+                let by_centre = camera.projected(g.error, centre);
                 d.over_only_by_sphere += (by_centre <= camera.pixel_error) as u32;
             }
         }
@@ -375,12 +385,6 @@ mod tests {
         let mesh = crate::geometry::terrain::terrain_mesh(3, 64).unwrap();
         let dag = ClusterDag::build("terrain", &mesh).unwrap();
         let mut rng = crate::rng::SplitMix64::new(11);
-        let proj = |cam: &CutCamera, g: &GroupBounds| -> f32 {
-            let d = (cam.eye - cam.eye.clamp(g.min, g.max))
-                .length()
-                .max(cam.znear);
-            g.error / d
-        };
         for _ in 0..200 {
             let eye = Vec3::new(
                 64.0 * rng.next_f32() - 8.0,
@@ -393,7 +397,7 @@ mod tests {
                 if let Some(r) = c.refined {
                     let (g, r) = (&dag.groups[c.group as usize], &dag.groups[r as usize]);
                     if g.error != f32::MAX {
-                        assert!(proj(&cam, g) >= proj(&cam, r), "{eye:?}");
+                        assert!(cam.projected_error(g) >= cam.projected_error(r), "{eye:?}");
                     }
                 }
             }

@@ -138,14 +138,9 @@ impl ClusterLod {
     }
 
     fn camera(&self, input: &FrameInput<'_>) -> CutCamera {
-        let s = input.scene;
-        CutCamera {
-            eye: s.camera(input.frame).eye,
-            pixels_per_unit: s.height as f32 / (2.0 * (s.fov_y * 0.5).tan()),
-            znear: s.near,
-            pixel_error: self.unified.pixel_error,
-            bound: self.bound,
-        }
+        input
+            .scene
+            .cut_camera(input.frame, self.unified.pixel_error, self.bound)
     }
 }
 

@@ -1,7 +1,7 @@
 //! What `lodbench describe` prints (and run.json's scene descriptions): a scene's settings, models, LODs and
 //! path, from its [`SceneDef`].
 
-use crate::geometry::cluster_dag::{CutBound, CutCamera, CutDiagnosis};
+use crate::geometry::cluster_dag::{CutBound, CutDiagnosis};
 use crate::geometry::lod::LodInfo;
 use crate::scene::bunny::BunnyPath;
 use crate::scene::config::SceneConfig;
@@ -85,13 +85,8 @@ pub struct CutAlongPath {
 fn cut_along_path(scene: &Scene, u: &Unified) -> CutAlongPath {
     let per_frame: Vec<CutDiagnosis> = (0..scene.frames)
         .map(|f| {
-            u.dag.diagnose(&CutCamera {
-                eye: scene.camera(f).eye,
-                pixels_per_unit: scene.height as f32 / (2.0 * (scene.fov_y * 0.5).tan()),
-                znear: scene.near,
-                pixel_error: u.pixel_error,
-                bound: CutBound::Sphere,
-            })
+            u.dag
+                .diagnose(&scene.cut_camera(f, u.pixel_error, CutBound::Sphere))
         })
         .collect();
     let n = per_frame.len().max(1) as f64;

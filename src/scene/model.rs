@@ -3,7 +3,7 @@
 //! frame number.
 
 use crate::geometry::blocks::PartitionMode;
-use crate::geometry::cluster_dag::ClusterDag;
+use crate::geometry::cluster_dag::{ClusterDag, CutBound, CutCamera};
 use crate::geometry::lod::LodChain;
 use crate::geometry::mesh::Mesh;
 use crate::scene::kind::{CameraMode, SceneKind};
@@ -179,6 +179,18 @@ impl Scene {
     /// The scene's name (the CSVs' `scene` column).
     pub fn name(&self) -> &'static str {
         self.kind.name()
+    }
+
+    /// How a cluster cut sees `frame`: its camera, this viewport's pixels per unit at distance 1, the near plane,
+    /// the threshold `pixel_error` and the `bound` distances are measured to (clusterlod and describe's cut).
+    pub fn cut_camera(&self, frame: u32, pixel_error: f32, bound: CutBound) -> CutCamera {
+        CutCamera {
+            eye: self.camera(frame).eye,
+            pixels_per_unit: self.height as f32 / (2.0 * (self.fov_y * 0.5).tan()),
+            znear: self.near,
+            pixel_error,
+            bound,
+        }
     }
 
     /// Animation angle of instance `i` on `frame` (radians; windmill blades), with a fixed per-instance phase
