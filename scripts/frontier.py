@@ -130,9 +130,9 @@ def paired(pairs, variables, run, scene, count, a, b):
     return None
 
 
-def cheapest(scene, pts, pairs, variables, curve):
-    """The rows of the "cheapest at or below a popping" table of `scene` (dicts, columns in COLUMNS). `curve`: the
-    variable along the curves (unused here: the labels name every swept value)."""
+def cheapest(scene, pts, pairs, variables):
+    """The rows of the "cheapest at or below a popping" table of `scene` (dicts, columns in COLUMNS); each point is
+    named by its method and every swept value."""
     base = sorted(p["lodpop"] for p in pts if p["method"] == p["baseline"] and p["lodpop"] == p["lodpop"])
     if not base:
         return []

@@ -177,12 +177,6 @@ def transition_table(rows, scene):
     return [out[k] for k in sorted(out, key=lambda k: (k[1], k[0], k[2], k[3]))]
 
 
-def k_none(per_transition):
-    """Whether the entries are (first, last, {method: pop}) (older folders), not (..., lods, {method: (lodpop,
-    pop)})."""
-    return len(per_transition[0]) != 4
-
-
 def transition_methods(per_transition):
     """Every method of the per-transition entries, in order of first appearance."""
     return list(OrderedDict.fromkeys(m for p in per_transition for m in p[-1]))
@@ -193,7 +187,7 @@ def transitions_figure(scene, per_transition, path):
     frames (older folders: `per_transition` entries are (first, last, {method: pop}))."""
     with_lodpop = len(per_transition[0]) == 4
     methods = transition_methods(per_transition)
-    missing = float("nan") if k_none(per_transition) else (float("nan"), float("nan"))
+    missing = (float("nan"), float("nan")) if with_lodpop else float("nan")
     x = np.arange(len(per_transition))
     width = 0.8 / len(methods)
     panels = [("max lodpop (pose held)", 0), ("max pop (motion included)", 1)] if with_lodpop else \
@@ -511,7 +505,7 @@ def report(folder: Path, transition: str = "worst") -> list:
             scene_pts = [p for p in scene_pts if p["count"] == first_count]
             frontier.figure(scene, scene_pts, variables[-1], figs / f"frontier_{scene}.png")
             made.append((f"frontier_{scene}.png", f"{scene}: cost against popping across {variables[-1]}"))
-            rows = frontier.cheapest(scene, scene_pts, pairs, variables, variables[-1])
+            rows = frontier.cheapest(scene, scene_pts, pairs, variables)
             if rows:
                 frontier_tables.append((f"{scene}: cheapest at or below a popping (paired within a run)", rows,
                                         frontier.COLUMNS))

@@ -33,7 +33,7 @@ def test_cheapest_is_paired_within_its_run_only(tmp_path):
     assert [p["setting"] for p in pts] == ["0.05"] * 3 + ["0.2"] * 3
     pairs = [pair("0.05", "alpha", "dither", 0.92, 0.88, 0.96), pair("0.2", "discrete", "dither", 0.95, 0.9, 1.01),
              pair("0.2", "alpha", "dither", 1.24, 1.1, 1.4)]
-    rows = {r["lodpop at most"].split(" ")[0]: r for r in frontier.cheapest("s", pts, pairs, ["band"], "band")}
+    rows = {r["lodpop at most"].split(" ")[0]: r for r in frontier.cheapest("s", pts, pairs, ["band"])}
     # At discrete's own popping discrete is cheapest (its cost 1.0 in both runs); the next method of that run
     # (band 0.05: alpha) is compared by the pair (discrete, alpha), which pairs.csv lacks here.
     assert rows["0.01"]["cheapest"].startswith("discrete")
@@ -50,7 +50,7 @@ def test_cheapest_is_paired_within_its_run_only(tmp_path):
     assert rows["0.00125"]["next in the same run"] == "none meets it"
     # An interval that holds 1 says no difference.
     pairs[2] = pair("0.2", "alpha", "dither", 1.02, 0.97, 1.08)
-    rows = frontier.cheapest("s", pts, pairs, ["band"], "band")
+    rows = frontier.cheapest("s", pts, pairs, ["band"])
     assert rows[1]["paired"].endswith("no difference")
 
 
