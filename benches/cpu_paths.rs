@@ -105,6 +105,9 @@ fn csv_export(c: &mut Criterion) {
             lag_rmse: None,
             shadow_rmse: None,
             shadow_lodpop: None,
+            splits: None,
+            merges: None,
+            select_cpu_ms: None,
             round: f / 360,
         })
         .collect();

@@ -215,6 +215,21 @@ impl RunConfig {
                     )));
                 }
             }
+            let height_field =
+                |k: &SceneKind| *k == SceneKind::Terrain && a.scene_args.mesh.is_none();
+            if let Some(scene) = scenes.iter().find(|k| !height_field(k)) {
+                if let Some(m) = methods
+                    .iter()
+                    .find(|m| crate::methods::needs_height_field(m))
+                {
+                    return Err(Error::Config(format!(
+                        "method {m} needs the terrain's height field: run it on --scene terrain without --mesh \
+                         (scene {}{} has none: a mesh is not a height field)",
+                        scene.name(),
+                        if a.scene_args.mesh.is_some() { " with --mesh" } else { "" }
+                    )));
+                }
+            }
         }
         let baseline = match &a.baseline {
             Some(b) if methods.iter().any(|m| m == b.trim()) => Some(b.trim().to_string()),

@@ -112,11 +112,16 @@ impl CutCamera {
         if g.error == f32::MAX {
             return f32::INFINITY;
         }
-        let d = match self.bound {
-            CutBound::Sphere => g.center.distance(self.eye) - g.radius,
-            CutBound::Box => (self.eye - self.eye.clamp(g.min, g.max)).length(),
-        };
-        self.projected(g.error, d)
+        match self.bound {
+            CutBound::Sphere => self.projected(g.error, g.center.distance(self.eye) - g.radius),
+            CutBound::Box => self.projected_to_box(g.error, g.min, g.max),
+        }
+    }
+
+    /// `error` in pixels at the camera's distance to the box `min`..`max` (0 inside it, then clamped to the
+    /// near plane): the bound `--cluster-bound box` and ROAM's triangles use.
+    pub fn projected_to_box(&self, error: f32, min: Vec3, max: Vec3) -> f32 {
+        self.projected(error, (self.eye - self.eye.clamp(min, max)).length())
     }
 
     /// `error` in pixels at distance `d` (clamped to the near plane).

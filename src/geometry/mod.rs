@@ -8,4 +8,5 @@ pub mod lod;
 pub mod mesh;
 pub mod morph;
 pub mod procgen;
+pub mod roam;
 pub mod terrain;

@@ -26,6 +26,13 @@ pub const BASE_WAVELENGTH: f32 = 40.0;
 /// Octaves of the noise.
 pub const OCTAVES: u32 = 6;
 
+/// The procedural terrain's height field as ROAM samples it: the scene's seed and the mesh's cells a side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TerrainField {
+    pub seed: u64,
+    pub quads: u32,
+}
+
 /// A lattice value in [-1, 1] for point (i, j) of `octave`.
 fn lattice(seed: u64, octave: u32, i: i64, j: i64) -> f32 {
     let h = seed

@@ -43,8 +43,19 @@ pub struct Draw {
 pub struct DrawStats {
     pub triangles: u64,
     pub draw_calls: u32,
-    /// Clusters drawn (`clusterlod`); None for methods that draw whole instances.
+    /// Clusters drawn (`clusterlod`; 1 for the one mesh of `roam`); None for methods that draw whole instances.
     pub clusters: Option<u64>,
+    /// What a method that selects its own geometry changed this frame and the CPU time of the selection
+    /// (`roam`); None for the others.
+    pub selection: Option<Selection>,
+}
+
+/// One frame's selection work (`roam`): bintree nodes split and merged, and the CPU time of the update.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Selection {
+    pub splits: u32,
+    pub merges: u32,
+    pub cpu_ns: u64,
 }
 
 /// A frame's draws: items added in any order, then sorted into buckets by (pipeline, model, LOD) so that each
@@ -114,6 +125,17 @@ impl std::ops::Add for DrawStats {
             clusters: match (self.clusters, o.clusters) {
                 (None, None) => None,
                 (a, b) => Some(a.unwrap_or(0) + b.unwrap_or(0)),
+            },
+            selection: match (self.selection, o.selection) {
+                (None, None) => None,
+                (a, b) => {
+                    let (a, b) = (a.unwrap_or_default(), b.unwrap_or_default());
+                    Some(Selection {
+                        splits: a.splits + b.splits,
+                        merges: a.merges + b.merges,
+                        cpu_ns: a.cpu_ns + b.cpu_ns,
+                    })
+                }
             },
         }
     }

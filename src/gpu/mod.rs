@@ -15,7 +15,7 @@ pub mod targets;
 pub mod timing;
 
 pub use context::{AdapterSummary, GpuContext, TimingSource};
-pub use draw_list::{Draw, DrawList, DrawStats, InstanceRaw, PipelineIndex};
+pub use draw_list::{Draw, DrawList, DrawStats, InstanceRaw, PipelineIndex, Selection};
 pub use instances::{changed_runs, InstanceBuffer, UploadCounters};
 pub use pipelines::{vertex_layouts, MeshPipeline, Vertex, MESH_WGSL};
 pub use readback::{read_texture, TextureReadback};

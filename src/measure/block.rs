@@ -180,6 +180,9 @@ impl<'a> BlockRunner<'a> {
                 lag_rmse: quality.and_then(|q| q.lag.as_ref().map(|l| l[f])),
                 shadow_rmse: quality.and_then(|q| q.shadow.as_ref().map(|s| s.rmse[f])),
                 shadow_lodpop: quality.and_then(|q| q.shadow.as_ref().map(|s| s.lodpop[f])),
+                splits: timed.stats[f].selection.map(|s| s.splits),
+                merges: timed.stats[f].selection.map(|s| s.merges),
+                select_cpu_ms: timed.stats[f].selection.map(|s| s.cpu_ns as f64 * 1e-6),
                 round: timed.round[f],
             })
             .collect()

@@ -60,6 +60,11 @@ pub struct FrameRecord {
     /// `--shadows on`: RMS of those objects lit by the method's shadow map minus the same lit by what the
     /// method cast with the previous frame's schedule: the shadow's own popping (0 on frame 0).
     pub shadow_lodpop: Option<f64>,
+    /// `roam*`: bintree nodes split and merged this frame (a forced split counts; a diamond is two nodes), and
+    /// the CPU time of the frame's update, walk and morphs, in the timed frame (empty for other methods).
+    pub splits: Option<u32>,
+    pub merges: Option<u32>,
+    pub select_cpu_ms: Option<f64>,
     /// The timing round the frame was timed in (0-based; `--rounds`).
     pub round: u32,
 }
@@ -817,6 +822,9 @@ impl FrameTimes {
             lag_rmse: None,
             shadow_rmse: None,
             shadow_lodpop: None,
+            splits: None,
+            merges: None,
+            select_cpu_ms: None,
         })
     }
 }
@@ -858,6 +866,9 @@ pub(crate) mod tests {
             lag_rmse: None,
             shadow_rmse: None,
             shadow_lodpop: None,
+            splits: None,
+            merges: None,
+            select_cpu_ms: None,
             round: 0,
         }
     }

@@ -17,6 +17,7 @@ pub mod fsi;
 pub mod geomorph;
 pub mod noise;
 pub mod reference;
+pub mod roam;
 
 pub use common::{instance_raw, instance_raw_with, FrameInput, Method, OpaqueInstances};
 
@@ -44,6 +45,9 @@ pub struct MethodOptions {
     #[command(flatten)]
     #[serde(flatten)]
     pub clusterlod: clusterlod::ClusterLodOptions,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub roam: roam::RoamOptions,
 }
 
 /// What a method's constructor gets; GPU objects are created there, once per scene block.
@@ -95,6 +99,8 @@ pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "blocks-noseams", about: "blocks without the seams (the ablation: cracks show where neighbours differ)", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-discrete", about: "blocks with seams, hard switches per block", create: |b| Ok(Box::new(discrete::Discrete::with_seams(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "clusterlod", about: "meshoptimizer's cluster DAG (Nanite-style), the per-frame cut at --pixel-error", create: |b| Ok(Box::new(clusterlod::ClusterLod::new(b.gpu, b.scene, &b.options.clusterlod)?)), options: |o| json(o.clusterlod) },
+    MethodEntry { name: "roam", about: "ROAM (Duchaineau et al. 1997): the terrain's bintree split and merged each frame at --pixel-error", create: |b| Ok(Box::new(roam::Roam::new(b.gpu, b.scene, None)?)), options: no_options },
+    MethodEntry { name: "roam-morph", about: "ROAM, each vertex a split adds moved in from its edge's midpoint over --roam-morph-frames", create: |b| Ok(Box::new(roam::Roam::new(b.gpu, b.scene, Some(b.options.roam.roam_morph_frames))?)), options: |o| json(o.roam) },
 ];
 
 /// The methods a run can name: the built-in ones, plus any a caller (a test, a downstream crate) adds.
@@ -169,9 +175,25 @@ pub fn is_reference(label: &str) -> bool {
 
 /// The methods that need a scene of one large mesh in blocks (`SceneKind::is_unified`): they draw its seams or
 /// its cluster DAG.
-pub const UNIFIED_ONLY: [&str; 4] = ["blocks", "blocks-noseams", "blocks-discrete", "clusterlod"];
+pub const UNIFIED_ONLY: [&str; 6] = [
+    "blocks",
+    "blocks-noseams",
+    "blocks-discrete",
+    "clusterlod",
+    "roam",
+    "roam-morph",
+];
 
-/// What a unified scene runs when `--method` is absent: the reference and the four unified methods.
+/// The methods that need the procedural terrain's height field (scene terrain without `--mesh`).
+pub const TERRAIN_ONLY: [&str; 2] = ["roam", "roam-morph"];
+
+/// Whether the method of `label` needs the terrain's height field.
+pub fn needs_height_field(label: &str) -> bool {
+    TERRAIN_ONLY.contains(&base_name(label))
+}
+
+/// What a unified scene runs when `--method` is absent: the reference and the four unified methods of blocks
+/// and clusters (roam and roam-morph need the terrain's height field and run when named).
 pub const UNIFIED_DEFAULT: [&str; 5] = [
     "reference",
     "blocks",

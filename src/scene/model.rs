@@ -6,6 +6,7 @@ use crate::geometry::blocks::PartitionMode;
 use crate::geometry::cluster_dag::{ClusterDag, CutBound, CutCamera};
 use crate::geometry::lod::LodChain;
 use crate::geometry::mesh::Mesh;
+use crate::geometry::terrain::TerrainField;
 use crate::scene::kind::{CameraMode, SceneKind};
 use crate::scene::schedule::ScheduleParams;
 use glam::{Mat4, Vec3};
@@ -390,6 +391,8 @@ pub struct Unified {
     /// `--pixel-error` as the blocks' switch distances and clusterlod's cut use it.
     pub pixel_error: f32,
     pub preprocessing: Preprocessing,
+    /// The procedural terrain's height field (scene terrain without `--mesh`), for `roam`; None otherwise.
+    pub terrain: Option<TerrainField>,
 }
 
 #[cfg(test)]

@@ -25,6 +25,7 @@ use crate::geometry::blocks::{BlockLod, Grid, Partition, PartitionMode, SeamPair
 use crate::geometry::cluster_dag::ClusterDag;
 use crate::geometry::lod::{Lod, LodChain};
 use crate::geometry::mesh::Mesh;
+use crate::geometry::terrain::TerrainField;
 use crate::scene::bunny::{self, BUNNY_COLOR};
 use crate::scene::config::SceneConfig;
 use crate::scene::kind::{ProfileValues, SceneKind};
@@ -74,6 +75,8 @@ pub struct UnifiedInput<'a> {
     pub width: u32,
     pub height: u32,
     pub fov_y: f32,
+    /// The procedural terrain's height field, when the mesh is it (for `roam`).
+    pub terrain: Option<TerrainField>,
 }
 
 /// Unified scene `kind`: its mesh (`--mesh`, the built-in bunny, or the terrain), its blocks as models with
@@ -106,6 +109,10 @@ pub fn def(
         width: pv.width,
         height: pv.height,
         fov_y,
+        terrain: (kind == SceneKind::Terrain && cfg.mesh.is_none()).then(|| TerrainField {
+            seed: SCENE_SEED,
+            quads: SceneKind::terrain_quads(cfg.profile),
+        }),
     })?;
     let set = ModelSet {
         models,
@@ -510,6 +517,7 @@ fn finish(
         seams: seams.seams,
         pixel_error: input.pixel_error,
         preprocessing,
+        terrain: input.terrain,
     };
     let parts = UnifiedParts {
         instances,

@@ -450,6 +450,23 @@ fn unified_scenes_and_methods_reject_what_does_not_fit() {
     );
     let out = lodbench(&["run", "--method", "clusterlod"], &[]);
     fails_with(&out, &["method clusterlod", "scene bunny-sweep"]);
+    // ROAM needs the terrain's height field: not bunny-halves, not a --mesh.
+    let out = lodbench(&["run", "--scene", "bunny-halves", "--method", "roam"], &[]);
+    fails_with(&out, &["method roam", "height field", "scene bunny-halves"]);
+    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/tetra.gltf");
+    let out = lodbench(
+        &[
+            "run",
+            "--scene",
+            "terrain",
+            "--mesh",
+            mesh,
+            "--method",
+            "roam-morph",
+        ],
+        &[],
+    );
+    fails_with(&out, &["method roam-morph", "height field", "--mesh"]);
     let out = lodbench(
         &[
             "describe",

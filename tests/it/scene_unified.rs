@@ -1,7 +1,7 @@
 //! The unified-LOD scenes on the software adapter: Blow 2003b Fig. 1 (bunny-halves), whose seam must keep the
 //! cut closed where the two halves show different LODs, and the terrain's methods side by side.
 
-use crate::common::{read_csv, run_into, scene_config};
+use crate::common::{col, read_csv, run_into, scene_config};
 use indicatif::ProgressBar;
 use lodbench::gpu::SceneGpu;
 use lodbench::measure::metrics::SequenceMetrics;
@@ -110,4 +110,64 @@ fn terrain_runs_its_methods() {
     assert_eq!(get("blocks", "crack_px_max"), 0.0);
     assert!(get("clusterlod", "units_drawn_mean") > 1.0);
     assert_eq!(get("reference", "units_drawn_mean"), 16.0);
+}
+
+/// ROAM on the terrain (regress profile, 16 frames of the flight): no crack pixel on any frame, with and
+/// without morphs; fewer triangles at a larger pixel error; splits and merges reported; the morph hides the
+/// splits: on the first frames, where the flight only splits, roam-morph's lodpop is a small part of roam's
+/// (its new vertices start on the coarser surface). Removing the morph (every vertex at its height at once,
+/// tried) fails the last check; dropping the forced split fails the crack check (and the bintree's unit tests).
+#[test]
+fn roam_has_no_cracks_and_its_morph_hides_splits() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |pe: &str| {
+        let out = run_into(
+            &dir.path().join(pe),
+            &[
+                "--scene",
+                "terrain",
+                "--profile",
+                "regress",
+                "--frames",
+                "16",
+                "--method",
+                "roam,roam-morph",
+                "--pixel-error",
+                pe,
+            ],
+        );
+        read_csv(&out.join("frames.csv"))
+    };
+    let (fine, coarse) = (run("0.5"), run("4"));
+    let sum = |rows: &crate::common::Rows, m: &str| col(rows, m, "triangles").iter().sum::<f64>();
+    for m in ["roam", "roam-morph"] {
+        for rows in [&fine, &coarse] {
+            assert_eq!(col(rows, m, "crack_px").len(), 16, "{m}");
+            assert!(col(rows, m, "crack_px").iter().all(|&c| c == 0.0), "{m}");
+            assert!(col(rows, m, "splits").iter().sum::<f64>() > 0.0, "{m}");
+        }
+        assert!(sum(&coarse, m) < 0.5 * sum(&fine, m), "{m}");
+        assert!(col(&fine, m, "merges").iter().sum::<f64>() > 0.0, "{m}");
+    }
+    assert_eq!(
+        col(&fine, "roam", "triangles"),
+        col(&fine, "roam-morph", "triangles")
+    );
+    let (splits, merges) = (col(&fine, "roam", "splits"), col(&fine, "roam", "merges"));
+    let (pop, morph_pop) = (
+        col(&fine, "roam", "lodpop"),
+        col(&fine, "roam-morph", "lodpop"),
+    );
+    let split_only: Vec<usize> = (1..16)
+        .filter(|&f| splits[f] > 0.0 && merges[f] == 0.0)
+        .collect();
+    assert!(!split_only.is_empty(), "{splits:?} {merges:?}");
+    for f in split_only {
+        assert!(
+            pop[f] > 0.0 && morph_pop[f] < 0.25 * pop[f],
+            "frame {f}: {} {}",
+            pop[f],
+            morph_pop[f]
+        );
+    }
 }
