@@ -26,11 +26,14 @@ pub const BASE_WAVELENGTH: f32 = 40.0;
 /// Octaves of the noise.
 pub const OCTAVES: u32 = 6;
 
-/// The procedural terrain's height field as ROAM samples it: the scene's seed and the mesh's cells a side.
+/// The procedural terrain's height field as ROAM and `blocks-tree` take it: the scene's seed, the mesh's cells a
+/// side and the blocks along a side.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TerrainField {
     pub seed: u64,
     pub quads: u32,
+    /// Blocks along a side (`--blocks`): the leaves of `blocks-tree`.
+    pub blocks: u32,
 }
 
 /// A lattice value in [-1, 1] for point (i, j) of `octave`.

@@ -9,6 +9,7 @@
 pub mod alpha;
 pub mod alpha_2pass;
 pub mod alpha_zwrite;
+pub mod blocks_tree;
 pub mod clusterlod;
 pub mod common;
 pub mod discrete;
@@ -98,6 +99,7 @@ pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "blocks", about: "unified LOD (Blow 2003a, 2003b): per-block alpha-zwrite blending, seams between the blocks", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::with_seams(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-noseams", about: "blocks without the seams (the ablation: cracks show where neighbours differ)", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-discrete", about: "blocks with seams, hard switches per block", create: |b| Ok(Box::new(discrete::Discrete::with_seams(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "blocks-tree", about: "Blow's hierarchy of blocks on the terrain: 2 x 2 blocks combined and reduced, a parent faded into its children, seams across levels", create: |b| Ok(Box::new(blocks_tree::BlocksTree::new(b.gpu, b.scene)?)), options: no_options },
     MethodEntry { name: "clusterlod", about: "meshoptimizer's cluster DAG (Nanite-style), the per-frame cut at --pixel-error", create: |b| Ok(Box::new(clusterlod::ClusterLod::new(b.gpu, b.scene, &b.options.clusterlod)?)), options: |o| json(o.clusterlod) },
     MethodEntry { name: "roam", about: "ROAM (Duchaineau et al. 1997): the terrain's bintree split and merged each frame at --pixel-error", create: |b| Ok(Box::new(roam::Roam::new(b.gpu, b.scene, None)?)), options: no_options },
     MethodEntry { name: "roam-morph", about: "ROAM, each vertex a split adds moved in from its edge's midpoint over --roam-morph-frames", create: |b| Ok(Box::new(roam::Roam::new(b.gpu, b.scene, Some(b.options.roam.roam_morph_frames))?)), options: |o| json(o.roam) },
@@ -175,17 +177,18 @@ pub fn is_reference(label: &str) -> bool {
 
 /// The methods that need a scene of one large mesh in blocks (`SceneKind::is_unified`): they draw its seams or
 /// its cluster DAG.
-pub const UNIFIED_ONLY: [&str; 6] = [
+pub const UNIFIED_ONLY: [&str; 7] = [
     "blocks",
     "blocks-noseams",
     "blocks-discrete",
+    "blocks-tree",
     "clusterlod",
     "roam",
     "roam-morph",
 ];
 
-/// The methods that need the procedural terrain's height field (scene terrain without `--mesh`).
-pub const TERRAIN_ONLY: [&str; 2] = ["roam", "roam-morph"];
+/// The methods that need the procedural terrain's height field and its grid (scene terrain without `--mesh`).
+pub const TERRAIN_ONLY: [&str; 3] = ["blocks-tree", "roam", "roam-morph"];
 
 /// Whether the method of `label` needs the terrain's height field.
 pub fn needs_height_field(label: &str) -> bool {
@@ -193,7 +196,7 @@ pub fn needs_height_field(label: &str) -> bool {
 }
 
 /// What a unified scene runs when `--method` is absent: the reference and the four unified methods of blocks
-/// and clusters (roam and roam-morph need the terrain's height field and run when named).
+/// and clusters (blocks-tree, roam and roam-morph need the terrain's height field and run when named).
 pub const UNIFIED_DEFAULT: [&str; 5] = [
     "reference",
     "blocks",

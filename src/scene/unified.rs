@@ -112,6 +112,9 @@ pub fn def(
         terrain: (kind == SceneKind::Terrain && cfg.mesh.is_none()).then(|| TerrainField {
             seed: SCENE_SEED,
             quads: SceneKind::terrain_quads(cfg.profile),
+            blocks: cfg
+                .blocks
+                .unwrap_or_else(|| SceneKind::terrain_blocks(cfg.profile)),
         }),
     })?;
     let set = ModelSet {

@@ -171,3 +171,44 @@ fn roam_has_no_cracks_and_its_morph_hides_splits() {
         );
     }
 }
+
+/// Blow's hierarchy on the terrain (regress profile, 8 x 8 leaves, 16 frames of the flight): the seams across
+/// levels leave no crack pixel on any frame (without them, tried: cracks on half the frames), the cut changes
+/// along the flight (nodes fade: lodpop over 0), and the root, a node of level 3, holds fewer triangles than the
+/// one-level blocks' last LOD over the same terrain (each block's locked corners and borders keep triangles the
+/// hierarchy reduces away).
+#[test]
+fn blocks_tree_has_no_cracks_and_its_far_node_is_coarser_than_the_last_lod() {
+    let args = ["--profile", "regress", "--blocks", "8", "--frames", "16"];
+    let dir = tempfile::tempdir().unwrap();
+    let mut argv = vec!["--scene", "terrain", "--method", "blocks-tree"];
+    argv.extend_from_slice(&args);
+    let rows = read_csv(&run_into(&dir.path().join("out"), &argv).join("frames.csv"));
+    let cracks = col(&rows, "blocks-tree", "crack_px");
+    assert_eq!(cracks.len(), 16);
+    assert!(cracks.iter().all(|&c| c == 0.0), "{cracks:?}");
+    assert!(col(&rows, "blocks-tree", "lodpop").iter().any(|&p| p > 0.0));
+    let units = col(&rows, "blocks-tree", "units_drawn");
+    assert!(units.iter().any(|&u| u != units[0]), "{units:?}");
+
+    let scene = SceneDef::new(SceneKind::Terrain, &scene_config("terrain", &args))
+        .unwrap()
+        .instantiate(1);
+    let unified = scene.unified.as_ref().unwrap();
+    let field = unified.terrain.unwrap();
+    let tree =
+        lodbench::geometry::block_tree::BlockTree::build(&unified.mesh, field.quads, field.blocks)
+            .unwrap();
+    let root = &tree.nodes[tree.root as usize];
+    assert_eq!(root.level, 3);
+    let last_lods: usize = scene
+        .models
+        .iter()
+        .map(|m| m.chain.lods.last().unwrap().mesh.triangle_count())
+        .sum();
+    assert!(
+        (root.index_count as usize / 3) < last_lods,
+        "root {} against {last_lods}",
+        root.index_count / 3
+    );
+}
