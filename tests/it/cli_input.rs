@@ -453,8 +453,14 @@ fn unified_scenes_and_methods_reject_what_does_not_fit() {
     // ROAM needs the terrain's height field: not bunny-halves, not a --mesh.
     let out = lodbench(&["run", "--scene", "bunny-halves", "--method", "roam"], &[]);
     fails_with(&out, &["method roam", "height field", "scene bunny-halves"]);
-    let out = lodbench(&["run", "--scene", "bunny-halves", "--method", "blocks-tree"], &[]);
-    fails_with(&out, &["method blocks-tree", "height field", "scene bunny-halves"]);
+    let out = lodbench(
+        &["run", "--scene", "bunny-halves", "--method", "blocks-tree"],
+        &[],
+    );
+    fails_with(
+        &out,
+        &["method blocks-tree", "height field", "scene bunny-halves"],
+    );
     let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/tetra.gltf");
     let out = lodbench(
         &[
