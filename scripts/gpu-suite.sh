@@ -30,7 +30,7 @@ name=$(printf '%s' "${best%%[*}" | sed 's/^ *//; s/ *$//' | tr -c 'A-Za-z0-9._-'
 out=results/gpu/$name
 mkdir -p "$out"
 echo "adapter: $best" | tee "$out/times.txt"
-for exp in fsi-fig8 sheliemietiev-fig5 sheliemietiev-fig6 trees-sorting unified-lod frontier; do
+for exp in fsi-fig8 sheliemietiev-fig5 sheliemietiev-fig6 trees-sorting unified-lod terrain-equal-error frontier; do
     extra=()
     if [[ $exp == trees-sorting ]]; then
         extra=(--set dump-every=50)
@@ -39,6 +39,9 @@ for exp in fsi-fig8 sheliemietiev-fig5 sheliemietiev-fig6 trees-sorting unified-
     "$lodbench" experiment "scenes/experiments/$exp.toml" --set "frames=$frames" --set warmup=10 \
         "${extra[@]}" --out "$out/$exp"
     python3 scripts/plot.py "$out/$exp"
+    if [[ $exp == terrain-equal-error ]]; then
+        python3 scripts/equal_error.py "$out/$exp"
+    fi
     echo "$exp: $(($(date +%s) - start)) s ($frames frames)" | tee -a "$out/times.txt"
 done
 echo

@@ -99,6 +99,25 @@ fn print_blocks(d: &SceneDescription) {
             c.worst.over
         );
     }
+    if let Some(h) = &d.hierarchy {
+        let levels: Vec<String> = h
+            .levels
+            .iter()
+            .map(|l| {
+                format!(
+                    "level {}: {} nodes, {} triangles, error up to {:.4}",
+                    l.level, l.nodes, l.triangles, l.error_max
+                )
+            })
+            .collect();
+        outln!(
+            "blocks-tree: {} x {} leaves; {}; built in {:.0} ms",
+            h.leaves,
+            h.leaves,
+            levels.join("; "),
+            h.build_ms
+        );
+    }
     outln!("(every block's LODs and switch distances: --json)");
 }
 

@@ -1,6 +1,7 @@
 //! What `lodbench describe` prints (and run.json's scene descriptions): a scene's settings, models, LODs and
 //! path, from its [`SceneDef`].
 
+use crate::geometry::block_tree::BlockTree;
 use crate::geometry::cluster_dag::{CutBound, CutDiagnosis};
 use crate::geometry::lod::LodInfo;
 use crate::scene::bunny::BunnyPath;
@@ -44,9 +45,31 @@ pub struct SceneDescription {
     /// frame with the most groups over the threshold because of their sphere).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cut: Option<CutAlongPath>,
+    /// The terrain's `blocks-tree` hierarchy: nodes and triangles per level (None without the height field's
+    /// grid).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hierarchy: Option<HierarchyDescription>,
     /// A user scene's instances, authored chains and camera flight.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub user: Option<crate::scene::user::UserParts>,
+}
+
+/// Blow's hierarchy of the terrain as `blocks-tree` builds it.
+#[derive(Debug, Clone, Serialize)]
+pub struct HierarchyDescription {
+    /// Leaves along a side.
+    pub leaves: u32,
+    /// Level 0 (the leaves) up to the root: its nodes, their triangles together, their largest error.
+    pub levels: Vec<HierarchyLevel>,
+    pub build_ms: f64,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct HierarchyLevel {
+    pub level: u32,
+    pub nodes: u32,
+    pub triangles: u64,
+    pub error_max: f32,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -66,6 +89,29 @@ pub struct LodDescription {
     /// "not reached by the sweep" for a bunny-scene switch nearer than the path's start ([`BunnyPath`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<&'static str>,
+}
+
+/// The terrain's hierarchy, per level (None without the height field's grid, or where it does not build).
+fn hierarchy(u: &Unified) -> Option<HierarchyDescription> {
+    let field = u.terrain?;
+    let tree = BlockTree::build(&u.mesh, field.quads, field.blocks).ok()?;
+    let top = tree.nodes[tree.root as usize].level;
+    let levels = (0..=top)
+        .map(|level| {
+            let nodes = tree.nodes.iter().filter(|n| n.level == level);
+            HierarchyLevel {
+                level,
+                nodes: nodes.clone().count() as u32,
+                triangles: nodes.clone().map(|n| n.index_count as u64 / 3).sum(),
+                error_max: nodes.map(|n| n.error).fold(0.0, f32::max),
+            }
+        })
+        .collect();
+    Some(HierarchyDescription {
+        leaves: field.blocks.clamp(1, field.quads),
+        levels,
+        build_ms: tree.build_ms,
+    })
 }
 
 /// [`CutDiagnosis`] along a unified scene's path: the means over its frames, and the frame where the most
@@ -137,6 +183,7 @@ impl SceneDef {
             notes: self.notes(),
             unified: self.unified().map(|u| u.data.preprocessing.clone()),
             cut: self.unified().map(|u| cut_along_path(&first, &u.data)),
+            hierarchy: self.unified().and_then(|u| hierarchy(&u.data)),
             user: self.user().cloned(),
         }
     }
