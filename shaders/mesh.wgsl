@@ -21,6 +21,9 @@ struct Camera {
     light_view_proj: mat4x4<f32>,
     // x: 1 with shadows; y: the shadow map's side in texels; z: depth bias.
     shadow: vec4<f32>,
+    // --shader-work (src/gpu/scene_gpu.rs): x: ALU iterations per shaded fragment; y: the weight their result is
+    // added with (0 in every run: the image is unchanged; a uniform, so the loop cannot be compiled away).
+    work: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -173,7 +176,13 @@ fn shade(in: VsOut, front: bool) -> vec3<f32> {
         lambert = lambert * lit(in.world);
     }
     let ambient = camera.light.w;
-    return in.color.rgb * (ambient + (1.0 - ambient) * lambert);
+    // --shader-work: a chain of dependent multiply-adds, each result in [0, 1), added with weight work.y.
+    var w = fract(dot(in.world, vec3<f32>(0.1, 0.2, 0.3)));
+    let iterations = u32(camera.work.x);
+    for (var i = 0u; i < iterations; i = i + 1u) {
+        w = fract(w * 1.618034 + 0.318310);
+    }
+    return in.color.rgb * (ambient + (1.0 - ambient) * lambert) + vec3<f32>(w * camera.work.y);
 }
 
 @fragment

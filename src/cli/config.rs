@@ -111,6 +111,7 @@ impl SceneConfig {
                 Some(a.count.clone())
             },
             fov_deg,
+            shader_work: a.shader_work,
             schedule,
             camera: a.camera,
             taa: a.taa.resolve()?,

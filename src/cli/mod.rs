@@ -231,6 +231,12 @@ pub struct SceneArgs {
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = 60.0)]
     pub fov: f32,
+    /// Extra work per shaded fragment, for every method and the reference: N dependent ALU iterations (a
+    /// multiply-add and a fract each) whose result is added with a weight of 0, so the image is unchanged while
+    /// no shader compiler can drop the loop (the weight is a uniform). A stand-in for an expensive material: what
+    /// drawing both LODs of a blend costs when fragments are dear (Scherzer & Wimmer 2008 section 2).
+    #[arg(long, default_value_t = 0)]
+    pub shader_work: u32,
     /// How k advances through a transition.
     #[arg(long, value_enum, default_value_t = FadeMode::Distance)]
     pub fade: FadeMode,

@@ -25,10 +25,14 @@ struct CameraRaw {
     /// `--shadows on`: world to the shadow map's clip space, and (on, side in texels, depth bias, 0).
     light_view_proj: [[f32; 4]; 4],
     shadow: [f32; 4],
+    /// `--shader-work`: (iterations, weight of their result, 0, 0); written once, by [`SceneGpu::write_work`].
+    work: [f32; 4],
 }
 
 /// Byte offset of `light_view_proj` in the camera uniform (what [`SceneGpu::write_camera`] leaves alone).
 const LIGHT_OFFSET: u64 = 64 + 16 + 16;
+/// Byte offset of `work` in the camera uniform.
+const WORK_OFFSET: u64 = LIGHT_OFFSET + 64 + 16;
 
 /// One of the scene's shadow maps: the one a shadow pass writes, and the one draws are lit by. The layer above
 /// decides what each map stands for; the GPU layer only keeps them apart.
@@ -309,7 +313,7 @@ impl SceneGpu {
             },
         );
         ctx.check_errors()?;
-        Ok(SceneGpu {
+        let gpu = SceneGpu {
             device: device.clone(),
             queue: ctx.queue.clone(),
             vertex_buffer,
@@ -329,7 +333,9 @@ impl SceneGpu {
             alpha_test,
             cull,
             uploads: UploadCounters::default(),
-        })
+        };
+        gpu.write_work(scene.shader_work, scene.shader_work_weight);
+        Ok(gpu)
     }
 
     /// The bytes (R, G, B) a target cleared to the background holds on this device: the sRGB encoding the
@@ -354,10 +360,22 @@ impl SceneGpu {
             light: [l.x, l.y, l.z, AMBIENT],
             light_view_proj: [[0.0; 4]; 4],
             shadow: [0.0; 4],
+            work: [0.0; 4],
         };
         let bytes = bytemuck::bytes_of(&raw);
         self.queue
             .write_buffer(&self.camera_buffer, 0, &bytes[..LIGHT_OFFSET as usize]);
+    }
+
+    /// `--shader-work`: every shaded fragment runs `iterations` dependent ALU iterations and adds their result
+    /// (in [0, 1)) with `weight`. Runs always give weight 0 (the image unchanged); a test gives 1 to see that the
+    /// loop runs.
+    pub fn write_work(&self, iterations: u32, weight: f32) {
+        self.queue.write_buffer(
+            &self.camera_buffer,
+            WORK_OFFSET,
+            bytemuck::cast_slice(&[iterations as f32, weight, 0.0, 0.0]),
+        );
     }
 
     /// `--shadows on`: this frame's light matrix (every shadow map of the frame shares it); shading reads the

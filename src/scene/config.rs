@@ -30,6 +30,8 @@ pub struct SceneConfig {
     pub blocks: Option<u32>,
     pub counts: Option<Vec<u32>>,
     pub fov_deg: f32,
+    /// `--shader-work`: extra ALU iterations per shaded fragment (0: none).
+    pub shader_work: u32,
     pub schedule: ScheduleParams,
     /// `--taa on`: the jitter of every frame's camera and the resolve after it.
     pub taa: Option<crate::effects::taa::Taa>,

@@ -32,6 +32,8 @@ pub struct SceneDef {
     pub family: Family,
     pub taa: Option<crate::effects::taa::Taa>,
     pub shadows: Option<crate::effects::shadow::Shadows>,
+    /// `--shader-work`: extra ALU iterations per shaded fragment.
+    pub shader_work: u32,
     /// `--camera-path`: replaces the family's camera.
     pub camera_path: Option<Arc<crate::scene::camera_path::CameraPath>>,
 }
@@ -84,6 +86,7 @@ impl SceneDef {
             family,
             taa: cfg.taa,
             shadows: cfg.shadows,
+            shader_work: cfg.shader_work,
             camera_path: cfg.camera_path.clone().map(Arc::new),
         })
     }
@@ -256,6 +259,8 @@ impl SceneDef {
             unified: layout.unified,
             taa: self.taa,
             shadows: self.shadows,
+            shader_work: self.shader_work,
+            shader_work_weight: 0.0,
             ground: None,
         }
     }

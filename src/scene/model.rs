@@ -157,6 +157,11 @@ pub struct Scene {
     pub taa: Option<crate::effects::taa::Taa>,
     /// `--shadows on`: the shadow map's settings (`effects/shadow.rs`).
     pub shadows: Option<crate::effects::shadow::Shadows>,
+    /// `--shader-work`: extra ALU iterations per shaded fragment (`shade` in shaders/mesh.wgsl; 0: none).
+    pub shader_work: u32,
+    /// The weight the shader work's result is added to the colour with: 0 in every run (the image unchanged);
+    /// a test sets 1 to see that the loop runs ([`crate::gpu::SceneGpu::write_work`]).
+    pub shader_work_weight: f32,
     /// The instance that is the bunny scenes' ground with `--shadows on`: static, always LOD0, receives
     /// shadows and casts none, left out of `lod_mean`.
     pub ground: Option<usize>,

@@ -653,3 +653,72 @@ fn max_transitions_caps_t_instances_and_records_the_wait() {
     assert_eq!(t, 1);
     assert!(wait > 0 && waiting_max > 0, "{wait} {waiting_max}");
 }
+
+/// `--shader-work N`: the loop runs (with the result's weight set to 1, the frame changes with N) and leaves
+/// every frame of a run as it is (weight 0: frames.csv's quality columns equal those without it). Removing the
+/// loop from `shade` (tried) makes the first half fail.
+#[test]
+fn shader_work_runs_and_leaves_the_image_alone() {
+    let frame0 = |work: &str, weight: f32| {
+        let mut scene = crate::common::sweep_scene(&[
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--frames",
+            "2",
+            "--shader-work",
+            work,
+        ]);
+        scene.shader_work_weight = weight;
+        let ctx = crate::common::gpu();
+        let mut block =
+            BlockRunner::new(&ctx, &scene, Default::default(), true, &Default::default()).unwrap();
+        let mut out = None;
+        block
+            .run_method("reference", 0, 1, &ProgressBar::hidden(), |f, img| {
+                if f == 0 {
+                    out = Some(img.method.to_vec());
+                }
+                Ok(())
+            })
+            .unwrap();
+        out.unwrap()
+    };
+    let plain = frame0("0", 0.0);
+    assert_eq!(frame0("64", 0.0), plain);
+    let (w0, w64) = (frame0("0", 1.0), frame0("64", 1.0));
+    assert_ne!(w0, plain);
+    assert_ne!(w64, w0, "64 iterations give the same colour as none");
+
+    let dir = tempfile::tempdir().unwrap();
+    let run = |work: &str| {
+        let out = crate::common::run_into(
+            &dir.path().join(work),
+            &[
+                "--scene",
+                "bunny-sweep",
+                "--profile",
+                "regress",
+                "--frames",
+                "24",
+                "--method",
+                "discrete,alpha",
+                "--shader-work",
+                work,
+            ],
+        );
+        crate::common::read_csv(&out.join("frames.csv"))
+            .into_iter()
+            .map(|r| {
+                (
+                    r["method"].clone(),
+                    r["frame"].clone(),
+                    r["rmse"].clone(),
+                    r["lodpop"].clone(),
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(run("0"), run("32"));
+}
