@@ -312,6 +312,20 @@ fn fs_fsi_t(in: VsOut, @builtin(front_facing) front: bool) -> FsiOut {
     if (visibility(in.object, in.params.x) > in.params.y || masked(in)) {
         discard;
     }
+    return fsi_t_out(in, front);
+}
+
+// `--vis-space world` (Scherzer & Wimmer 2008 section 3.3 rejects it): the same lookup at the world-space
+// position, so the pattern stays in place while an animated object moves through it.
+@fragment
+fn fs_fsi_t_world(in: VsOut, @builtin(front_facing) front: bool) -> FsiOut {
+    if (visibility(in.world, in.params.x) > in.params.y || masked(in)) {
+        discard;
+    }
+    return fsi_t_out(in, front);
+}
+
+fn fsi_t_out(in: VsOut, front: bool) -> FsiOut {
     var out: FsiOut;
     out.color = vec4<f32>(shade(in, front), 1.0);
     // params is interpolated: a constant can come out a hair below the integer. Back faces write the next id

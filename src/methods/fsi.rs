@@ -112,6 +112,23 @@ pub struct FsiOptions {
     /// it lands within a pixel of the pixel (rejects the disocclusion ghosts of Scherzer & Wimmer 2008 section 4.2).
     #[arg(long, value_enum, default_value_t = FsiCheck::None)]
     pub fsi_check: FsiCheck,
+    /// `fsi*`: where the visibility texture is looked up: `object` (the paper's: the object-space position
+    /// before animation, so the pattern moves with the object) or `world` (the world-space position: the pattern
+    /// stays in place while an animated part moves through it; claim F27).
+    #[arg(long, value_enum, default_value_t = VisSpace::Object)]
+    pub vis_space: VisSpace,
+}
+
+/// `--vis-space`: the space FSI's visibility texture is looked up in.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum VisSpace {
+    /// The object-space position before animation (Scherzer & Wimmer 2008 section 3.3).
+    Object,
+    /// The world-space position after animation and the instance transform.
+    World,
 }
 
 impl Default for FsiOptions {
@@ -438,7 +455,14 @@ impl Fsi {
             })
         };
         let n_pipeline = pipeline("fsi n-instances", "fs_fsi_n", None);
-        let t_pipeline = pipeline("fsi t-instances", "fs_fsi_t", None);
+        let t_pipeline = pipeline(
+            "fsi t-instances",
+            match options.vis_space {
+                VisSpace::Object => "fs_fsi_t",
+                VisSpace::World => "fs_fsi_t_world",
+            },
+            None,
+        );
 
         let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
             binding,

@@ -80,6 +80,11 @@ fn json(v: impl serde::Serialize) -> Option<serde_json::Value> {
     serde_json::to_value(v).ok()
 }
 
+/// The options FSI's ablations read: the visibility texture and where it is looked up (not `--fsi-check`).
+fn fsi_ablation_options(o: &MethodOptions) -> Option<serde_json::Value> {
+    json(serde_json::json!({ "vis_texture": o.fsi.vis_texture, "vis_space": o.fsi.vis_space }))
+}
+
 /// Every built-in method, in the order runs use when `--method` is absent. One line a method (rustfmt would
 /// spread each over eight).
 #[rustfmt::skip]
@@ -94,8 +99,8 @@ pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "dither-skip", about: "dither, a LOD the pattern gives no pixel at this k not drawn (not run by default)", create: |b| Ok(Box::new(dither::Dither::new(b.gpu, b.scene, &b.options.dither, b.seed, true))), options: |o| json(o.dither) },
     MethodEntry { name: "geomorph", about: "geomorphing: the finer LOD's vertices move to their targets on the coarser", create: |b| Ok(Box::new(geomorph::Geomorph::new(b.gpu, b.scene, &b.options.geomorph))), options: |o| json(o.geomorph) },
     MethodEntry { name: "fsi", about: "Frame Sequential Interpolation (Scherzer & Wimmer 2008)", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::Sequential))), options: |o| json(o.fsi) },
-    MethodEntry { name: "fsi-noreproject", about: "FSI ablation: the older buffer read at the same pixel", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::NoReproject))), options: |o| json(o.fsi.vis_texture) },
-    MethodEntry { name: "fsi-sameframe", about: "FSI ablation: both LOD buffers rendered every frame", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::SameFrame))), options: |o| json(o.fsi.vis_texture) },
+    MethodEntry { name: "fsi-noreproject", about: "FSI ablation: the older buffer read at the same pixel", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::NoReproject))), options: fsi_ablation_options },
+    MethodEntry { name: "fsi-sameframe", about: "FSI ablation: both LOD buffers rendered every frame", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::SameFrame))), options: fsi_ablation_options },
     MethodEntry { name: "blocks", about: "unified LOD (Blow 2003a, 2003b): per-block alpha-zwrite blending, seams between the blocks", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::with_seams(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-noseams", about: "blocks without the seams (the ablation: cracks show where neighbours differ)", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-discrete", about: "blocks with seams, hard switches per block", create: |b| Ok(Box::new(discrete::Discrete::with_seams(b.gpu, b.scene))), options: no_options },

@@ -514,3 +514,42 @@ fn e_static_transitions_toggle_out_of_phase() {
     let alternation = lodbench::measure::records::tri_alternation_max(&out.rows);
     assert!(alternation < 0.02, "{alternation} {tris:?}");
 }
+
+/// `--vis-space world` (claim F27): the visibility texture looked up at the world-space position. On windmills,
+/// whose instances are placed away from the origin, the two lookups keep different fragments on frames that
+/// combine a transition's LOD buffers (a transition frame, or the frame after one, whose older buffer is of the
+/// transition) and give the same frames elsewhere. Looking up the object-space position in both entry points
+/// (tried) fails the first check. (On bunny-sweep the bunny's transform is the identity: the lookups agree.)
+#[test]
+fn g_world_space_lookup_changes_only_transition_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |space: &str| {
+        let out = crate::common::run_into(
+            &dir.path().join(space),
+            &[
+                "--scene",
+                "windmills",
+                "--profile",
+                "regress",
+                "--frames",
+                "48",
+                "--method",
+                "fsi",
+                "--vis-space",
+                space,
+            ],
+        );
+        crate::common::read_csv(&out.join("frames.csv"))
+    };
+    let (object, world) = (run("object"), run("world"));
+    let in_transition: Vec<bool> = object.iter().map(|r| r["t_instances"] != "0").collect();
+    let mut differ = 0;
+    for (f, (a, b)) in object.iter().zip(&world).enumerate() {
+        if a["rmse"] != b["rmse"] {
+            differ += 1;
+            let combined = in_transition[f] || (f > 0 && in_transition[f - 1]);
+            assert!(combined, "frame {f} differs away from a transition");
+        }
+    }
+    assert!(differ > 0, "no frame differs");
+}
