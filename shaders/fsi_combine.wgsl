@@ -8,6 +8,10 @@
 //                                                would z-fight), averaged in linear RGB;
 //   anything else (one t-instance)            -> the closer fragment, depths compared in the older frame's
 //                                                depth space (the newer depth reprojected by eq. 2).
+// `fsi-blend` (frame-sequential blending, section 3.3's rejected alternative) replaces the last two cases: the
+// LOD buffers hold complete LODs and each t-instance fragment its LOD's blend weight in alpha, and any pixel with a
+// t-instance in either buffer is the two colours mixed by that weight (the newer buffer's t-instance, else the
+// older's), whatever lies in front of what.
 // With `--fsi-check forward` (not in the paper; see `FsiCheck` in src/methods/fsi.rs) the older fragment used
 // is one that lands within a pixel of this pixel's centre when reprojected forward with its own depth
 // (`forward`, eq. 2 inverted): eq. 2's lookup if it does, else the texel found by moving the lookup by the
@@ -20,7 +24,8 @@ struct Combine {
     reproject: mat4x4<f32>,
     // P_new * V_new * V_old^-1 * P_old^-1 (clip space of the older frame to clip space of the newer one).
     forward: mat4x4<f32>,
-    // Viewport size in pixels (x, y); z: mode, 0 = reproject, 1 = same pixel; w: 1 = forward check.
+    // Viewport size in pixels (x, y); z: mode, 0 = reproject, 1 = same pixel; w: the combination, 0 = the
+    // paper's, 1 = with the forward check, 2 = frame-sequential blending (`fsi-blend`).
     size_mode: vec4<f32>,
 };
 
@@ -123,7 +128,7 @@ fn combine_pixel(p: vec2<i32>, pos: vec2<f32>) -> vec4<f32> {
         }
         q = vec2<i32>(floor(r.xy));
         dn_old = r.z;
-        if (combine.size_mode.w > 0.5) {
+        if (combine.size_mode.w > 0.5 && combine.size_mode.w < 1.5) {
             q = forward_match(p, q);
             if (q.x < 0) {
                 return cn;
@@ -134,6 +139,13 @@ fn combine_pixel(p: vec2<i32>, pos: vec2<f32>) -> vec4<f32> {
     let ido = textureLoad(old_id, q, 0).r;
     if (idn == 0u && ido == 0u) {
         return cn;
+    }
+    if (combine.size_mode.w > 1.5) {
+        // Frame-sequential blending: the two finished buffers mixed by the weight of the t-instance's LOD in
+        // the newer buffer (its alpha), or, where only the older shows a t-instance, by that LOD's own weight.
+        let w_new = select(1.0 - co.a, cn.a, idn != 0u);
+        let mixed = mix(srgb_to_linear(co.rgb), srgb_to_linear(cn.rgb), w_new);
+        return vec4<f32>(linear_to_srgb(mixed), 1.0);
     }
     if (idn == ido) {
         let mixed = 0.5 * (srgb_to_linear(cn.rgb) + srgb_to_linear(co.rgb));

@@ -325,6 +325,19 @@ fn fs_fsi_t_world(in: VsOut, @builtin(front_facing) front: bool) -> FsiOut {
     return fsi_t_out(in, front);
 }
 
+// `fsi-blend` (frame-sequential blending, Scherzer & Wimmer 2008 section 3.3, Fig. 4): the LOD complete, no
+// visibility texture; the LOD's blend weight (params.y: k for the incoming LOD, 1 - k for the outgoing one) in
+// the colour's alpha, which the combination pass mixes by.
+@fragment
+fn fs_fsi_t_blend(in: VsOut, @builtin(front_facing) front: bool) -> FsiOut {
+    if (masked(in)) {
+        discard;
+    }
+    var out = fsi_t_out(in, front);
+    out.color.a = in.params.y;
+    return out;
+}
+
 fn fsi_t_out(in: VsOut, front: bool) -> FsiOut {
     var out: FsiOut;
     out.color = vec4<f32>(shade(in, front), 1.0);

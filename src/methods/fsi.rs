@@ -74,6 +74,10 @@ pub enum Variant {
     NoReproject,
     /// Both LOD buffers rendered every frame, same camera.
     SameFrame,
+    /// Frame-sequential blending (section 3.3, Fig. 4, the alternative the paper rejects): one LOD buffer per
+    /// frame as `Sequential`, each t-instance's LOD complete (no visibility texture), and the two buffers
+    /// alpha-blended by the LOD's weight (k for the incoming LOD, 1 - k for the outgoing one).
+    Blend,
 }
 
 /// `--fsi-check`: an optional test on the older buffer's fragment before the combination pass uses it. Not in
@@ -134,6 +138,16 @@ pub enum VisSpace {
 impl Default for FsiOptions {
     fn default() -> Self {
         crate::defaults::clap_defaults()
+    }
+}
+
+/// `fsi-blend`'s weight of LOD `lod` of a t-instance in state `s`: k for the incoming LOD, 1 - k for the
+/// outgoing one (the two buffers' weights at one k add up to 1).
+pub fn blend_weight(s: &InstanceState, lod: u32) -> f32 {
+    if lod == s.lod_to {
+        s.k
+    } else {
+        1.0 - s.k
     }
 }
 
@@ -457,9 +471,10 @@ impl Fsi {
         let n_pipeline = pipeline("fsi n-instances", "fs_fsi_n", None);
         let t_pipeline = pipeline(
             "fsi t-instances",
-            match options.vis_space {
-                VisSpace::Object => "fs_fsi_t",
-                VisSpace::World => "fs_fsi_t_world",
+            match (variant, options.vis_space) {
+                (Variant::Blend, _) => "fs_fsi_t_blend",
+                (_, VisSpace::Object) => "fs_fsi_t",
+                (_, VisSpace::World) => "fs_fsi_t_world",
             },
             None,
         );
@@ -647,7 +662,11 @@ impl Fsi {
                     lod,
                     params: [
                         self.repeats_per_unit[inst.model as usize],
-                        tau_with_margin(s, lod, self.margin[i]),
+                        if self.variant == Variant::Blend {
+                            blend_weight(s, lod)
+                        } else {
+                            tau_with_margin(s, lod, self.margin[i])
+                        },
                         lod as f32,
                         front_id(i) as f32,
                     ],
@@ -750,6 +769,16 @@ impl Fsi {
 }
 
 impl Fsi {
+    /// The combination the pass makes (`size_mode.w` of fsi_combine.wgsl): 0 the paper's, 1 with the forward
+    /// check, 2 frame-sequential blending.
+    fn combination(&self) -> f32 {
+        match (self.variant, self.forward_check) {
+            (Variant::Blend, _) => 2.0,
+            (_, true) => 1.0,
+            _ => 0.0,
+        }
+    }
+
     /// The combination pass over the LOD buffers of `group`, into `target`.
     fn combine(
         &self,
@@ -778,6 +807,12 @@ impl Fsi {
     fn scratch(&mut self, gpu: &SceneGpu, scene: &Scene) -> &Scratch {
         let (w, h) = (scene.width, scene.height);
         let n = scene.instances.len() as u32;
+        // Both buffers at one pose: no reprojection, no forward check (fsi-sameframe's combination), fsi-blend's
+        // blending.
+        let combination = match self.variant {
+            Variant::Blend => self.combination(),
+            _ => 0.0,
+        };
         let (device, layout, view, format) = (
             &gpu.device,
             &self.combine_layout,
@@ -795,11 +830,10 @@ impl Fsi {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
-            // Both buffers at one pose: no reprojection, no forward check (fsi-sameframe's combination).
             let raw = CombineRaw {
                 reproject: Mat4::IDENTITY.to_cols_array_2d(),
                 forward: Mat4::IDENTITY.to_cols_array_2d(),
-                size_mode: [w as f32, h as f32, 1.0, 0.0],
+                size_mode: [w as f32, h as f32, 1.0, combination],
             };
             gpu.queue
                 .write_buffer(&uniform, 0, bytemuck::bytes_of(&raw));
@@ -971,7 +1005,7 @@ impl Method for Fsi {
             });
         }
 
-        let same_pixel = self.variant != Variant::Sequential;
+        let same_pixel = !matches!(self.variant, Variant::Sequential | Variant::Blend);
         let raw = CombineRaw {
             reproject: reprojection(&camera, &old_camera).to_cols_array_2d(),
             forward: reprojection(&old_camera, &camera).to_cols_array_2d(),
@@ -979,7 +1013,7 @@ impl Method for Fsi {
                 target.width as f32,
                 target.height as f32,
                 if same_pixel { 1.0 } else { 0.0 },
-                if self.forward_check { 1.0 } else { 0.0 },
+                self.combination(),
             ],
         };
         gpu.queue

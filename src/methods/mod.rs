@@ -101,6 +101,7 @@ pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "fsi", about: "Frame Sequential Interpolation (Scherzer & Wimmer 2008)", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::Sequential))), options: |o| json(o.fsi) },
     MethodEntry { name: "fsi-noreproject", about: "FSI ablation: the older buffer read at the same pixel", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::NoReproject))), options: fsi_ablation_options },
     MethodEntry { name: "fsi-sameframe", about: "FSI ablation: both LOD buffers rendered every frame", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::SameFrame))), options: fsi_ablation_options },
+    MethodEntry { name: "fsi-blend", about: "FSI ablation: frame-sequential blending, the two LOD buffers alpha-blended by k, no visibility texture (not run by default)", create: |b| Ok(Box::new(fsi::Fsi::new(b.gpu, b.scene, &b.options.fsi, b.seed, fsi::Variant::Blend))), options: no_options },
     MethodEntry { name: "blocks", about: "unified LOD (Blow 2003a, 2003b): per-block alpha-zwrite blending, seams between the blocks", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::with_seams(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-noseams", about: "blocks without the seams (the ablation: cracks show where neighbours differ)", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "blocks-discrete", about: "blocks with seams, hard switches per block", create: |b| Ok(Box::new(discrete::Discrete::with_seams(b.gpu, b.scene))), options: no_options },
@@ -212,7 +213,7 @@ pub const UNIFIED_DEFAULT: [&str; 5] = [
 
 /// Built-in methods a run draws only when `--method` names them: variants that test a claim (their image is
 /// another method's, or they ablate one).
-pub const NOT_DEFAULT: [&str; 1] = ["dither-skip"];
+pub const NOT_DEFAULT: [&str; 2] = ["dither-skip", "fsi-blend"];
 
 /// Whether the method of `label` needs a unified scene.
 pub fn needs_unified(label: &str) -> bool {

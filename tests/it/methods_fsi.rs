@@ -20,6 +20,8 @@ struct Frame {
     reproject: Mat4,
     /// With `--fsi-check forward` on `fsi`: eq. 2 inverted (older clip space to newer).
     forward: Option<Mat4>,
+    /// `fsi-blend`: frame-sequential blending instead of the paper's cases.
+    blend: bool,
 }
 
 /// Renders frames 0..=last with `variant` and returns the last one with both LOD buffers.
@@ -61,7 +63,7 @@ fn render_fsi_checked(
         (b1, b0)
     };
     let reproject = match variant {
-        Variant::Sequential if last > 0 => {
+        Variant::Sequential | Variant::Blend if last > 0 => {
             reprojection(&scene.camera(last), &scene.camera(last - 1))
         }
         _ => Mat4::IDENTITY,
@@ -74,6 +76,7 @@ fn render_fsi_checked(
         older,
         reproject,
         forward,
+        blend: variant == Variant::Blend,
     }
 }
 
@@ -96,6 +99,8 @@ enum Case {
     OlderCloser,
     /// `--fsi-check forward`: no older fragment found that reprojects into the pixel; the newer colour.
     NoMatch,
+    /// `fsi-blend`: a t-instance in either buffer; the two colours mixed by its LOD's weight.
+    Blend,
 }
 
 /// Where pixel position (x, y) of one frame at `depth` lies in the other by the clip-to-clip matrix `m`, in
@@ -195,6 +200,18 @@ fn expected(fr: &Frame, x: u32, y: u32, reproject: bool) -> Option<(Case, [f32; 
     if idn == 0 && ido == 0 {
         return Some((Case::BothN, newer, q));
     }
+    if fr.blend {
+        // The weight of the newer buffer's t-instance LOD (its alpha byte), else 1 - the older one's.
+        let (an, ao) = (
+            fr.newer.color[p * 4 + 3] as f64 / 255.0,
+            fr.older.color[qi * 4 + 3] as f64 / 255.0,
+        );
+        let w = if idn != 0 { an } else { 1.0 - ao };
+        let mix = |i: usize| {
+            linear_to_srgb((1.0 - w) * srgb_to_linear(co[i]) + w * srgb_to_linear(cn[i]))
+        };
+        return Some((Case::Blend, [mix(0), mix(1), mix(2)], q));
+    }
     if idn == ido {
         let avg = |i: usize| linear_to_srgb(0.5 * (srgb_to_linear(cn[i]) + srgb_to_linear(co[i])));
         return Some((Case::Average, [avg(0), avg(1), avg(2)], q));
@@ -229,7 +246,11 @@ fn check_combination(fr: &Frame, reproject: bool) -> (Vec<(Case, usize)>, Lookup
             lookups.push(Some((case, q)));
             let p = ((y * w + x) * 4) as usize;
             let got = &fr.out[p..p + 3];
-            let tol = if case == Case::Average { 1.0 } else { 0.0 };
+            let tol = if matches!(case, Case::Average | Case::Blend) {
+                1.0
+            } else {
+                0.0
+            };
             if (0..3).any(|i| (got[i] as f32 - want[i]).abs() > tol + 1e-3) {
                 bad.push((x, y, case, got.to_vec(), want));
             }
@@ -552,4 +573,34 @@ fn g_world_space_lookup_changes_only_transition_frames() {
         }
     }
     assert!(differ > 0, "no frame differs");
+}
+
+/// (h) `fsi-blend` (frame-sequential blending, claim F28): the two LOD buffers hold complete LODs (no visibility
+/// texture: no pixel of a t-instance is discarded) and every pixel with a t-instance in either buffer is the two
+/// colours mixed by the LOD's weight, k for the incoming LOD and 1 - k for the outgoing one, checked against the
+/// CPU pixel by pixel: the near bunny at k = 0.25 in front of a far one at LOD3, on two consecutive frames.
+#[test]
+fn h_frame_sequential_blending_mixes_by_k() {
+    let ctx = crate::common::gpu();
+    let d = near_distance();
+    let s0 = d / (1.0 - 0.025);
+    let scene = static_scene(&[d, d * 1.7], [s0, s0 * 1.2, s0 * 1.4], 4, "fixed");
+    for last in [2, 3] {
+        let fr = render_fsi(&ctx, &scene, Variant::Blend, last);
+        let (counts, _) = check_combination(&fr, true);
+        assert!(count(&counts, Case::Blend) > 2000, "{counts:?}");
+        // The weights the buffers carry: 0.25 for LOD1 (incoming), 0.75 for LOD0, in whichever buffer.
+        let mut weights: Vec<u8> = (0..(W * H) as usize)
+            .filter(|&p| fr.newer.id[p] == 1)
+            .map(|p| fr.newer.color[p * 4 + 3])
+            .collect();
+        weights.dedup();
+        assert_eq!(
+            weights.len(),
+            1,
+            "one LOD, one weight: {:?}",
+            &weights[..weights.len().min(4)]
+        );
+        assert!([64u8, 191].contains(&weights[0]), "{}", weights[0]);
+    }
 }
