@@ -244,6 +244,20 @@ fn fs_translucent_occluded(in: VsOut, @builtin(front_facing) front: bool) -> @lo
     return vec4<f32>(shade(in, front), in.params.y);
 }
 
+// alpha-sorted's peel (src/methods/alpha_sorted.rs, shaders/peel.wgsl): the translucent fragment, kept only behind the
+// previous layer's depth (the depth attachment, a copy of the opaque depth with a less-equal test, keeps the
+// nearest of them in front of the opaque surface).
+@group(1) @binding(3) var peel_previous: texture_depth_2d;
+
+@fragment
+fn fs_translucent_peel(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let previous = textureLoad(peel_previous, vec2<i32>(in.clip.xy), 0);
+    if (in.clip.z <= previous || masked(in)) {
+        discard;
+    }
+    return vec4<f32>(shade(in, front), in.params.y);
+}
+
 // Noise blending (Sheliemietiev et al. 2023 section 9, eq. 3): a pixel of a t-instance keeps the incoming LOD where
 // k > noise(x, y) and the outgoing LOD elsewhere. params.x = k; params.y = role: 1 incoming, 0 outgoing.
 struct NoiseParams {

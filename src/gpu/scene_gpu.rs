@@ -533,6 +533,11 @@ impl SceneGpu {
         pass
     }
 
+    /// The scissor rectangle draws are limited to now ([`SceneGpu::scissored`]), for passes a method begins itself.
+    pub fn scissor(&self) -> Option<[u32; 4]> {
+        self.scissor.get()
+    }
+
     /// Draws `count` instances from absolute instance `first` of `buffer` at (model, LOD) with `pipeline`;
     /// for methods that need a pass per instance.
     #[allow(

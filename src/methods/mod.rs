@@ -8,6 +8,7 @@
 
 pub mod alpha;
 pub mod alpha_2pass;
+pub mod alpha_sorted;
 pub mod alpha_zwrite;
 pub mod blocks_tree;
 pub mod clusterlod;
@@ -94,6 +95,7 @@ pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "alpha", about: "Giegl's unpopping: one LOD opaque, the other blended over it", create: |b| Ok(Box::new(alpha::Alpha::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "alpha-2pass", about: "unpopping, double pass: each translucent LOD shows only its nearest surface", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene, alpha_2pass::Weights::Unpop))), options: no_options },
     MethodEntry { name: "alpha-linear", about: "Sheliemietiev et al. 2023's alpha blending: both LODs translucent, 1 - k and k, double pass each", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene, alpha_2pass::Weights::Linear))), options: no_options },
+    MethodEntry { name: "alpha-sorted", about: "alpha's blend composited in exact depth order per pixel (depth peeling): the order-independent reference of its sorting error (not run by default)", create: |b| Ok(Box::new(alpha_sorted::AlphaSorted::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "alpha-zwrite", about: "Blow's unpopping: translucent with Z-writes, the compare switch", create: |b| Ok(Box::new(alpha_zwrite::AlphaZWrite::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "dither", about: "noise blending: complementary screen-space discard", create: |b| Ok(Box::new(dither::Dither::new(b.gpu, b.scene, &b.options.dither, b.seed, false))), options: |o| json(o.dither) },
     MethodEntry { name: "dither-skip", about: "dither, a LOD the pattern gives no pixel at this k not drawn (not run by default)", create: |b| Ok(Box::new(dither::Dither::new(b.gpu, b.scene, &b.options.dither, b.seed, true))), options: |o| json(o.dither) },
@@ -213,7 +215,7 @@ pub const UNIFIED_DEFAULT: [&str; 5] = [
 
 /// Built-in methods a run draws only when `--method` names them: variants that test a claim (their image is
 /// another method's, or they ablate one).
-pub const NOT_DEFAULT: [&str; 2] = ["dither-skip", "fsi-blend"];
+pub const NOT_DEFAULT: [&str; 3] = ["alpha-sorted", "dither-skip", "fsi-blend"];
 
 /// Whether the method of `label` needs a unified scene.
 pub fn needs_unified(label: &str) -> bool {
