@@ -74,6 +74,22 @@ fn type_rank(t: wgpu::DeviceType) -> u8 {
 
 /// Every adapter wgpu finds, best first (discrete, integrated, virtual, CPU).
 pub fn enumerate_adapters() -> Vec<wgpu::Adapter> {
+    let _driver = driver_lock();
+    enumerate_unlocked()
+}
+
+/// One driver initialisation at a time in this process: instance creation, adapter enumeration and device
+/// creation from several threads at once have crashed drivers (wgpu issues 10010 and 10234; an intermittent
+/// SIGSEGV in libc's allocator during the parallel integration tests on lavapipe). The lock is held only while a
+/// context is made, never while it renders.
+fn driver_lock() -> std::sync::MutexGuard<'static, ()> {
+    static DRIVER: Mutex<()> = Mutex::new(());
+    DRIVER
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+fn enumerate_unlocked() -> Vec<wgpu::Adapter> {
     let inst = instance();
     let mut adapters = pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all()));
     adapters.sort_by_key(|a| type_rank(a.get_info().device_type));
@@ -122,7 +138,8 @@ pub fn choose_adapter(found: &[AdapterSummary], spec: Option<&str>) -> Result<us
 impl GpuContext {
     /// Opens the adapter `--adapter` names ([`choose_adapter`]: an index or a part of a name), or the best.
     pub fn new(spec: Option<&str>) -> Result<GpuContext> {
-        let adapters = enumerate_adapters();
+        let driver = driver_lock();
+        let adapters = enumerate_unlocked();
         if adapters.is_empty() {
             return Err(Error::NoAdapter(NO_ADAPTER_HELP.into()));
         }
@@ -159,6 +176,7 @@ impl GpuContext {
             }
         }));
         let timestamp_period_ns = queue.get_timestamp_period();
+        drop(driver);
         Ok(GpuContext {
             info: found[index].clone(),
             adapter,
