@@ -10,12 +10,12 @@
 //! ([`Method::selection_changed`]). `units_drawn` counts the nodes drawn, opaque or translucent.
 
 use super::alpha::OVER;
-use super::common::{FrameInput, Method};
+use super::common::{mesh_vertex_buffer, FrameInput, Method};
 use crate::error::{Error, Result};
 use crate::geometry::block_tree::{BlockTree, Cut};
 use crate::geometry::cluster_dag::CutBound;
 use crate::gpu::{
-    DrawList, DrawStats, InstanceBuffer, InstanceRaw, MeshPipeline, RenderTarget, SceneGpu, Vertex,
+    DrawList, DrawStats, InstanceBuffer, InstanceRaw, MeshPipeline, RenderTarget, SceneGpu,
 };
 use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
@@ -81,24 +81,7 @@ impl BlocksTree {
             unified.pixel_error,
             scene.schedule.band,
         );
-        let m = &unified.mesh;
-        let vertices: Vec<Vertex> = m
-            .positions
-            .iter()
-            .zip(&m.normals)
-            .map(|(p, n)| Vertex {
-                position: *p,
-                normal: *n,
-                aux: [0.0; 4],
-            })
-            .collect();
-        let vertex_buffer = gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("blocks-tree vertices"),
-                contents: bytemuck::cast_slice(&vertices),
-                usage: wgpu::BufferUsages::VERTEX,
-            });
+        let vertex_buffer = mesh_vertex_buffer(gpu, &unified.mesh, "blocks-tree vertices");
         let index_buffer = gpu
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {

@@ -4,14 +4,13 @@
 //! not used: the cut is this method's own selection, and lodpop's counterfactual is the previous frame's cut
 //! drawn at this frame's pose ([`Method::selection_changed`]).
 
-use super::common::{FrameInput, Method};
+use super::common::{identity_instance, mesh_vertex_buffer, FrameInput, Method};
 use crate::error::{Error, Result};
 use crate::geometry::cluster_dag::{CutBound, CutCamera};
-use crate::gpu::{DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu, Vertex};
+use crate::gpu::{DrawStats, InstanceBuffer, RenderTarget, SceneGpu};
 use crate::scene::schedule::InstanceState;
 use crate::scene::unified::Unified;
 use crate::scene::Scene;
-use glam::Mat4;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
@@ -51,24 +50,7 @@ impl ClusterLod {
                 scene.name()
             ))
         })?;
-        let m = &unified.mesh;
-        let vertices: Vec<Vertex> = m
-            .positions
-            .iter()
-            .zip(&m.normals)
-            .map(|(p, n)| Vertex {
-                position: *p,
-                normal: *n,
-                aux: [0.0; 4],
-            })
-            .collect();
-        let vertex_buffer = gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("clusterlod vertices"),
-                contents: bytemuck::cast_slice(&vertices),
-                usage: wgpu::BufferUsages::VERTEX,
-            });
+        let vertex_buffer = mesh_vertex_buffer(gpu, &unified.mesh, "clusterlod vertices");
         let index_buffer = gpu
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -76,17 +58,7 @@ impl ClusterLod {
                 contents: bytemuck::cast_slice(&unified.dag.indices),
                 usage: wgpu::BufferUsages::INDEX,
             });
-        let instance = gpu.create_instance_buffer("clusterlod instance", 1);
-        let mut instance_list = crate::gpu::DrawList::default();
-        let [r, g, b] = scene.models.first().map_or([0.7; 3], |m| m.color);
-        instance_list.push(
-            0,
-            0,
-            0,
-            InstanceRaw::new(&Mat4::IDENTITY, [r, g, b, 0.0], [0.0, 1.0, 0.0, 0.0]),
-        );
-        instance_list.build();
-        gpu.upload(&instance, &instance_list);
+        let instance = identity_instance(gpu, scene, "clusterlod instance");
         Ok(ClusterLod {
             unified,
             bound: options.cluster_bound,

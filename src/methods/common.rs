@@ -3,7 +3,9 @@
 
 use crate::effects::shadow::Caster;
 use crate::error::Result;
-use crate::gpu::{DrawList, DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu};
+use crate::gpu::{
+    DrawList, DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu, Vertex,
+};
 use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
 use glam::Mat4;
@@ -346,6 +348,49 @@ impl BlendLists {
         gpu.upload_at(buffer, n_opaque, &self.translucent);
         n_opaque
     }
+}
+
+/// A vertex buffer of `mesh`'s positions and normals (no aux): what the methods that draw a unified scene's
+/// whole mesh themselves (`clusterlod`, `blocks-tree`) upload once.
+pub fn mesh_vertex_buffer(
+    gpu: &SceneGpu,
+    mesh: &crate::geometry::mesh::Mesh,
+    label: &str,
+) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    let vertices: Vec<Vertex> = mesh
+        .positions
+        .iter()
+        .zip(&mesh.normals)
+        .map(|(p, n)| Vertex {
+            position: *p,
+            normal: *n,
+            aux: [0.0; 4],
+        })
+        .collect();
+    gpu.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::cast_slice(&vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        })
+}
+
+/// The one opaque instance of a method that draws a unified scene's mesh at the identity transform, in the
+/// colour of the scene's first model, uploaded.
+pub fn identity_instance(gpu: &SceneGpu, scene: &Scene, label: &str) -> InstanceBuffer {
+    let instance = gpu.create_instance_buffer(label, 1);
+    let mut list = DrawList::default();
+    let [r, g, b] = scene.models.first().map_or([0.7; 3], |m| m.color);
+    list.push(
+        0,
+        0,
+        0,
+        InstanceRaw::new(&Mat4::IDENTITY, [r, g, b, 0.0], [0.0, 1.0, 0.0, 0.0]),
+    );
+    list.build();
+    gpu.upload(&instance, &list);
+    instance
 }
 
 pub fn instance_raw(input: &FrameInput<'_>, i: usize, k: f32, alpha: f32, lod: u32) -> InstanceRaw {

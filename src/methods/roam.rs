@@ -12,17 +12,15 @@
 //! time of the update, the triangulation's walk and the morphs go to frames.csv (`splits`, `merges`,
 //! `select_cpu_ms`).
 
-use super::common::{FrameInput, Method};
+use super::common::{identity_instance, FrameInput, Method};
 use crate::error::{Error, Result};
 use crate::geometry::cluster_dag::CutBound;
 use crate::geometry::roam::{Bintree, HeightField};
 use crate::geometry::terrain::{height, TERRAIN_SIZE};
-use crate::gpu::{
-    DrawStats, InstanceBuffer, InstanceRaw, RenderTarget, SceneGpu, Selection, Vertex,
-};
+use crate::gpu::{DrawStats, InstanceBuffer, RenderTarget, SceneGpu, Selection, Vertex};
 use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use std::time::Instant;
 use wgpu::util::DeviceExt;
 
@@ -116,17 +114,7 @@ impl Roam {
                 mapped_at_creation: false,
             })
         };
-        let instance = gpu.create_instance_buffer("roam instance", 1);
-        let mut list = crate::gpu::DrawList::default();
-        let [r, g, b] = scene.models.first().map_or([0.7; 3], |m| m.color);
-        list.push(
-            0,
-            0,
-            0,
-            InstanceRaw::new(&Mat4::IDENTITY, [r, g, b, 0.0], [0.0, 1.0, 0.0, 0.0]),
-        );
-        list.build();
-        gpu.upload(&instance, &list);
+        let instance = identity_instance(gpu, scene, "roam instance");
         let slots = if morph_frames.is_some() { 4096 } else { 0 };
         let n_vertices = grid.len();
         Ok(Roam {
