@@ -83,7 +83,8 @@ impl QualityTargets {
 pub struct QualityKernels {
     /// rmse, pop, de2000, uncovered and crack pixels of (method, reference).
     pub metric: MetricKernel,
-    /// Times the metric kernel alone (its own cost, reported in run.json).
+    /// Times the metric kernel alone on every [`METRIC_TIMED_EVERY`]th frame (its own cost, reported in
+    /// run.json).
     pub metric_timer: Option<GpuTimer>,
     /// lodpop: pair 0 = (method, before), pair 1 = (now, before).
     pub lodpop: DiffKernel,
@@ -111,7 +112,7 @@ impl QualityKernels {
                 (quality.metrics.contains(&Metric::De2000), quality.reduction),
                 gpu.background_bytes(ctx)?,
             )?,
-            metric_timer: GpuTimer::new(ctx, frames),
+            metric_timer: GpuTimer::new(ctx, frames.div_ceil(METRIC_TIMED_EVERY)),
         })
     }
 }
@@ -190,6 +191,11 @@ pub struct QualityStage {
 
 /// Keep at most this many quality-pass frames queued on the GPU.
 const QUALITY_IN_FLIGHT: usize = 2;
+
+/// The metric kernel is timed on frames 0, n, 2n, ... only: each timed frame adds two timestamp passes and a
+/// resolve, fixed costs as large as a small frame's kernel on a CPU rasteriser, and `metric_gpu_ms_median` is a
+/// median, which a sample of a block's frames estimates.
+pub const METRIC_TIMED_EVERY: u32 = 8;
 
 /// The schedule states of the last frames, newest first: lodpop's history.
 struct StateHistory {
@@ -284,6 +290,8 @@ struct Walk<'d> {
     reference_is_method_frame: bool,
     /// Frames whose reference frame was copied, not drawn.
     reference_copied: u32,
+    /// The metric timer's slots written in this pass.
+    metric_timed: Vec<u32>,
 }
 
 impl QualityStage {
@@ -365,6 +373,7 @@ impl QualityStage {
             reference_is_method_frame: is_reference
                 && Self::reference_copyable(&self.taa, &self.shadow_share),
             reference_copied: 0,
+            metric_timed: Vec::new(),
         };
         let pass_start = Instant::now();
         if let Some(taa) = &mut self.taa {
@@ -413,11 +422,18 @@ impl QualityStage {
         let shadows = self.shadow_maps(base, method, &input, previous);
         self.apply_effects(base, &input, &mut encoder, (f, previous.is_some()));
         let view_proj = base.scene.camera(f).view_proj();
-        let tiles = walk
+        let mut tiles = walk
             .coverage
             .frame_tiles(base.scene, &driver.matrices, view_proj);
+        if copy_method {
+            // The reference's frame compared with itself (the same draw, copied): every figure of the kernel
+            // is 0 by construction, so no tile is read (frame 0 still zeroes the block's sums).
+            tiles.clear();
+        }
         walk.tiles_read += tiles.len() as u64;
-        self.encode_metrics(base, &mut encoder, f, &tiles);
+        if self.encode_metrics(base, &mut encoder, f, &tiles) {
+            walk.metric_timed.push(f / METRIC_TIMED_EVERY);
+        }
         let mut reads = self.request_reads(base, method, &mut encoder, dump);
         let mut index = ctx
             .queue
@@ -572,22 +588,28 @@ impl QualityStage {
         }
     }
 
-    /// Stage 4: the metric kernel on (method, reference) over `tiles`, timed on its own.
+    /// Stage 4: the metric kernel on (method, reference) over `tiles`, timed on its own every
+    /// [`METRIC_TIMED_EVERY`]th frame where it reads a tile (returns whether this frame was timed).
     fn encode_metrics(
         &self,
         base: &BlockGpu<'_>,
         encoder: &mut wgpu::CommandEncoder,
         f: u32,
         tiles: &[u32],
-    ) {
+    ) -> bool {
         let k = &self.kernels;
-        if let Some(t) = &k.metric_timer {
-            t.begin(encoder, f);
+        let timer = match &k.metric_timer {
+            Some(t) if f.is_multiple_of(METRIC_TIMED_EVERY) && !tiles.is_empty() => Some(t),
+            _ => None,
+        };
+        if let Some(t) = timer {
+            t.begin(encoder, f / METRIC_TIMED_EVERY);
         }
         k.metric.encode(&base.ctx.queue, encoder, f, tiles);
-        if let Some(t) = &k.metric_timer {
-            t.end(encoder, f);
+        if let Some(t) = timer {
+            t.end(encoder, f / METRIC_TIMED_EVERY);
         }
+        timer.is_some()
     }
 
     /// Stage 5: copies of the frames for FLIP or a dump, and of the method's intermediate images (FSI's LOD
@@ -860,7 +882,12 @@ impl QualityStage {
         };
         let metric_gpu_ms_median = match &k.metric_timer {
             Some(t) => {
-                let ms: Vec<f64> = t.read(ctx)?.into_iter().flatten().collect();
+                let slots = t.read(ctx)?;
+                let ms: Vec<f64> = walk
+                    .metric_timed
+                    .iter()
+                    .filter_map(|&i| slots.get(i as usize).copied().flatten())
+                    .collect();
                 crate::measure::stats::percentile(&ms, 50.0)
             }
             None => None,
