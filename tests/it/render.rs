@@ -9,8 +9,9 @@ use lodbench::measure::{BlockRunner, QualityOptions};
 use lodbench::scene::SceneKind;
 use std::path::Path;
 
-/// The acceptance check of a run, on the ci profile: the three files; reference rows score 0; discrete scores 0 while
-/// LOD0 is shown and > 0 after the first switch; its pop peaks on switch frames.
+/// The acceptance check of a run, on the ci profile (the README's main job at a quarter of its frames, 600: the
+/// sweep goes through every LOD the same way, four times faster): the three files; reference rows score 0; discrete
+/// scores 0 while LOD0 is shown and > 0 after the first switch; its pop peaks on switch frames.
 #[test]
 fn ci_sweep_reference_and_discrete() {
     let dir = tempfile::tempdir().unwrap();
@@ -23,6 +24,8 @@ fn ci_sweep_reference_and_discrete() {
         "reference,discrete",
         "--profile",
         "ci",
+        "--frames",
+        "600",
         "--out",
         out_s,
     ]);
@@ -96,7 +99,7 @@ fn ci_sweep_reference_and_discrete() {
     let summary = read_csv(&out.join("summary.csv"));
     assert_eq!(summary.len(), 2);
     let d = summary.iter().find(|r| r["method"] == "discrete").unwrap();
-    assert_eq!(d["frames"], "2400");
+    assert_eq!(d["frames"], "600");
     let pop_max: f64 = d["pop_max"].parse().unwrap();
     assert_eq!(pop_max, pop[argmax]);
 }
