@@ -415,7 +415,14 @@ impl QualityStage {
             self.clear_kernels(&mut encoder);
         }
         let copy_method = walk.reference_is_method_frame;
-        if self.render_frames(base, method, (&input, f, copy_method), &mut encoder) {
+        let read_back = dump || self.flip;
+        if self.render_frames(
+            base,
+            method,
+            (&input, f, copy_method),
+            &mut encoder,
+            read_back,
+        ) {
             walk.reference_copied += 1;
         }
         let previous = walk.history.previous();
@@ -477,13 +484,16 @@ impl QualityStage {
     /// Stage 1: the reference and the method, each lit by its own shadow map. The reference frame is not drawn
     /// (returns true) where an earlier pass kept frame `f` in the cache, or where `copy_method` says the
     /// method's frame is the same draw (copied); a drawn or copied reference frame is kept for the next pass
-    /// where the cache has room.
+    /// where the cache has room. The method's frame is copied into the reference target only where something
+    /// reads that target this frame (a dump or FLIP: the metric kernel skips a frame compared with itself); the
+    /// cache then keeps it from the method's target.
     fn render_frames(
         &mut self,
         base: &BlockGpu<'_>,
         method: &mut dyn Method,
         (input, f, copy_method): (&FrameInput<'_>, u32, bool),
         encoder: &mut wgpu::CommandEncoder,
+        read_back: bool,
     ) -> bool {
         let (gpu, t, reference) = (&base.gpu, &self.targets, &mut self.reference);
         let cache = self.reference_cache.as_ref();
@@ -497,11 +507,15 @@ impl QualityStage {
         gpu.lit_by(ShadowRole::Method.map(), || {
             method.encode(gpu, input, encoder, &t.method)
         });
-        if from_method {
+        if from_method && read_back {
             t.method.copy_color_to(encoder, &t.reference);
         }
         if let (false, Some(c)) = (from_cache, cache) {
-            c.store(encoder, f, &t.reference);
+            c.store(
+                encoder,
+                f,
+                if from_method { &t.method } else { &t.reference },
+            );
         }
         from_cache || from_method
     }

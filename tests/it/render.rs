@@ -104,6 +104,44 @@ fn ci_sweep_reference_and_discrete() {
     assert_eq!(pop_max, pop[argmax]);
 }
 
+/// The reference's own quality pass reads its frame as the reference only where a dump or FLIP needs it: there
+/// its dumped reference image is its dumped frame, byte for byte, and its FLIP error is 0 on every frame (a stale
+/// reference target, one not refreshed from the method's frame, scores about 0.6 here); discrete's pass, which
+/// copies the reference from the cache the reference's pass filled, dumps the same reference images.
+#[test]
+fn the_references_own_pass_dumps_and_flips_its_own_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    #[rustfmt::skip]
+    let cfg = run_config(&[
+        "--scene", "bunny-sweep", "--method", "reference,discrete", "--width", "64", "--height", "48",
+        "--frames", "12", "--warmup", "0", "--dump-frames", "--dump-every", "4", "--metrics", "rmse,pop,flip",
+        "--out", out.to_str().unwrap(),
+    ]);
+    run::run(&cfg).unwrap();
+    let rows = read_csv(&out.join("frames.csv"));
+    let flip = col(&rows, "reference", "flip_mean");
+    assert_eq!(flip.len(), 12);
+    assert!(
+        flip.iter().all(|&x| x == 0.0),
+        "reference flip_mean {flip:?}"
+    );
+    let png = |method: &str, f: u32, kind: &str| {
+        let name = format!("bunny-sweep_{method}_c1_f{f:05}_{kind}.png");
+        image::open(out.join("frames").join(&name))
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .to_rgba8()
+    };
+    for f in [0, 4, 8] {
+        let frame = png("reference", f, "method");
+        assert!(frame == png("reference", f, "reference"), "frame {f}");
+        assert!(
+            frame == png("discrete", f, "reference"),
+            "frame {f}: cached"
+        );
+    }
+}
+
 /// The same flags twice give identical quality columns (and everything else that is not a time), for every
 /// method: the frame-sequential ones (fsi*) and the noise-driven one (dither) included.
 #[test]
