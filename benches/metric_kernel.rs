@@ -103,23 +103,14 @@ fn disc(width: u32, height: u32, radius: f64, tint: u8) -> Vec<u8> {
 
 fn fill(ctx: &GpuContext, target: &RenderTarget, rgba: &[u8]) {
     ctx.queue.write_texture(
-        wgpu::TexelCopyTextureInfo {
-            texture: &target.color,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
+        target.color.as_image_copy(),
         rgba,
         wgpu::TexelCopyBufferLayout {
             offset: 0,
             bytes_per_row: Some(target.width * 4),
             rows_per_image: Some(target.height),
         },
-        wgpu::Extent3d {
-            width: target.width,
-            height: target.height,
-            depth_or_array_layers: 1,
-        },
+        target.color.size(),
     );
 }
 

@@ -23,11 +23,14 @@ const FIGURES: [&str; 8] = [
 const METHODS: &str =
     "reference,discrete,alpha,alpha-2pass,alpha-linear,alpha-zwrite,dither,geomorph";
 
-/// Per block of run.json: (method, metric_tile_share, counterfactual_pixel_share).
-fn shares(dir: &Path) -> Vec<(String, f64, Option<f64>)> {
-    metric_times(dir);
+/// A run's run.json.
+fn run_json(dir: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(dir.join("run.json")).unwrap();
-    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+/// Per block of run.json: (method, metric_tile_share, counterfactual_pixel_share).
+fn shares(json: &serde_json::Value) -> Vec<(String, f64, Option<f64>)> {
     json["blocks"]
         .as_array()
         .unwrap()
@@ -69,9 +72,7 @@ fn the_covered_region_gives_the_full_frames_figures_on_trees() {
 /// The metric kernel's own time per frame (`metric_gpu_ms_median`, from a sample of the frames where the kernel
 /// ran): none for the reference, whose frame is compared with itself and never read, a positive time for every
 /// other block (lavapipe has timestamps).
-fn metric_times(dir: &Path) {
-    let text = std::fs::read_to_string(dir.join("run.json")).unwrap();
-    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+fn metric_times(json: &serde_json::Value) {
     if json["timing_source"] != "gpu-timestamps" {
         return;
     }
@@ -107,7 +108,9 @@ fn covered_equals_full(scene: &str, frames: &str, count: &str) {
                     c
                 })
                 .collect();
-            figures.push((cells, shares(&out)));
+            let json = run_json(&out);
+            metric_times(&json);
+            figures.push((cells, shares(&json)));
         }
         let (covered, full) = (&figures[0], &figures[1]);
         assert_eq!(covered.0.len(), full.0.len(), "{scene}: rows");
