@@ -5,8 +5,10 @@
 // Both images are read through Rgba8Unorm views of the sRGB targets, i.e. as the stored sRGB-encoded bytes.
 // Per pixel, with d = a - b per channel: |d.r|^2 + |d.g|^2 + |d.b|^2 -> rms = sqrt(sum / (3 * 255^2 * pixels)).
 // One workgroup per row of the rectangle `x0..x1` by `y0..y1` (outside it the two frames are known to be equal:
-// lodpop's counterfactual is drawn only there, src/measure/quality.rs), 64 invocations, no barriers (as shaders/metrics.wgsl, for the same reasons); a run of at
-// most 8192 / 64 = 128 pixels keeps each partial sum below 2^32 (128 * 3 * 255^2).
+// lodpop's counterfactual is drawn only there, src/measure/quality.rs), LANES invocations (a pipeline constant,
+// as in shaders/metrics.wgsl: 64 on a GPU, 8 on a CPU adapter, one vector of lavapipe's 256-bit lanes adding an
+// eighth of the atomics 64 would), no barriers (as shaders/metrics.wgsl, for the same reasons); a run of at
+// most 8192 / 8 = 1024 pixels keeps each partial sum below 2^32 (1024 * 3 * 255^2).
 
 struct Params {
     width: u32,
@@ -24,13 +26,13 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> sums: array<atomic<u32>>;
 @group(0) @binding(3) var<uniform> params: Params;
 
-const LANES: u32 = 64u;
+override LANES: u32 = 64u;
 
 fn to_bytes(v: vec4<f32>) -> vec3<i32> {
     return vec3<i32>(round(clamp(v.rgb, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0));
 }
 
-@compute @workgroup_size(64, 1, 1)
+@compute @workgroup_size(LANES, 1, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let y = params.y0 + gid.y;
     if (y >= params.y1) {

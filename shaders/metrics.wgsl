@@ -14,23 +14,27 @@
 //              its row or its column, and the reference's surface on every pixel within CRACK_MARGIN of it (a gap
 //              inside the surface, not a silhouette that a coarser LOD moved inwards)
 //                                                                                -> crack_px = count
-// Uncovered pixels are counted in the loop; those of a row are listed (`uncovered_list`) and the crack test runs
-// on the list in a second dispatch, `crack_main`.
+// Uncovered pixels are counted and marked in the loop, then listed (`uncovered_list`) without reading the frames
+// again; the crack test runs on the list in a second dispatch, `crack_main`, sized by `main` through `crack_args`
+// (an indirect dispatch: no workgroup where no pixel is uncovered, one per 8 listed pixels otherwise).
 // e_t is kept per pixel in `prev_error` for the next frame. Each frame slot holds three 64-bit sums and the two
 // 32-bit counts (8 words; a count stays below 8192^2 = 2^26).
 // Two pipeline-overridable switches: DE2000 adds de2000 (`--metrics de2000`, which costs more than the rest);
-// WORKGROUP_REDUCE sums the tile's 64 partial sums in workgroup memory behind a barrier and adds them with one
+// WORKGROUP_REDUCE sums the tile's LANES partial sums in workgroup memory behind a barrier and adds them with one
 // invocation (`--metric-reduction workgroup`) instead of each invocation adding its own (the default, `atomics`,
 // measured faster on lavapipe: docs/measurement.md, "Cost of the quality pass").
 //
-// One workgroup per 16 x 16 tile of the frame, 64 invocations, over the tiles listed in `tiles` (the quality
+// One workgroup per 16 x 16 tile of the frame, LANES invocations, over the tiles listed in `tiles` (the quality
 // pass lists those an instance can cover now or covered on the previous frame, src/measure/coverage.rs; every
 // tile where it cannot bound them): outside them both frames show the background and e_t = e_(t-1) = 0, so
-// every sum is the whole frame's. Invocation i reads the pixels (i % 16, i / 16 + 4 j), j = 0..3, of its tile
-// (neighbouring invocations read neighbouring pixels), then its sums reach a 64-bit total made of two u32
-// atomics per frame slot, directly or through the workgroup reduction. Four pixels per invocation keep each
-// partial sum far below 2^32 (4 * 780300 for pop; 4 * 65536 * 120 for de2000, CIEDE2000 staying below 120
-// between sRGB colours); the reduction carries into the high word. The tiles come in rows of at most
+// every sum is the whole frame's. Invocation i reads the tile's pixels k = i + LANES j, j = 0..PIXELS - 1, at
+// (k % 16, k / 16) (neighbouring invocations read neighbouring pixels), then its sums reach a 64-bit total made
+// of two u32 atomics per frame slot, directly or through the workgroup reduction. LANES is a pipeline
+// constant (src/gpu/compute.rs, `kernel_lanes`): 64 on a GPU, 8 on a CPU adapter, where 8 invocations are one
+// vector of lavapipe's 256-bit lanes and each adds its sums with a quarter of the atomics per pixel that 64 do
+// (the reads are the same; benches/metric_kernel.rs). At most 32 pixels per invocation keep each partial sum
+// far below 2^32 (32 * 585225 for rmse, 32 * 780300 for pop, 32 * 65536 * 120 for de2000, CIEDE2000 staying
+// below 120 between sRGB colours); the reduction carries into the high word. The tiles come in rows of at most
 // MAX_ROW workgroups (a dispatch's limit per dimension): tile index = workgroup_id.y * MAX_ROW + workgroup_id.x.
 
 struct Params {
@@ -53,7 +57,18 @@ struct Params {
 @group(0) @binding(4) var<uniform> params: Params;
 // The frame's uncovered pixels (indices y * width + x), appended by `main`, checked for cracks by `crack_main`.
 @group(0) @binding(5) var<storage, read_write> uncovered_list: array<u32>;
-@group(0) @binding(6) var<storage, read_write> uncovered_count: atomic<u32>;
+// How many `uncovered_list` holds, then `crack_main`'s indirect dispatch (x, y, z): x = the workgroups its
+// CRACK_LANES invocations each need for one listed pixel, at most MAX_CRACK_GROUPS. `count` and `groups` are
+// zeroed before each frame, y and z stay 1.
+struct CrackArgs {
+    count: atomic<u32>,
+    groups: atomic<u32>,
+    y: u32,
+    z: u32,
+};
+@group(0) @binding(6) var<storage, read_write> crack_args: CrackArgs;
+// The same buffer, read-only, in `crack_main`'s own bind group (it is that dispatch's indirect arguments too).
+@group(0) @binding(8) var<storage, read> crack_count: array<u32>;
 // The tiles this frame reads, each as tx | ty << 16.
 @group(0) @binding(7) var<storage, read> tiles: array<u32>;
 
@@ -69,7 +84,9 @@ fn add_u64(lo: u32, value: u32) {
     }
 }
 
-const LANES: u32 = 64u;
+// Invocations per tile (8, 16, 32 or 64: the `uncovered` mask holds PIXELS bits) and the pixels each reads.
+override LANES: u32 = 64u;
+override PIXELS: u32 = 256u / LANES;
 const TILE: u32 = 16u;
 const MAX_ROW: u32 = 65535u;
 const CRACK_REACH: i32 = 4;
@@ -193,17 +210,23 @@ fn ciede2000(lab1: vec3<f32>, lab2: vec3<f32>) -> f32 {
     return sqrt(max(x * x + y * y + z * z + rt * y * z, 0.0));
 }
 
+// The first LANES entries are used.
 var<workgroup> partial: array<vec3<u32>, 64>;
 
-/// Workgroups of `crack_main` (each of 64 invocations).
-const CRACK_GROUPS: u32 = 4u;
+/// Invocations of a `crack_main` workgroup, and the most workgroups it is given (past that, each invocation
+/// tests several pixels).
+const CRACK_LANES: u32 = 8u;
+const MAX_CRACK_GROUPS: u32 = 4096u;
 
-// The crack test of every uncovered pixel `main` listed (dispatched after it, CRACK_GROUPS workgroups).
-@compute @workgroup_size(64, 1, 1)
-fn crack_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let n = atomicLoad(&uncovered_count);
+// The crack test of every uncovered pixel `main` listed (dispatched after it, indirectly through `crack_args`).
+@compute @workgroup_size(8, 1, 1)
+fn crack_main(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let n = crack_count[0];
     var cracks = 0u;
-    for (var i = gid.x; i < n; i = i + 64u * CRACK_GROUPS) {
+    for (var i = gid.x; i < n; i = i + CRACK_LANES * groups.x) {
         let idx = uncovered_list[i];
         let p = vec2<i32>(i32(idx % params.width), i32(idx / params.width));
         let enclosed = enclosed_along(p, vec2<i32>(1, 0)) || enclosed_along(p, vec2<i32>(0, 1));
@@ -232,23 +255,26 @@ fn add_u64_pair(lo: u32, v: vec2<u32>) {
 override DE2000: bool = false;
 override WORKGROUP_REDUCE: bool = false;
 
-// Pixel j (0..3) of invocation `lid` in the tile at `origin`: (x, y), and whether it lies inside the frame.
+// Pixel j (0..PIXELS - 1) of invocation `lid` in the tile at `origin`: (x, y), and whether it lies inside the
+// frame.
 fn tile_pixel(origin: vec2<u32>, lid: u32, j: u32) -> vec3<u32> {
-    let x = origin.x + (lid & (TILE - 1u));
-    let y = origin.y + (lid >> 4u) + 4u * j;
+    let k = lid + LANES * j;
+    let x = origin.x + k % TILE;
+    let y = origin.y + k / TILE;
     return vec3<u32>(x, y, select(0u, 1u, x < params.width && y < params.height));
 }
 
-@compute @workgroup_size(64, 1, 1)
+@compute @workgroup_size(LANES, 1, 1)
 fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let listed = wid.y * MAX_ROW + wid.x;
     // Workgroups past the list still take part in the workgroup's barrier, with nothing to add.
-    let pixels = select(0u, 4u, listed < params.tile_count);
+    let pixels = select(0u, PIXELS, listed < params.tile_count);
     let packed = tiles[min(listed, max(params.tile_count, 1u) - 1u)];
     let origin = vec2<u32>(packed & 0xffffu, packed >> 16u) * TILE;
     var rmse_sum = 0u;
     var pop_sum = 0u;
     var de_sum = 0u;
+    // Bit j: pixel j is uncovered.
     var uncovered = 0u;
     let bg = background_bytes();
     for (var j = 0u; j < pixels; j = j + 1u) {
@@ -260,7 +286,7 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
         let a = to_bytes(textureLoad(method_img, p, 0));
         let b = to_bytes(textureLoad(reference_img, p, 0));
         let e = a - b;
-        uncovered = uncovered + select(0u, 1u, all(a == bg) && any(b != bg));
+        uncovered = uncovered | select(0u, 1u << j, all(a == bg) && any(b != bg));
         let s = u32(abs(e.x) + abs(e.y) + abs(e.z));
         rmse_sum = rmse_sum + s * s;
         if (DE2000 && s != 0u) {
@@ -281,24 +307,24 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
         prev_error[idx] = biased.x | (biased.y << 10u) | (biased.z << 20u);
     }
     let slot = params.slot * SLOT_WORDS;
-    // Only an invocation that met an uncovered pixel walks its pixels again to list them: the crack test's
-    // neighbourhood reads run in `crack_main`, on the list, not in this loop (lavapipe runs a branch's body for
-    // every pixel of a vector whatever the condition, so the test inside the loop slowed every frame several
-    // times over).
+    // The marked pixels listed, from the mask: no second read of the frames (lavapipe runs a branch's body for
+    // every pixel of a vector whatever the condition, so the listing costs what it reads). The neighbourhood
+    // reads of the crack test run in `crack_main`, on the list: in this loop they slowed every frame several
+    // times over.
     if (uncovered != 0u) {
-        atomicAdd(&sums[slot + 6u], uncovered);
-        for (var j = 0u; j < pixels; j = j + 1u) {
-            let q = tile_pixel(origin, lid, j);
-            if (q.z == 0u) {
-                continue;
-            }
-            let p = vec2<i32>(i32(q.x), i32(q.y));
-            let a = to_bytes(textureLoad(method_img, p, 0));
-            let b = to_bytes(textureLoad(reference_img, p, 0));
-            if (all(a == bg) && any(b != bg)) {
-                uncovered_list[atomicAdd(&uncovered_count, 1u)] = q.y * params.width + q.x;
-            }
+        atomicAdd(&sums[slot + 6u], countOneBits(uncovered));
+    }
+    var marked = uncovered;
+    loop {
+        if (marked == 0u) {
+            break;
         }
+        let j = firstTrailingBit(marked);
+        marked = marked & (marked - 1u);
+        let q = tile_pixel(origin, lid, j);
+        let at = atomicAdd(&crack_args.count, 1u);
+        uncovered_list[at] = q.y * params.width + q.x;
+        atomicMax(&crack_args.groups, min(at / CRACK_LANES + 1u, MAX_CRACK_GROUPS));
     }
     if (!WORKGROUP_REDUCE) {
         add_u64_pair(slot, vec2<u32>(rmse_sum, 0u));

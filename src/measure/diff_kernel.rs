@@ -3,7 +3,7 @@
 //! (bound once); `encode` picks the pair.
 
 use crate::error::Result;
-use crate::gpu::compute::{bind_group, results_buffers, uniform_buffer};
+use crate::gpu::compute::{bind_group, kernel_lanes, results_buffers, uniform_buffer};
 use crate::gpu::context::GpuContext;
 use crate::gpu::targets::RenderTarget;
 use crate::measure::coverage::PixelRect;
@@ -41,7 +41,10 @@ impl DiffKernel {
             layout: None,
             module: &module,
             entry_point: Some("main"),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &[("LANES", kernel_lanes(ctx) as f64)],
+                ..Default::default()
+            },
             cache: None,
         });
         let [sums, readback] = results_buffers(device, [label, label], frames as u64 * 8);

@@ -3,15 +3,16 @@
 //! frame reads the tiles it is given (all of them, or those [`crate::measure::coverage::Coverage`] says can
 //! differ from the background).
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu::compute::{
-    bind_group, buffer, read_only_storage_entry, results_buffers, storage_entry, texture_entry,
-    uniform_buffer, uniform_entry,
+    bind_group, buffer, kernel_lanes, read_only_storage_entry, results_buffers, storage_entry,
+    texture_entry, uniform_buffer, uniform_entry,
 };
 use crate::gpu::context::GpuContext;
 use crate::gpu::targets::RenderTarget;
 use crate::measure::coverage::TILE;
 use crate::measure::metrics::{FrameMetrics, MetricReduction};
+use wgpu::util::DeviceExt;
 use wgpu::BufferUsages as U;
 
 pub const METRICS_WGSL: &str = include_str!("../../shaders/metrics.wgsl");
@@ -20,12 +21,14 @@ pub struct MetricKernel {
     pipeline: wgpu::ComputePipeline,
     /// `crack_main`: the crack test of the uncovered pixels `main` listed.
     crack_pipeline: wgpu::ComputePipeline,
-    uncovered_count: wgpu::Buffer,
+    /// `crack_args` in the shader: the listed pixels' count, then `crack_main`'s indirect dispatch (x, 1, 1).
+    crack_args: wgpu::Buffer,
     _uncovered_list: wgpu::Buffer,
     /// The frame's tile list (`tiles` in the shader), each as `tx | ty << 16`.
     tiles: wgpu::Buffer,
     tiles_x: u32,
     bind_group: wgpu::BindGroup,
+    crack_bind_group: wgpu::BindGroup,
     params: wgpu::Buffer,
     sums: wgpu::Buffer,
     readback: wgpu::Buffer,
@@ -35,7 +38,7 @@ pub struct MetricKernel {
     background: u32,
 }
 
-/// One layout for both entry points, so one bind group serves the two dispatches of a frame.
+/// The bindings of `main`.
 fn metric_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("metric layout"),
@@ -52,27 +55,45 @@ fn metric_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
+/// The bindings of `crack_main`: `crack_args` read-only (binding 8), since the same dispatch reads it as its
+/// indirect arguments, a use wgpu does not allow beside a writable binding.
+fn crack_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("crack test layout"),
+        entries: &[
+            texture_entry(0),
+            texture_entry(1),
+            storage_entry(3),
+            uniform_entry(4),
+            storage_entry(5),
+            read_only_storage_entry(8),
+        ],
+    })
+}
+
 /// The pipelines of `main` (the per-pixel figures) and `crack_main` (the crack test of the uncovered pixels),
-/// with the shader's DE2000 and WORKGROUP_REDUCE constants.
+/// with the shader's DE2000, WORKGROUP_REDUCE and LANES constants.
 fn metric_pipelines(
     device: &wgpu::Device,
     module: &wgpu::ShaderModule,
-    layout: &wgpu::BindGroupLayout,
+    layouts: [&wgpu::BindGroupLayout; 2],
     (de2000, reduction): (bool, MetricReduction),
+    lanes: u32,
 ) -> [wgpu::ComputePipeline; 2] {
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("metric pipeline layout"),
-        bind_group_layouts: &[Some(layout)],
-        immediate_size: 0,
-    });
     let constants = [
         ("DE2000", de2000 as u32 as f64),
         (
             "WORKGROUP_REDUCE",
             (reduction == MetricReduction::Workgroup) as u32 as f64,
         ),
+        ("LANES", lanes as f64),
     ];
-    let compute = |label, entry_point| {
+    let compute = |label, entry_point, layout| {
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(layout)],
+            immediate_size: 0,
+        });
         device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(label),
             layout: Some(&pipeline_layout),
@@ -86,13 +107,13 @@ fn metric_pipelines(
         })
     };
     [
-        compute("metric kernel", "main"),
-        compute("crack kernel", "crack_main"),
+        compute("metric kernel", "main", layouts[0]),
+        compute("crack kernel", "crack_main", layouts[1]),
     ]
 }
 
-/// Workgroups of `crack_main` (CRACK_GROUPS in the shader).
-const CRACK_GROUPS: u32 = 4;
+/// Bytes of `crack_args` zeroed before each frame: the count and the dispatch's x.
+const CRACK_ARGS_CLEARED: u64 = 8;
 
 /// Workgroups per row of the tile dispatch (MAX_ROW in the shader: a dispatch's limit per dimension).
 const MAX_ROW: u32 = 65535;
@@ -102,15 +123,34 @@ const SLOT_WORDS: u32 = 8;
 
 impl MetricKernel {
     /// Compares `method` against `reference` (both the same size) over up to `frames` frames; `de2000`: also
-    /// the mean CIEDE2000 (else it reads 0); `reduction`: how a row's partial sums are added; `background`:
-    /// the bytes a target cleared to the background holds (for uncovered_px and crack_px).
+    /// the mean CIEDE2000 (else it reads 0); `reduction`: how a tile's partial sums are added; `background`:
+    /// the bytes a target cleared to the background holds (for uncovered_px and crack_px). A tile is read by
+    /// [`kernel_lanes`] invocations.
     pub fn new(
+        ctx: &GpuContext,
+        targets: (&RenderTarget, &RenderTarget),
+        frames: u32,
+        options: (bool, MetricReduction),
+        background: [u8; 3],
+    ) -> Result<MetricKernel> {
+        Self::with_lanes(ctx, targets, frames, options, background, kernel_lanes(ctx))
+    }
+
+    /// [`MetricKernel::new`] with `lanes` invocations a tile (8, 16, 32 or 64), whatever the adapter: the
+    /// figures are the same (test `measure_metric_kernel`).
+    pub fn with_lanes(
         ctx: &GpuContext,
         (method, reference): (&RenderTarget, &RenderTarget),
         frames: u32,
         (de2000, reduction): (bool, MetricReduction),
         background: [u8; 3],
+        lanes: u32,
     ) -> Result<MetricKernel> {
+        if !matches!(lanes, 8 | 16 | 32 | 64) {
+            return Err(Error::Gpu(format!(
+                "the metric kernel takes 8, 16, 32 or 64 invocations a tile, not {lanes}"
+            )));
+        }
         let device = &ctx.device;
         let (width, height) = (method.width, method.height);
         let frames = frames.max(1);
@@ -118,12 +158,21 @@ impl MetricKernel {
             label: Some("metrics.wgsl"),
             source: wgpu::ShaderSource::Wgsl(METRICS_WGSL.into()),
         });
-        let layout = metric_layout(device);
-        let [pipeline, crack_pipeline] =
-            metric_pipelines(device, &module, &layout, (de2000, reduction));
+        let (layout, crack) = (metric_layout(device), crack_layout(device));
+        let [pipeline, crack_pipeline] = metric_pipelines(
+            device,
+            &module,
+            [&layout, &crack],
+            (de2000, reduction),
+            lanes,
+        );
         let pixels = width as u64 * height as u64;
         let uncovered_list = buffer(device, "uncovered pixels", pixels.max(1) * 4, U::STORAGE);
-        let uncovered_count = buffer(device, "uncovered pixel count", 4, U::STORAGE | U::COPY_DST);
+        let crack_args = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("crack test arguments"),
+            contents: bytemuck::cast_slice(&[0u32, 0, 1, 1]),
+            usage: U::STORAGE | U::INDIRECT | U::COPY_DST,
+        });
         let prev_error = buffer(device, "previous error image", pixels * 4, U::STORAGE);
         let (tiles_x, tiles_y) = (width.div_ceil(TILE), height.div_ceil(TILE));
         let tiles = buffer(
@@ -145,19 +194,40 @@ impl MetricKernel {
             sums.as_entire_binding(),
             params.as_entire_binding(),
             uncovered_list.as_entire_binding(),
-            uncovered_count.as_entire_binding(),
+            crack_args.as_entire_binding(),
             tiles.as_entire_binding(),
         ];
         let bind_group = bind_group(device, "metric bind group", &layout, resources);
+        let crack_entries = [
+            (
+                0,
+                wgpu::BindingResource::TextureView(&method.color_bytes_view),
+            ),
+            (
+                1,
+                wgpu::BindingResource::TextureView(&reference.color_bytes_view),
+            ),
+            (3, sums.as_entire_binding()),
+            (4, params.as_entire_binding()),
+            (5, uncovered_list.as_entire_binding()),
+            (8, crack_args.as_entire_binding()),
+        ]
+        .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });
+        let crack_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("crack test bind group"),
+            layout: &crack,
+            entries: &crack_entries,
+        });
         ctx.check_errors()?;
         Ok(MetricKernel {
             pipeline,
             crack_pipeline,
-            uncovered_count,
+            crack_args,
             _uncovered_list: uncovered_list,
             tiles,
             tiles_x,
             bind_group,
+            crack_bind_group,
             params,
             sums,
             readback,
@@ -184,7 +254,7 @@ impl MetricKernel {
         if frame == 0 {
             encoder.clear_buffer(&self.sums, 0, None);
         }
-        encoder.clear_buffer(&self.uncovered_count, 0, None);
+        encoder.clear_buffer(&self.crack_args, 0, Some(CRACK_ARGS_CLEARED));
         let count = tiles.len() as u32;
         let params = [
             self.width,
@@ -213,7 +283,9 @@ impl MetricKernel {
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.dispatch_workgroups(count.min(MAX_ROW), count.div_ceil(MAX_ROW), 1);
         pass.set_pipeline(&self.crack_pipeline);
-        pass.dispatch_workgroups(CRACK_GROUPS, 1, 1);
+        pass.set_bind_group(0, &self.crack_bind_group, &[]);
+        // x = 0 (nothing uncovered): no workgroup, and on lavapipe no thread woken.
+        pass.dispatch_workgroups_indirect(&self.crack_args, 4);
     }
 
     /// rmse, pop, de2000, uncovered_px and crack_px of frames `0..frames`, after their submissions.

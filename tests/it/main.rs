@@ -24,6 +24,7 @@ mod commands_experiment;
 // src/measure: the quality pass's figures, and runs without it.
 mod measure_coverage;
 mod measure_lodpop;
+mod measure_metric_kernel;
 mod measure_quality_off;
 mod measure_reference_cache;
 mod measure_timing;
