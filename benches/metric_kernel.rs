@@ -12,11 +12,16 @@
 //! - `kernel-no-tiles`: the kernel's per-frame set-up (its parameters written, its counter cleared) with no tile;
 //! - `kernel`: the kernel over a centred square of tiles, `--share` of the frame's tiles (bunny-sweep at the ci
 //!   profile reads 0.11 of them, run.json's `metric_tile_share`);
-//! - `kernel-full`: over every tile (the first frame of a pass, or a scene without a bound).
+//! - `kernel-full`: over every tile (the first frame of a pass, or a scene without a bound);
+//! - `kernel-64`, `kernel-64-full`: the same with 64 invocations a tile, a GPU's (the adapter's own count is
+//!   `kernel_lanes`: 8 on a CPU adapter, so on a GPU these repeat `kernel` and `kernel-full`, an A/A pair);
+//! - `kernel-equal`: `kernel` with the method's frame the reference's (nothing uncovered: the crack test's
+//!   indirect dispatch gets no workgroup).
 //!
 //! Printed per variant: the median over rounds of the round's mean time per frame, and against `submit` the
 //! paired difference per frame (mean over rounds and 95 % t interval) and the paired ratio (geometric mean and
-//! 95 % t interval), the rule of docs/measurement.md.
+//! 95 % t interval), the rule of docs/measurement.md; then the same for `kernel-64` against `kernel`,
+//! `kernel-64-full` against `kernel-full` and `kernel-equal` against `kernel`.
 
 #![allow(
     clippy::unwrap_used,
@@ -35,7 +40,17 @@ use lodbench::rng::SplitMix64;
 use std::time::Instant;
 
 const BACKGROUND: [u8; 3] = [60, 63, 69];
-const VARIANTS: [&str; 4] = ["submit", "kernel-no-tiles", "kernel", "kernel-full"];
+const VARIANTS: [&str; 7] = [
+    "submit",
+    "kernel-no-tiles",
+    "kernel",
+    "kernel-full",
+    "kernel-64",
+    "kernel-64-full",
+    "kernel-equal",
+];
+/// (variant, against): the pairs printed after the table against `submit`.
+const PAIRS: [(usize, usize); 3] = [(4, 2), (5, 3), (6, 2)];
 
 struct Args {
     rounds: usize,
@@ -142,11 +157,30 @@ fn main() {
         BACKGROUND,
     )
     .expect("the metric kernel");
+    let kernel_64 = MetricKernel::with_lanes(
+        &ctx,
+        (&method, &reference),
+        2,
+        (false, MetricReduction::Atomics),
+        BACKGROUND,
+        64,
+    )
+    .expect("the metric kernel, 64 lanes");
+    let equal = MetricKernel::new(
+        &ctx,
+        (&reference, &reference),
+        2,
+        (false, MetricReduction::Atomics),
+        BACKGROUND,
+    )
+    .expect("the metric kernel on equal frames");
     let all: Vec<u32> = (0..w.div_ceil(TILE) * h.div_ceil(TILE)).collect();
     let some = centred_tiles(w, h, a.share);
     // Frame 0 fills the previous-error image over every tile; every timed frame is frame 1 (pop against it).
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    kernel.encode(&ctx.queue, &mut encoder, 0, &all);
+    for k in [&kernel, &kernel_64, &equal] {
+        k.encode(&ctx.queue, &mut encoder, 0, &all);
+    }
     ctx.queue.submit([encoder.finish()]);
     let frame = |variant: usize| {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -154,7 +188,10 @@ fn main() {
             0 => {}
             1 => kernel.encode(&ctx.queue, &mut encoder, 1, &[]),
             2 => kernel.encode(&ctx.queue, &mut encoder, 1, &some),
-            _ => kernel.encode(&ctx.queue, &mut encoder, 1, &all),
+            3 => kernel.encode(&ctx.queue, &mut encoder, 1, &all),
+            4 => kernel_64.encode(&ctx.queue, &mut encoder, 1, &some),
+            5 => kernel_64.encode(&ctx.queue, &mut encoder, 1, &all),
+            _ => equal.encode(&ctx.queue, &mut encoder, 1, &some),
         }
         let index = ctx.queue.submit([encoder.finish()]);
         ctx.device
@@ -198,20 +235,31 @@ fn main() {
     );
     for (v, name) in VARIANTS.iter().enumerate() {
         let median = percentile(&ms[v], 50.0).unwrap_or(f64::NAN);
-        let diffs: Vec<f64> = ms[v].iter().zip(&ms[0]).map(|(x, s)| x - s).collect();
-        let logs: Vec<f64> = ms[v]
-            .iter()
-            .zip(&ms[0])
-            .map(|(x, s)| (x / s).ln())
-            .collect();
-        let show = |m: Option<(f64, Option<(f64, f64)>)>, f: &dyn Fn(f64) -> f64| match m {
-            Some((m, Some((lo, hi)))) => format!("{:.4} [{:.4}, {:.4}]", f(m), f(lo), f(hi)),
-            _ => "-".into(),
-        };
-        println!(
-            "{name:<16} {median:>10.4} {:>28} {:>26}",
-            show(paired_log_ratio(&diffs), &|x| x),
-            show(paired_log_ratio(&logs), &f64::exp)
-        );
+        let (diff, ratio) = paired(&ms[v], &ms[0]);
+        println!("{name:<16} {median:>10.4} {diff:>28} {ratio:>26}");
     }
+    println!(
+        "{:<32} {:>28} {:>26}",
+        "pair (variant against)", "difference, ms [95% CI]", "ratio [95% CI]"
+    );
+    for (v, base) in PAIRS {
+        let (diff, ratio) = paired(&ms[v], &ms[base]);
+        let name = format!("{} against {}", VARIANTS[v], VARIANTS[base]);
+        println!("{name:<32} {diff:>28} {ratio:>26}");
+    }
+}
+
+/// The paired difference per frame and the paired ratio of `x` against `base`, round by round (mean and
+/// geometric mean over rounds, 95 % t intervals), printed.
+fn paired(x: &[f64], base: &[f64]) -> (String, String) {
+    let diffs: Vec<f64> = x.iter().zip(base).map(|(x, b)| x - b).collect();
+    let logs: Vec<f64> = x.iter().zip(base).map(|(x, b)| (x / b).ln()).collect();
+    let show = |m: Option<(f64, Option<(f64, f64)>)>, f: &dyn Fn(f64) -> f64| match m {
+        Some((m, Some((lo, hi)))) => format!("{:.4} [{:.4}, {:.4}]", f(m), f(lo), f(hi)),
+        _ => "-".into(),
+    };
+    (
+        show(paired_log_ratio(&diffs), &|x| x),
+        show(paired_log_ratio(&logs), &f64::exp),
+    )
 }
