@@ -15,8 +15,8 @@
 //! - `kernel-full`: over every tile (the first frame of a pass, or a scene without a bound);
 //! - `kernel-64`, `kernel-64-full`: the same with 64 invocations a tile, a GPU's (the adapter's own count is
 //!   `kernel_lanes`: 8 on a CPU adapter, so on a GPU these repeat `kernel` and `kernel-full`, an A/A pair);
-//! - `kernel-equal`: `kernel` with the method's frame the reference's (nothing uncovered: the crack test's
-//!   indirect dispatch gets no workgroup).
+//! - `kernel-equal`: `kernel` with the method's frame the reference's (nothing uncovered: the crack test finds
+//!   an empty list).
 //!
 //! Printed per variant: the median over rounds of the round's mean time per frame, and against `submit` the
 //! paired difference per frame (mean over rounds and 95 % t interval) and the paired ratio (geometric mean and

@@ -15,8 +15,8 @@
 //              inside the surface, not a silhouette that a coarser LOD moved inwards)
 //                                                                                -> crack_px = count
 // Uncovered pixels are counted and marked in the loop, then listed (`uncovered_list`) without reading the frames
-// again; the crack test runs on the list in a second dispatch, `crack_main`, sized by `main` through `crack_args`
-// (an indirect dispatch: no workgroup where no pixel is uncovered, one per 8 listed pixels otherwise).
+// again; the crack test runs on the list in a second dispatch, `crack_main` (a fixed number of workgroups of
+// CRACK_LANES invocations, each testing every (CRACK_LANES * groups)-th listed pixel).
 // e_t is kept per pixel in `prev_error` for the next frame. Each frame slot holds three 64-bit sums and the two
 // 32-bit counts (8 words; a count stays below 8192^2 = 2^26).
 // Two pipeline-overridable switches: DE2000 adds de2000 (`--metrics de2000`, which costs more than the rest);
@@ -57,18 +57,8 @@ struct Params {
 @group(0) @binding(4) var<uniform> params: Params;
 // The frame's uncovered pixels (indices y * width + x), appended by `main`, checked for cracks by `crack_main`.
 @group(0) @binding(5) var<storage, read_write> uncovered_list: array<u32>;
-// How many `uncovered_list` holds, then `crack_main`'s indirect dispatch (x, y, z): x = the workgroups its
-// CRACK_LANES invocations each need for one listed pixel, at most MAX_CRACK_GROUPS. `count` and `groups` are
-// zeroed before each frame, y and z stay 1.
-struct CrackArgs {
-    count: atomic<u32>,
-    groups: atomic<u32>,
-    y: u32,
-    z: u32,
-};
-@group(0) @binding(6) var<storage, read_write> crack_args: CrackArgs;
-// The same buffer, read-only, in `crack_main`'s own bind group (it is that dispatch's indirect arguments too).
-@group(0) @binding(8) var<storage, read> crack_count: array<u32>;
+// How many `uncovered_list` holds (zeroed before each frame).
+@group(0) @binding(6) var<storage, read_write> uncovered_count: atomic<u32>;
 // The tiles this frame reads, each as tx | ty << 16.
 @group(0) @binding(7) var<storage, read> tiles: array<u32>;
 
@@ -213,18 +203,18 @@ fn ciede2000(lab1: vec3<f32>, lab2: vec3<f32>) -> f32 {
 // The first LANES entries are used.
 var<workgroup> partial: array<vec3<u32>, 64>;
 
-/// Invocations of a `crack_main` workgroup, and the most workgroups it is given (past that, each invocation
-/// tests several pixels).
+/// Invocations of a `crack_main` workgroup: one vector of lavapipe's, which runs every workgroup's loop body at
+/// least once whatever the list holds.
 const CRACK_LANES: u32 = 8u;
-const MAX_CRACK_GROUPS: u32 = 4096u;
 
-// The crack test of every uncovered pixel `main` listed (dispatched after it, indirectly through `crack_args`).
+// The crack test of every uncovered pixel `main` listed (dispatched after it; its workgroup count is the
+// kernel's, src/measure/metric_kernel.rs).
 @compute @workgroup_size(8, 1, 1)
 fn crack_main(
     @builtin(global_invocation_id) gid: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let n = crack_count[0];
+    let n = atomicLoad(&uncovered_count);
     var cracks = 0u;
     for (var i = gid.x; i < n; i = i + CRACK_LANES * groups.x) {
         let idx = uncovered_list[i];
@@ -322,9 +312,7 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
         let j = firstTrailingBit(marked);
         marked = marked & (marked - 1u);
         let q = tile_pixel(origin, lid, j);
-        let at = atomicAdd(&crack_args.count, 1u);
-        uncovered_list[at] = q.y * params.width + q.x;
-        atomicMax(&crack_args.groups, min(at / CRACK_LANES + 1u, MAX_CRACK_GROUPS));
+        uncovered_list[atomicAdd(&uncovered_count, 1u)] = q.y * params.width + q.x;
     }
     if (!WORKGROUP_REDUCE) {
         add_u64_pair(slot, vec2<u32>(rmse_sum, 0u));

@@ -12,7 +12,6 @@ use crate::gpu::context::GpuContext;
 use crate::gpu::targets::RenderTarget;
 use crate::measure::coverage::TILE;
 use crate::measure::metrics::{FrameMetrics, MetricReduction};
-use wgpu::util::DeviceExt;
 use wgpu::BufferUsages as U;
 
 pub const METRICS_WGSL: &str = include_str!("../../shaders/metrics.wgsl");
@@ -21,14 +20,14 @@ pub struct MetricKernel {
     pipeline: wgpu::ComputePipeline,
     /// `crack_main`: the crack test of the uncovered pixels `main` listed.
     crack_pipeline: wgpu::ComputePipeline,
-    /// `crack_args` in the shader: the listed pixels' count, then `crack_main`'s indirect dispatch (x, 1, 1).
-    crack_args: wgpu::Buffer,
+    /// Workgroups of `crack_main` ([`crack_groups`]).
+    crack_groups: u32,
+    uncovered_count: wgpu::Buffer,
     _uncovered_list: wgpu::Buffer,
     /// The frame's tile list (`tiles` in the shader), each as `tx | ty << 16`.
     tiles: wgpu::Buffer,
     tiles_x: u32,
     bind_group: wgpu::BindGroup,
-    crack_bind_group: wgpu::BindGroup,
     params: wgpu::Buffer,
     sums: wgpu::Buffer,
     readback: wgpu::Buffer,
@@ -38,7 +37,7 @@ pub struct MetricKernel {
     background: u32,
 }
 
-/// The bindings of `main`.
+/// One layout for both entry points, so one bind group serves the two dispatches of a frame.
 fn metric_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("metric layout"),
@@ -55,28 +54,12 @@ fn metric_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
-/// The bindings of `crack_main`: `crack_args` read-only (binding 8), since the same dispatch reads it as its
-/// indirect arguments, a use wgpu does not allow beside a writable binding.
-fn crack_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("crack test layout"),
-        entries: &[
-            texture_entry(0),
-            texture_entry(1),
-            storage_entry(3),
-            uniform_entry(4),
-            storage_entry(5),
-            read_only_storage_entry(8),
-        ],
-    })
-}
-
 /// The pipelines of `main` (the per-pixel figures) and `crack_main` (the crack test of the uncovered pixels),
 /// with the shader's DE2000, WORKGROUP_REDUCE and LANES constants.
 fn metric_pipelines(
     device: &wgpu::Device,
     module: &wgpu::ShaderModule,
-    layouts: [&wgpu::BindGroupLayout; 2],
+    layout: &wgpu::BindGroupLayout,
     (de2000, reduction): (bool, MetricReduction),
     lanes: u32,
 ) -> [wgpu::ComputePipeline; 2] {
@@ -107,13 +90,22 @@ fn metric_pipelines(
         })
     };
     [
-        compute("metric kernel", "main", layouts[0]),
-        compute("crack kernel", "crack_main", layouts[1]),
+        compute("metric kernel", "main", layout),
+        compute("crack kernel", "crack_main", layout),
     ]
 }
 
-/// Bytes of `crack_args` zeroed before each frame: the count and the dispatch's x.
-const CRACK_ARGS_CLEARED: u64 = 8;
+/// Workgroups of `crack_main` (8 invocations each) for a frame of `pixels` pixels (the most its list can hold)
+/// and a metric kernel of `lanes` invocations a tile: enough that no invocation tests more than 1,024 listed
+/// pixels on a CPU adapter (8 lanes) or 64 on a GPU. On lavapipe the bound is a limit, not a choice: gallivm
+/// ends a vector of invocations after 65,535 loop iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS), about 1,400
+/// crack tests of some 45 iterations each, and a longer list was undercounted without a word (test
+/// `measure_metric_kernel`). A fixed count rather than an indirect dispatch sized by the list: lavapipe reads
+/// indirect arguments at a cost larger than the test's (docs/findings/timing.md).
+pub fn crack_groups(lanes: u32, pixels: u64) -> u32 {
+    let per_invocation: u64 = if lanes == 8 { 1024 } else { 64 };
+    pixels.div_ceil(8 * per_invocation).clamp(1, MAX_ROW as u64) as u32
+}
 
 /// Workgroups per row of the tile dispatch (MAX_ROW in the shader: a dispatch's limit per dimension).
 const MAX_ROW: u32 = 65535;
@@ -136,8 +128,8 @@ impl MetricKernel {
         Self::with_lanes(ctx, targets, frames, options, background, kernel_lanes(ctx))
     }
 
-    /// [`MetricKernel::new`] with `lanes` invocations a tile (8, 16, 32 or 64), whatever the adapter: the
-    /// figures are the same (test `measure_metric_kernel`).
+    /// [`MetricKernel::new`] with `lanes` invocations a tile (8, 16, 32 or 64) and [`crack_groups`] of them,
+    /// whatever the adapter: the figures are the same (test `measure_metric_kernel`).
     pub fn with_lanes(
         ctx: &GpuContext,
         (method, reference): (&RenderTarget, &RenderTarget),
@@ -158,21 +150,12 @@ impl MetricKernel {
             label: Some("metrics.wgsl"),
             source: wgpu::ShaderSource::Wgsl(METRICS_WGSL.into()),
         });
-        let (layout, crack) = (metric_layout(device), crack_layout(device));
-        let [pipeline, crack_pipeline] = metric_pipelines(
-            device,
-            &module,
-            [&layout, &crack],
-            (de2000, reduction),
-            lanes,
-        );
+        let layout = metric_layout(device);
+        let [pipeline, crack_pipeline] =
+            metric_pipelines(device, &module, &layout, (de2000, reduction), lanes);
         let pixels = width as u64 * height as u64;
         let uncovered_list = buffer(device, "uncovered pixels", pixels.max(1) * 4, U::STORAGE);
-        let crack_args = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("crack test arguments"),
-            contents: bytemuck::cast_slice(&[0u32, 0, 1, 1]),
-            usage: U::STORAGE | U::INDIRECT | U::COPY_DST,
-        });
+        let uncovered_count = buffer(device, "uncovered pixel count", 4, U::STORAGE | U::COPY_DST);
         let prev_error = buffer(device, "previous error image", pixels * 4, U::STORAGE);
         let (tiles_x, tiles_y) = (width.div_ceil(TILE), height.div_ceil(TILE));
         let tiles = buffer(
@@ -194,40 +177,20 @@ impl MetricKernel {
             sums.as_entire_binding(),
             params.as_entire_binding(),
             uncovered_list.as_entire_binding(),
-            crack_args.as_entire_binding(),
+            uncovered_count.as_entire_binding(),
             tiles.as_entire_binding(),
         ];
         let bind_group = bind_group(device, "metric bind group", &layout, resources);
-        let crack_entries = [
-            (
-                0,
-                wgpu::BindingResource::TextureView(&method.color_bytes_view),
-            ),
-            (
-                1,
-                wgpu::BindingResource::TextureView(&reference.color_bytes_view),
-            ),
-            (3, sums.as_entire_binding()),
-            (4, params.as_entire_binding()),
-            (5, uncovered_list.as_entire_binding()),
-            (8, crack_args.as_entire_binding()),
-        ]
-        .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });
-        let crack_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("crack test bind group"),
-            layout: &crack,
-            entries: &crack_entries,
-        });
         ctx.check_errors()?;
         Ok(MetricKernel {
             pipeline,
             crack_pipeline,
-            crack_args,
+            crack_groups: crack_groups(lanes, pixels),
+            uncovered_count,
             _uncovered_list: uncovered_list,
             tiles,
             tiles_x,
             bind_group,
-            crack_bind_group,
             params,
             sums,
             readback,
@@ -254,7 +217,7 @@ impl MetricKernel {
         if frame == 0 {
             encoder.clear_buffer(&self.sums, 0, None);
         }
-        encoder.clear_buffer(&self.crack_args, 0, Some(CRACK_ARGS_CLEARED));
+        encoder.clear_buffer(&self.uncovered_count, 0, None);
         let count = tiles.len() as u32;
         let params = [
             self.width,
@@ -283,9 +246,7 @@ impl MetricKernel {
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.dispatch_workgroups(count.min(MAX_ROW), count.div_ceil(MAX_ROW), 1);
         pass.set_pipeline(&self.crack_pipeline);
-        pass.set_bind_group(0, &self.crack_bind_group, &[]);
-        // x = 0 (nothing uncovered): no workgroup, and on lavapipe no thread woken.
-        pass.dispatch_workgroups_indirect(&self.crack_args, 4);
+        pass.dispatch_workgroups(self.crack_groups, 1, 1);
     }
 
     /// rmse, pop, de2000, uncovered_px and crack_px of frames `0..frames`, after their submissions.
