@@ -31,7 +31,7 @@
 // (k % 16, k / 16) (neighbouring invocations read neighbouring pixels), then its sums reach a 64-bit total made
 // of two u32 atomics per frame slot, directly or through the workgroup reduction. LANES is a pipeline
 // constant (src/gpu/compute.rs, `kernel_lanes`): 64 on a GPU, 8 on a CPU adapter, where 8 invocations are one
-// vector of lavapipe's 256-bit lanes and each adds its sums with a quarter of the atomics per pixel that 64 do
+// vector of lavapipe's 256-bit lanes adding their sums with an eighth of the atomics per pixel that 64 do
 // (the reads are the same; benches/metric_kernel.rs). At most 32 pixels per invocation keep each partial sum
 // far below 2^32 (32 * 585225 for rmse, 32 * 780300 for pop, 32 * 65536 * 120 for de2000, CIEDE2000 staying
 // below 120 between sRGB colours); the reduction carries into the high word. The tiles come in rows of at most

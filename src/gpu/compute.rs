@@ -5,7 +5,7 @@ use crate::gpu::context::GpuContext;
 
 /// Invocations per workgroup of the metric and difference kernels (`LANES` in shaders/metrics.wgsl and
 /// shaders/diff.wgsl): 8 on a CPU adapter (lavapipe runs a workgroup as vectors of 8 invocations and an atomic
-/// one invocation at a time, so 8 invocations each reading 4 times the pixels add a quarter of the atomics per
+/// one invocation at a time, so 8 invocations each reading 8 times the pixels add an eighth of the atomics per
 /// pixel: benches/metric_kernel.rs), 64 on a GPU (where 8 would leave most of a warp idle).
 pub fn kernel_lanes(ctx: &GpuContext) -> u32 {
     match ctx.adapter.get_info().device_type {
