@@ -29,6 +29,7 @@
     reason = "a bench fails by panicking"
 )]
 
+use lodbench::gpu::compute::kernel_lanes;
 use lodbench::gpu::context::GpuContext;
 use lodbench::gpu::targets::RenderTarget;
 use lodbench::measure::coverage::TILE;
@@ -116,19 +117,6 @@ fn disc(width: u32, height: u32, radius: f64, tint: u8) -> Vec<u8> {
     rgba
 }
 
-fn fill(ctx: &GpuContext, target: &RenderTarget, rgba: &[u8]) {
-    ctx.queue.write_texture(
-        target.color.as_image_copy(),
-        rgba,
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(target.width * 4),
-            rows_per_image: Some(target.height),
-        },
-        target.color.size(),
-    );
-}
-
 /// The tiles of a centred square holding `share` of the frame's tiles (at least one).
 fn centred_tiles(width: u32, height: u32, share: f64) -> Vec<u32> {
     let (tx, ty) = (width.div_ceil(TILE), height.div_ceil(TILE));
@@ -147,33 +135,24 @@ fn main() {
     let reference = RenderTarget::new(&ctx.device, "reference", w, h);
     let radius = w.min(h) as f64 * 0.2;
     // A hair smaller: a few uncovered pixels on its edge (bunny-sweep at ci: a median of 6 a frame).
-    fill(&ctx, &method, &disc(w, h, radius - 0.05, 0));
-    fill(&ctx, &reference, &disc(w, h, radius, 3));
-    let kernel = MetricKernel::new(
-        &ctx,
-        (&method, &reference),
-        2,
-        (false, MetricReduction::Atomics),
-        BACKGROUND,
-    )
-    .expect("the metric kernel");
-    let kernel_64 = MetricKernel::with_lanes(
-        &ctx,
-        (&method, &reference),
-        2,
-        (false, MetricReduction::Atomics),
-        BACKGROUND,
-        64,
-    )
-    .expect("the metric kernel, 64 lanes");
-    let equal = MetricKernel::new(
-        &ctx,
-        (&reference, &reference),
-        2,
-        (false, MetricReduction::Atomics),
-        BACKGROUND,
-    )
-    .expect("the metric kernel on equal frames");
+    method.write_color(&ctx.queue, &disc(w, h, radius - 0.05, 0));
+    reference.write_color(&ctx.queue, &disc(w, h, radius, 3));
+    // Two frame slots (frame 0 fills the previous-error image, frame 1 is timed), the default figures.
+    let kernel_of = |method, lanes| {
+        MetricKernel::with_lanes(
+            &ctx,
+            (method, &reference),
+            2,
+            (false, MetricReduction::Atomics),
+            BACKGROUND,
+            lanes,
+        )
+        .expect("the metric kernel")
+    };
+    let lanes = kernel_lanes(&ctx);
+    let kernel = kernel_of(&method, lanes);
+    let kernel_64 = kernel_of(&method, 64);
+    let equal = kernel_of(&reference, lanes);
     let all: Vec<u32> = (0..w.div_ceil(TILE) * h.div_ceil(TILE)).collect();
     let some = centred_tiles(w, h, a.share);
     // Frame 0 fills the previous-error image over every tile; every timed frame is frame 1 (pop against it).

@@ -98,6 +98,21 @@ impl RenderTarget {
         );
     }
 
+    /// Writes `rgba` (tightly packed RGBA8, `width` x `height`, sRGB-encoded bytes) into this target's colour
+    /// through `queue`: synthetic frames for the metric kernel's bench and tests.
+    pub fn write_color(&self, queue: &wgpu::Queue, rgba: &[u8]) {
+        queue.write_texture(
+            self.color.as_image_copy(),
+            rgba,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(self.width * 4),
+                rows_per_image: Some(self.height),
+            },
+            self.color.size(),
+        );
+    }
+
     /// Bytes of colour and depth this target holds.
     pub fn bytes(&self) -> u64 {
         self.width as u64 * self.height as u64 * 8

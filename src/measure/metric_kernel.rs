@@ -63,6 +63,11 @@ fn metric_pipelines(
     (de2000, reduction): (bool, MetricReduction),
     lanes: u32,
 ) -> [wgpu::ComputePipeline; 2] {
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("metric pipeline layout"),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
     let constants = [
         ("DE2000", de2000 as u32 as f64),
         (
@@ -71,12 +76,7 @@ fn metric_pipelines(
         ),
         ("LANES", lanes as f64),
     ];
-    let compute = |label, entry_point, layout| {
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(label),
-            bind_group_layouts: &[Some(layout)],
-            immediate_size: 0,
-        });
+    let compute = |label, entry_point| {
         device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(label),
             layout: Some(&pipeline_layout),
@@ -90,8 +90,8 @@ fn metric_pipelines(
         })
     };
     [
-        compute("metric kernel", "main", layout),
-        compute("crack kernel", "crack_main", layout),
+        compute("metric kernel", "main"),
+        compute("crack kernel", "crack_main"),
     ]
 }
 

@@ -28,19 +28,6 @@ fn frame(width: u32, height: u32, surface: impl Fn(u32, u32) -> bool) -> Vec<u8>
         .collect()
 }
 
-fn fill(ctx: &GpuContext, target: &RenderTarget, rgba: &[u8]) {
-    ctx.queue.write_texture(
-        target.color.as_image_copy(),
-        rgba,
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(target.width * 4),
-            rows_per_image: Some(target.height),
-        },
-        target.color.size(),
-    );
-}
-
 /// The metric kernel's figures of `frames` against `reference`, with `lanes` invocations a tile, every tile read.
 fn run_kernel(
     ctx: &GpuContext,
@@ -61,9 +48,9 @@ fn run_kernel(
     )
     .unwrap();
     let tiles: Vec<u32> = (0..w.div_ceil(TILE) * h.div_ceil(TILE)).collect();
-    fill(ctx, &reference_target, reference);
+    reference_target.write_color(&ctx.queue, reference);
     for (f, rgba) in frames.iter().enumerate() {
-        fill(ctx, &method_target, rgba);
+        method_target.write_color(&ctx.queue, rgba);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         kernel.encode(&ctx.queue, &mut encoder, f as u32, &tiles);
         ctx.queue.submit([encoder.finish()]);
