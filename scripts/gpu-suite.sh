@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The papers' experiments on this machine's GPU, in one command (docs/cluster.md, "The GPU suite"):
-#   scripts/gpu-suite.sh [FRAMES]
-# runs scenes/experiments/{fsi-fig8,sheliemietiev-fig5,sheliemietiev-fig6,trees-sorting,unified-lod,frontier}.toml at
+#   scripts/gpu-suite.sh [FRAMES [EXPERIMENT ...]]
+# runs scenes/experiments/aa-gpu.toml (the A/A check the suite's ratios are read against, then
+# scripts/aa_check.py), then {fsi-fig8,sheliemietiev-fig5,sheliemietiev-fig6,trees-sorting,unified-lod,
+# terrain-equal-error,frontier}.toml, or only the EXPERIMENTs named (file names without .toml), at
 # the papers' scenes, instance counts and viewports, with FRAMES timed frames (default 150; the papers' 3,600
 # would take hours) and 10 warm-up frames per block, into results/gpu/<adapter>/<experiment>/, draws the
 # figures (scripts/plot.py), writes each experiment's wall time to results/gpu/<adapter>/times.txt and prints
@@ -10,6 +12,15 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${1:-${FRAMES:-150}}
+shift || true
+all=(aa-gpu fsi-fig8 sheliemietiev-fig5 sheliemietiev-fig6 trees-sorting unified-lod terrain-equal-error frontier)
+experiments=("${@:-${all[@]}}")
+for exp in "${experiments[@]}"; do
+    if [[ ! -f scenes/experiments/$exp.toml ]]; then
+        echo "error: no experiment '$exp' (scenes/experiments/$exp.toml); the suite's are: ${all[*]}" >&2
+        exit 2
+    fi
+done
 case $frames in
     '' | *[!0-9]*) echo "error: FRAMES must be a whole number, not '$frames'" >&2; exit 2 ;;
 esac
@@ -29,8 +40,8 @@ esac
 name=$(printf '%s' "${best%%[*}" | sed 's/^ *//; s/ *$//' | tr -c 'A-Za-z0-9._-' '_')
 out=results/gpu/$name
 mkdir -p "$out"
-echo "adapter: $best" | tee "$out/times.txt"
-for exp in fsi-fig8 sheliemietiev-fig5 sheliemietiev-fig6 trees-sorting unified-lod terrain-equal-error frontier; do
+echo "adapter: $best" | tee -a "$out/times.txt"
+for exp in "${experiments[@]}"; do
     extra=()
     if [[ $exp == trees-sorting ]]; then
         extra=(--set dump-every=50)
@@ -38,7 +49,11 @@ for exp in fsi-fig8 sheliemietiev-fig5 sheliemietiev-fig6 trees-sorting unified-
     start=$(date +%s)
     "$lodbench" experiment "scenes/experiments/$exp.toml" --set "frames=$frames" --set warmup=10 \
         "${extra[@]}" --out "$out/$exp"
-    python3 scripts/plot.py "$out/$exp"
+    if [[ $exp == aa-gpu ]]; then
+        python3 scripts/aa_check.py "$out/$exp" | tee "$out/$exp/aa_check.md"
+    else
+        python3 scripts/plot.py "$out/$exp"
+    fi
     if [[ $exp == terrain-equal-error ]]; then
         python3 scripts/equal_error.py "$out/$exp"
     fi

@@ -600,6 +600,16 @@ fn the_gpu_suite_refuses_a_software_adapter() {
         .output()
         .unwrap();
     assert!(String::from_utf8_lossy(&e.stderr).contains("whole number"));
+    // An experiment named that the suite does not have is refused by name, before any run.
+    let e = Command::new("bash")
+        .arg(&script)
+        .args(["5", "frontier", "fsi-fig9"])
+        .env("LODBENCH", env!("CARGO_BIN_EXE_lodbench"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&e.stderr);
+    assert_eq!(e.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("no experiment 'fsi-fig9'"), "{stderr}");
 }
 
 /// The programs the Slurm test needs (slurm-wlm and munge, from `bash .ci/setup-tests`), searched on PATH and in
