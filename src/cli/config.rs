@@ -7,6 +7,7 @@ use crate::effects::OnOff;
 use crate::error::{Error, Result};
 use crate::formats::{COLOR_FORMAT, DEPTH_FORMAT, MAX_SIDE, MSAA_SAMPLES};
 use crate::measure::metrics::{Metric, MetricReduction, MetricRegion};
+use crate::measure::QualitySchedule;
 use crate::methods::{MethodOptions, Registry};
 use crate::scene::schedule::ScheduleParams;
 use crate::scene::{ProfileValues, SceneConfig, SceneKind, SweepStart};
@@ -150,6 +151,8 @@ pub struct RunConfig {
     pub adapter: Option<String>,
     /// `--quality off`: the timing rounds only, no quality pass (its figures empty).
     pub quality: OnOff,
+    /// `--quality-schedule`.
+    pub quality_schedule: QualitySchedule,
     /// `--reference-cache-mib`.
     pub reference_cache_mib: u64,
     pub dump_frames: bool,
@@ -283,6 +286,7 @@ impl RunConfig {
             out: a.out.clone(),
             adapter: a.adapter.clone(),
             quality: a.quality,
+            quality_schedule: a.quality_schedule,
             reference_cache_mib: a.reference_cache_mib,
             dump_frames: a.dump_frames,
             dump_every: a.dump_every,

@@ -10,6 +10,7 @@ pub mod experiment_file;
 use crate::effects::OnOff;
 use crate::geometry::blocks::PartitionMode;
 use crate::measure::metrics::{Metric, MetricReduction, MetricRegion};
+use crate::measure::QualitySchedule;
 use crate::methods::MethodOptions;
 use crate::scene::schedule::FadeMode;
 use crate::scene::{CameraMode, Profile, SweepStart};
@@ -331,6 +332,12 @@ pub struct RunArgs {
     /// times null. Refused with --dump-frames and --metrics de2000/flip, which need the pass.
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     pub quality: OnOff,
+    /// When the quality pass is made: `rounds` (default) a segment of every method's pass right after each
+    /// timing round, over the same frames, so that quality_to_renders_ratio is paired round by round; `after`
+    /// every timing round first, back to back as with --quality off, then the quality segments (the timing
+    /// rounds then have no quality work between them; docs/measurement.md, "Quality pass").
+    #[arg(long, value_enum, default_value_t = QualitySchedule::Rounds)]
+    pub quality_schedule: QualitySchedule,
     /// GPU memory (MiB) a scene block may keep of the reference's frames, so that its second and later methods
     /// copy the reference frame instead of drawing it again (every figure is the same; the first frames that
     /// fit are kept). 0 draws it in every method's pass. Not used under TAA or with shadows.

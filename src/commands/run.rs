@@ -9,9 +9,7 @@ use crate::measure::records::{
     pair_records, round_records, BlockInfo, Clock, FrameRecord, PairRecord, RoundRecord,
     SummaryRecord, TransitionRecord,
 };
-use crate::measure::{
-    reference_ms_per_frame, BlockRunner, FrameImages, MethodSetup, QualityOptions,
-};
+use crate::measure::{BlockRunner, FrameImages, MethodSetup, QualityOptions};
 use crate::methods::{is_reference, Registry};
 use crate::results::csv::{
     write_pairs, write_rounds, write_summary, write_transitions, FramesWriter,
@@ -210,8 +208,9 @@ fn run_blocks(
     Ok(output.summaries)
 }
 
-/// The frames the progress bar counts: per block, every method's warm-up, timed and quality frames, and the
-/// reference's warm-up and timed frames when it is timed without being reported (with the quality pass only).
+/// The frames the progress bar counts: per block, every method's warm-up, timed and quality frames (with the
+/// quality pass's own warm-up), and the reference's warm-up and timed frames when it is timed without being
+/// reported (with the quality pass only).
 fn total_frames(cfg: &RunConfig, defs: &[SceneDef]) -> u64 {
     let quality = cfg.quality_pass() as u64;
     defs.iter()
@@ -221,7 +220,7 @@ fn total_frames(cfg: &RunConfig, defs: &[SceneDef]) -> u64 {
             let timed_only = quality * !methods.iter().any(|m| is_reference(m)) as u64;
             let (warmup, frames) = (pv.warmup as u64, pv.frames as u64);
             d.counts.len() as u64
-                * (methods.len() as u64 * (warmup + (1 + quality) * frames)
+                * (methods.len() as u64 * (1 + quality) * (warmup + frames)
                     + timed_only * (warmup + frames))
         })
         .sum()
@@ -239,8 +238,8 @@ fn progress_bar(total: u64) -> ProgressBar {
 }
 
 impl RunJob<'_> {
-    /// Scene block `def` with `count` instances, the `block_index`-th of the run: the timing rounds of its
-    /// methods, then each reported method's quality pass, its summaries and its rounds.
+    /// Scene block `def` with `count` instances, the `block_index`-th of the run: its methods' rounds (timing,
+    /// then quality pass, round by round), their summaries and rounds.
     fn run_block(
         &self,
         def: &SceneDef,
@@ -264,6 +263,7 @@ impl RunJob<'_> {
             reduction: cfg.metric_reduction,
             region: cfg.metric_region,
             timing_only: !cfg.quality_pass(),
+            schedule: cfg.quality_schedule,
             // Kept only for a block whose quality pass runs more than one method.
             reference_cache_bytes: if methods.len() > 1 {
                 cfg.reference_cache_mib << 20
@@ -274,35 +274,25 @@ impl RunJob<'_> {
         let mut block =
             BlockRunner::new(&self.ctx, &scene, setup, self.dumper.is_some(), &quality)?;
         block.dump_transitions_only(cfg.dump_transitions);
+        let stage = match cfg.quality_pass() {
+            true => "timing and quality rounds",
+            false => "timing rounds",
+        };
         self.progress
-            .set_message(format!("{} n={} timing rounds", def.name(), count));
+            .set_message(format!("{} n={} {stage}", def.name(), count));
         // Each block's shuffles have their own seed, derived from --seed and the block's position.
         let rounds_seed = crate::rng::SplitMix64::new(cfg.seed ^ 0x524F_554E_4453)
             .next_u64()
             .wrapping_add(block_index);
-        let (timed, block_rounds) =
-            block.time_methods(&methods, warmup, cfg.rounds, rounds_seed, &self.progress)?;
-        let reference_ms = reference_ms_per_frame(&timed);
+        let (outputs, block_rounds) = block.measure_block(
+            &methods,
+            (warmup, cfg.rounds, rounds_seed),
+            cfg.dump_every,
+            &self.progress,
+            |method, f, images| self.dump(&scene, method, f, images),
+        )?;
         let mut measured = Vec::new();
-        for m in timed {
-            if block_rounds.timed_only.contains(&m.label) {
-                continue;
-            }
-            let method = m.label.clone();
-            let stage = if cfg.quality_pass() {
-                "quality"
-            } else {
-                "records"
-            };
-            self.progress
-                .set_message(format!("{} n={} {method} {stage}", def.name(), count));
-            let out = block.measure_quality(
-                m,
-                reference_ms,
-                cfg.dump_every,
-                &self.progress,
-                |f, images| self.dump(&scene, &method, f, images),
-            )?;
+        for out in outputs {
             output.frames_csv.write_block(&out.rows)?;
             output.transitions.extend(out.transitions);
             measured.push(MeasuredMethod {
@@ -310,7 +300,6 @@ impl RunJob<'_> {
                 rows: out.rows,
             });
             manifest.blocks.push(out.info);
-            manifest.write(self.out_dir)?;
         }
         // The reported methods in the order they were listed (pairs.csv's a before b), and the block's one clock.
         measured.sort_by_key(|m| {

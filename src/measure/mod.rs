@@ -25,14 +25,12 @@ pub mod reference_cache;
 pub mod stats;
 pub mod timing;
 
-pub use block::{BlockOutput, BlockRunner};
+pub use block::{BlockOutput, BlockRunner, DumpPolicy};
 pub use context::{BlockGpu, MethodSetup};
 pub use driver::{FrameDriver, FrameFacts};
-pub use quality::{DumpPolicy, FrameImages, QualityOptions, QualityStage};
+pub use quality::{FrameImages, QualityOptions, QualitySchedule, QualityStage};
 pub use records::{BlockRounds, Round};
-pub use timing::{
-    reference_ms_per_frame, round_frames, shuffled_order, TimedMethod, Uploads, WarmUpPlan,
-};
+pub use timing::{round_frames, shuffled_order, Prepared, TimedMethod, Uploads, WarmUpPlan};
 
 pub use crate::methods::is_reference;
 pub use driver::INTERRUPTED;

@@ -10,6 +10,11 @@
 //! 7. **collect**: FLIP and the dump callback on the read-back images, or a bound on the frames in flight.
 //!
 //! The scalars of all frames are read back once at the end. FSI's combination pass is timed here.
+//!
+//! A method's pass is made in segments, one after each timing round over the same frames
+//! ([`super::block::BlockRunner::measure_block`]), by an instance of the method of its own, warmed up as the
+//! timed one: so its frames are the timed frames, and each segment's time is paired with the round's timing
+//! segments for `quality_to_renders_ratio`.
 
 use super::context::BlockGpu;
 use super::coverage::{Coverage, PixelRect};
@@ -32,6 +37,29 @@ use indicatif::ProgressBar;
 use std::collections::VecDeque;
 use std::time::Instant;
 
+/// When a block's quality segments are made (`--quality-schedule`).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum QualitySchedule {
+    /// In every round, right after its timing segments: `quality_to_renders_ratio` pairs each quality segment
+    /// with the timing segments seconds before it; the timing rounds run between quality segments.
+    #[default]
+    Rounds,
+    /// After the last timing round, round by round: the timing rounds run back to back, as in a `--quality
+    /// off` run, and each quality segment is divided by timing segments minutes before it.
+    After,
+}
+
 /// What the quality pass computes besides rmse, pop and lodpop, and how.
 #[derive(Debug, Clone, Default)]
 pub struct QualityOptions {
@@ -43,6 +71,8 @@ pub struct QualityOptions {
     pub region: MetricRegion,
     /// `--quality off`: no quality pass at all (the block builds no stage; its figures are empty).
     pub timing_only: bool,
+    /// `--quality-schedule`.
+    pub schedule: QualitySchedule,
     /// Bytes the block may keep of the reference's frames for its next methods (`--reference-cache-mib`;
     /// 0: draw the reference in every method's pass). [`ReferenceCache`] says where it is not used.
     pub reference_cache_bytes: u64,
@@ -147,6 +177,8 @@ pub struct QualityPass {
     /// Frames whose reference frame was copied instead of drawn: from the block's [`ReferenceCache`], or in
     /// the reference's own pass from its frame.
     pub reference_frames_copied: u32,
+    /// The pass's segments (one per timing round), each timed on its own.
+    pub segments: Vec<SegmentCost>,
 }
 
 /// The images of one dumped quality-pass frame, RGBA8.
@@ -158,16 +190,9 @@ pub struct FrameImages<'i> {
     pub extras: &'i [(DumpKind, Vec<u8>)],
 }
 
-/// Which quality-pass frames are handed to the caller's dump callback.
-#[derive(Debug, Clone, Copy)]
-pub struct DumpPolicy {
-    /// Dump at all (the stage was built with read-back for it).
-    pub dump: bool,
-    /// Only frames with an instance in transition (`--dump-transitions`).
-    pub transitions_only: bool,
-}
-
-/// The quality pass's own GPU objects on a block, reused by every method measured on it.
+/// The quality pass's own GPU objects for one method on a block: its targets, kernels (a slot per frame), TAA
+/// streams and shadow share, which carry from one segment of its pass to the next while other methods' passes
+/// run in between (the block's reference cache is the one thing the stages share).
 pub struct QualityStage {
     targets: QualityTargets,
     kernels: QualityKernels,
@@ -178,15 +203,12 @@ pub struct QualityStage {
     flip: bool,
     /// The method's and the reference's read-back, with `--metrics flip` or dumps.
     readback: Option<[TextureReadback; 2]>,
-    pub dumps: DumpPolicy,
     /// `--taa on`: the resolve and the two image streams.
     taa: Option<TaaStreams>,
     /// `--shadows on`: the shadow's own share of the error.
     shadow_share: Option<ShadowShare>,
     /// `--metric-region`.
     region: MetricRegion,
-    /// The reference's frames, kept by the first pass for the next (None: drawn in every pass).
-    reference_cache: Option<ReferenceCache>,
 }
 
 /// Keep at most this many quality-pass frames queued on the GPU.
@@ -271,10 +293,21 @@ struct FrameReads {
     extras: Vec<(DumpKind, TextureReadback)>,
 }
 
-/// What the pass carries from frame to frame.
-struct Walk<'d> {
+/// One segment of a quality pass: its frames, its wall time and what it rendered besides the method's frames.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SegmentCost {
+    pub frames: [u32; 2],
+    pub ms: f64,
+    /// Frames on which lodpop's counterfactual was drawn.
+    pub counterfactual_frames: u32,
+    /// Frames whose reference frame was copied, not drawn.
+    pub reference_copied: u32,
+}
+
+/// What the pass carries from frame to frame, and from one segment to the next.
+pub struct Walk {
     /// Per frame, whether it goes to the dump callback.
-    dump_frames: &'d [bool],
+    dump_frames: Vec<bool>,
     history: StateHistory,
     in_flight: VecDeque<wgpu::SubmissionIndex>,
     flip: Vec<Option<f64>>,
@@ -292,6 +325,8 @@ struct Walk<'d> {
     reference_copied: u32,
     /// The metric timer's slots written in this pass.
     metric_timed: Vec<u32>,
+    /// The pass's segments so far.
+    segments: Vec<SegmentCost>,
 }
 
 impl QualityStage {
@@ -314,14 +349,8 @@ impl QualityStage {
             Some(_) => Some(ShadowShare::new(ctx, scene, &targets.reference)?),
         };
         let taa = TaaStreams::new(ctx, scene);
-        let reference_cache = if Self::reference_copyable(&taa, &shadow_share) {
-            ReferenceCache::new(ctx, (w, h), scene.frames, quality.reference_cache_bytes)
-        } else {
-            None
-        };
         Ok(QualityStage {
             taa,
-            reference_cache,
             shadow_share,
             targets,
             kernels,
@@ -330,11 +359,28 @@ impl QualityStage {
             region: quality.region,
             flip,
             readback,
-            dumps: DumpPolicy {
-                dump,
-                transitions_only: false,
-            },
         })
+    }
+
+    /// The block's reference cache for rounds of at most `round_frames` frames (`quality.reference_cache_bytes`),
+    /// where a copy of the reference frame can stand in for a draw in this stage's passes (None: drawn in every
+    /// pass).
+    pub fn reference_cache(
+        &self,
+        base: &BlockGpu<'_>,
+        quality: &QualityOptions,
+        round_frames: u32,
+    ) -> Option<ReferenceCache> {
+        let scene = base.scene;
+        match Self::reference_copyable(&self.taa, &self.shadow_share) {
+            true => ReferenceCache::new(
+                base.ctx,
+                (scene.width, scene.height),
+                round_frames,
+                quality.reference_cache_bytes,
+            ),
+            false => None,
+        }
     }
 
     /// Whether the reference frame is made by the frame alone, so that a copy of it can stand in for a draw: not
@@ -343,24 +389,23 @@ impl QualityStage {
         taa.is_none() && shadow_share.is_none()
     }
 
-    /// The quality pass of `method` (`is_reference`: the reference itself) walking `driver`; `dump_frames`: per
-    /// frame, whether it goes to `on_frames`.
-    pub(super) fn pass(
+    /// The start of the quality pass of `method` (`is_reference`: the reference itself): what it carries from
+    /// frame to frame. `dump_frames`: per frame, whether it goes to the dump callback. The pass is then made in
+    /// segments ([`QualityStage::segment`]) and read at the end ([`QualityStage::finish`]).
+    pub fn begin(
         &mut self,
         base: &BlockGpu<'_>,
-        (method, is_reference): (&mut dyn Method, bool),
-        driver: &mut FrameDriver<'_>,
-        dump_frames: &[bool],
-        progress: &ProgressBar,
-        on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
-    ) -> Result<QualityPass> {
-        let frames = base.scene.frames;
-        driver.reset();
+        (method, is_reference): (&dyn Method, bool),
+        dump_frames: Vec<bool>,
+    ) -> Walk {
+        if let Some(taa) = &mut self.taa {
+            taa.reset();
+        }
         let mut walk = Walk {
             dump_frames,
             history: StateHistory::new(method.lodpop_history().max(1)),
             in_flight: VecDeque::new(),
-            flip: vec![None; frames as usize],
+            flip: vec![None; base.scene.frames as usize],
             has_lag: false,
             coverage: Coverage::new(
                 base.scene,
@@ -374,23 +419,53 @@ impl QualityStage {
                 && Self::reference_copyable(&self.taa, &self.shadow_share),
             reference_copied: 0,
             metric_timed: Vec::new(),
+            segments: Vec::new(),
         };
-        let pass_start = Instant::now();
-        if let Some(taa) = &mut self.taa {
-            taa.reset();
-        }
         walk.coverage.reset();
-        for f in 0..frames {
+        walk
+    }
+
+    /// The quality pass of `method` over `frames`, the next frames of its walk `driver` (reset before the
+    /// first segment), timed by the wall clock from its first command to the GPU's last; `cache`: the block's
+    /// reference frames (kept by whichever pass drew them first).
+    pub fn segment(
+        &mut self,
+        base: &BlockGpu<'_>,
+        (method, driver): (&mut dyn Method, &mut FrameDriver<'_>),
+        (walk, frames): (&mut Walk, std::ops::Range<u32>),
+        cache: Option<&ReferenceCache>,
+        progress: &ProgressBar,
+        on_frames: &mut dyn FnMut(u32, FrameImages<'_>) -> Result<()>,
+    ) -> Result<()> {
+        let start = Instant::now();
+        let before = (walk.counterfactual_pixels.1, walk.reference_copied);
+        let first = frames.start;
+        for f in frames.clone() {
             check_interrupt()?;
             driver.advance(f);
-            self.quality_frame(base, method, driver, f, &mut walk, on_frames)?;
+            self.quality_frame(base, (method, cache), driver, f, walk, on_frames)?;
             progress.inc(1);
         }
         base.ctx.wait_idle()?;
-        let ms_per_frame = pass_start.elapsed().as_secs_f64() * 1e3 / frames as f64;
-        if let Some(cache) = &mut self.reference_cache {
-            cache.stored(frames);
-        }
+        walk.in_flight.clear();
+        walk.segments.push(SegmentCost {
+            frames: [first, frames.end],
+            ms: start.elapsed().as_secs_f64() * 1e3,
+            counterfactual_frames: walk.counterfactual_pixels.1 - before.0,
+            reference_copied: walk.reference_copied - before.1,
+        });
+        Ok(())
+    }
+
+    /// After the last segment: every kernel's per-frame figures, read back once.
+    pub fn finish(
+        &self,
+        base: &BlockGpu<'_>,
+        method: &dyn Method,
+        walk: Walk,
+    ) -> Result<QualityPass> {
+        let frames = base.scene.frames.max(1) as f64;
+        let ms_per_frame = walk.segments.iter().map(|s| s.ms).sum::<f64>() / frames;
         self.read_figures(base, method, walk, ms_per_frame)
     }
 
@@ -398,11 +473,11 @@ impl QualityStage {
     fn quality_frame(
         &mut self,
         base: &BlockGpu<'_>,
-        method: &mut dyn Method,
+        (method, cache): (&mut dyn Method, Option<&ReferenceCache>),
         driver: &FrameDriver<'_>,
         f: u32,
-        walk: &mut Walk<'_>,
-        on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
+        walk: &mut Walk,
+        on_frames: &mut dyn FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<()> {
         let (ctx, dump) = (base.ctx, walk.dump_frames[f as usize]);
         base.write_frame(f);
@@ -418,7 +493,7 @@ impl QualityStage {
         let read_back = dump || self.flip;
         if self.render_frames(
             base,
-            method,
+            (method, cache),
             (&input, f, copy_method),
             &mut encoder,
             read_back,
@@ -490,13 +565,12 @@ impl QualityStage {
     fn render_frames(
         &mut self,
         base: &BlockGpu<'_>,
-        method: &mut dyn Method,
+        (method, cache): (&mut dyn Method, Option<&ReferenceCache>),
         (input, f, copy_method): (&FrameInput<'_>, u32, bool),
         encoder: &mut wgpu::CommandEncoder,
         read_back: bool,
     ) -> bool {
         let (gpu, t, reference) = (&base.gpu, &self.targets, &mut self.reference);
-        let cache = self.reference_cache.as_ref();
         let from_cache = cache.is_some_and(|c| c.restore(encoder, f, &t.reference));
         let from_method = !from_cache && copy_method;
         if !from_cache && !from_method {
@@ -828,8 +902,8 @@ impl QualityStage {
         f: u32,
         reads: FrameReads,
         index: wgpu::SubmissionIndex,
-        walk: &mut Walk<'_>,
-        on_frames: &mut impl FnMut(u32, FrameImages<'_>) -> Result<()>,
+        walk: &mut Walk,
+        on_frames: &mut dyn FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<()> {
         let ctx = base.ctx;
         if let (true, Some([m, r])) = (reads.frames, &self.readback) {
@@ -880,6 +954,7 @@ impl QualityStage {
         walk: Walk,
         ms_per_frame: f64,
     ) -> Result<QualityPass> {
+        let segments = walk.segments.clone();
         let (ctx, k, frames) = (base.ctx, &self.kernels, base.scene.frames);
         let pixels = base.scene.width as f64 * base.scene.height as f64;
         let metric_tile_share =
@@ -923,6 +998,7 @@ impl QualityStage {
             counterfactual_pixel_share,
             counterfactual_frames: drawn_frames,
             reference_frames_copied: walk.reference_copied,
+            segments,
         })
     }
 }

@@ -597,8 +597,13 @@ pub struct BlockInfo {
     /// `counterfactual_frame_share`). What the pass costs beyond its renders: 1.0 would be free kernels,
     /// copies and read-backs. The counterfactual counts as a whole render though it is drawn inside a scissor,
     /// so where it is drawn often this is a lower bound of that overhead; `quality_to_timing_ratio` is the plain
-    /// ratio.
+    /// ratio. Made round by round (each quality segment over the renders timed in its own round; the geometric
+    /// mean of the rounds' ratios), with its Student-t 95 % interval over rounds (null with one round).
     pub quality_to_renders_ratio: Option<f64>,
+    pub quality_to_renders_ratio_ci95_lo: Option<f64>,
+    pub quality_to_renders_ratio_ci95_hi: Option<f64>,
+    /// The ratio of each round, in round order.
+    pub quality_to_renders_by_round: Option<Vec<f64>>,
     /// The share of the quality pass's frames on which lodpop's counterfactual was drawn (some instance's
     /// image-state changed; None: no quality pass).
     pub counterfactual_frame_share: Option<f64>,

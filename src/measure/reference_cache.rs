@@ -1,5 +1,5 @@
-//! The reference's frames of a block, kept on the GPU by the first method's quality pass so that the next
-//! methods' quality passes copy them instead of drawing the reference again.
+//! The reference's frames of a block's current round, kept on the GPU by the round's first quality segment so
+//! that the next methods' segments of the round copy them instead of drawing the reference again.
 //!
 //! The reference frame of frame `f` is the same picture whatever method is measured: every instance at LOD0
 //! under frame `f`'s camera and animation (src/methods/reference.rs). So a run of n methods on a block draws the
@@ -7,8 +7,11 @@
 //! of the quality pass (docs/measurement.md, "The reference cache").
 //!
 //! Not used where the reference frame depends on more than the frame: under TAA (its stream carries a history)
-//! and with shadows (its shadow map is drawn in the same pass). The budget (`--reference-cache-mib`) bounds
-//! the memory: the first frames that fit are kept, the rest drawn as before. Every figure is the same with the
+//! and with shadows (its shadow map is drawn in the same pass). Every method's quality segment of round r covers
+//! the same frames within round r (src/measure/block.rs), so the cache holds one round's frames and is
+//! reused from round to round: its memory is a round's, not the path's, and it does not grow while the rounds
+//! are timed. The budget (`--reference-cache-mib`) bounds it: the first frames of a round that fit are kept,
+//! the rest drawn as before. Every figure is the same with the
 //! cache as without it: the copy is the reference's colour, byte for byte, and nothing reads its depth (test
 //! `measure_reference_cache`).
 
@@ -26,15 +29,17 @@ pub struct ReferenceCache {
     frame_bytes: u64,
     frames_per_chunk: u32,
     chunks: Vec<wgpu::Buffer>,
-    /// Frames `0..capacity` have a slot.
+    /// Frames `first..first + capacity` have a slot.
     capacity: u32,
-    /// Frames `0..filled` hold the reference (set when a pass that stored them has ended).
+    /// The first frame of the current round.
+    first: u32,
+    /// Frames `first..filled` hold the reference (set when a segment that stored them has ended).
     filled: u32,
 }
 
 impl ReferenceCache {
-    /// A cache of the first frames of `frames` at `width` x `height` that fit in `budget` bytes; None when not
-    /// one fits.
+    /// A cache of the first frames of a round of `frames` frames (the longest round) at `width` x `height` that
+    /// fit in `budget` bytes; None when not one fits.
     pub fn new(
         ctx: &GpuContext,
         (width, height): (u32, u32),
@@ -69,12 +74,14 @@ impl ReferenceCache {
             frames_per_chunk,
             chunks,
             capacity,
+            first: 0,
             filled: 0,
         })
     }
 
-    /// Frame `f`'s slot.
+    /// Frame `f`'s slot (`first <= f < first + capacity`).
     fn slot(&self, f: u32) -> wgpu::TexelCopyBufferInfo<'_> {
+        let f = f - self.first;
         wgpu::TexelCopyBufferInfo {
             buffer: &self.chunks[(f / self.frames_per_chunk) as usize],
             layout: wgpu::TexelCopyBufferLayout {
@@ -101,7 +108,7 @@ impl ReferenceCache {
         f: u32,
         target: &RenderTarget,
     ) -> bool {
-        if f >= self.filled {
+        if f < self.first || f >= self.filled {
             return false;
         }
         encoder.copy_buffer_to_texture(self.slot(f), target.color.as_image_copy(), self.extent());
@@ -111,7 +118,7 @@ impl ReferenceCache {
     /// Records the copy of `target`'s colour (frame `f`'s reference, just drawn) into the cache, where it has a
     /// slot and does not hold it yet.
     pub fn store(&self, encoder: &mut wgpu::CommandEncoder, f: u32, target: &RenderTarget) {
-        if f >= self.filled && f < self.capacity {
+        if f >= self.filled && f < self.first + self.capacity {
             encoder.copy_texture_to_buffer(
                 target.color.as_image_copy(),
                 self.slot(f),
@@ -120,8 +127,14 @@ impl ReferenceCache {
         }
     }
 
-    /// A pass stored frames `0..frames` and ended: later passes copy them.
-    pub fn stored(&mut self, frames: u32) {
-        self.filled = self.filled.max(frames.min(self.capacity));
+    /// A round starts at frame `first`: the slots are free for its frames.
+    pub fn begin_round(&mut self, first: u32) {
+        self.first = first;
+        self.filled = first;
+    }
+
+    /// A segment stored the round's frames up to `end` and ended: later segments of the round copy them.
+    pub fn stored(&mut self, end: u32) {
+        self.filled = self.filled.max(end.min(self.first + self.capacity));
     }
 }

@@ -4,7 +4,7 @@
 //!   each side of its midpoint, so every pipeline a method uses has run once before timing, then the first
 //!   timed frame's pose as the frame before it (`Method::replay_as_previous`), so the first timed frame finds
 //!   the state every later one finds.
-//! - Timing rounds ([`BlockRunner::time_methods`]): the path is cut into `rounds` consecutive segments; round r
+//! - Timing rounds ([`BlockGpu::time_round`], driven by `BlockRunner::measure_block`): the path is cut into `rounds` consecutive segments; round r
 //!   times every method over segment r in a seeded shuffled order, each method continuing its own walk, so drift
 //!   of the machine's speed falls on all methods alike and each round pairs the methods on the same frames.
 //!   Nothing but the method's own work is in a timed frame (no metric, no read-back, no stage timestamps). Each
@@ -52,6 +52,8 @@ pub struct TimedMethod<'s> {
     pub(super) gpu_ms: Vec<Option<f64>>,
     /// Wall time of the method's timed segments, ms.
     wall_ms: f64,
+    /// Wall time of each timed segment (one per round, in round order), ms.
+    pub(super) segment_ms: Vec<f64>,
     pub(super) uploads: Uploads,
     /// `--warmup` (the frames of the path rendered untimed first; [`WarmUpPlan`] adds transition frames).
     pub(super) warmup: u32,
@@ -62,15 +64,6 @@ impl TimedMethod<'_> {
     pub fn ms_per_frame(&self) -> f64 {
         self.wall_ms / self.cpu_ms.len().max(1) as f64
     }
-}
-
-/// The timing-round time per frame of the (first) reference among `timed`, listed or timed only: the denominator
-/// of `quality_to_renders_ratio`.
-pub fn reference_ms_per_frame(timed: &[TimedMethod<'_>]) -> Option<f64> {
-    timed
-        .iter()
-        .find(|t| is_reference(&t.label))
-        .map(TimedMethod::ms_per_frame)
 }
 
 /// The frames every method renders untimed before the rounds: the first `warmup` frames of the path (wrapping),
@@ -124,23 +117,28 @@ pub fn shuffled_order(n: usize, rng: &mut SplitMix64) -> Vec<usize> {
     order
 }
 
+/// The methods of a block, created and warmed up, before their rounds.
+pub struct Prepared<'s> {
+    pub methods: Vec<TimedMethod<'s>>,
+    /// The block's rounds as run.json records them (its `rounds` still empty).
+    pub info: BlockRounds,
+    pub plan: WarmUpPlan,
+}
+
 impl<'a> BlockGpu<'a> {
-    /// Creates the methods `labels` (a label `NAME#k` is another instance of NAME), warms each up
-    /// ([`WarmUpPlan`]), then times them in `rounds` interleaved rounds: round r times every method over the
-    /// frames [`round_frames`]`(r)`, in an order shuffled from `seed`, each method continuing its own walk along
-    /// the path. When no label is the reference and `time_reference` (the quality pass runs), the reference is
-    /// timed too (its time per frame is the denominator of run.json's `quality_to_renders_ratio`) and returned
-    /// last, labelled `reference`.
-    pub fn time_methods(
+    /// Creates the methods `labels` (a label `NAME#k` is another instance of NAME) and warms each up
+    /// ([`WarmUpPlan`]). When no label is the reference and `time_reference` (the quality pass runs), the
+    /// reference is created too (its time per frame is the denominator of run.json's `quality_to_renders_ratio`),
+    /// last, labelled `reference`. Each round is then [`BlockGpu::time_round`].
+    pub fn prepare_methods(
         &self,
         labels: &[String],
         warmup: u32,
-        rounds: u32,
         seed: u64,
         time_reference: bool,
         progress: &ProgressBar,
-    ) -> Result<(Vec<TimedMethod<'a>>, BlockRounds)> {
-        let (scene, frames) = (self.scene, self.scene.frames);
+    ) -> Result<Prepared<'a>> {
+        let scene = self.scene;
         let mut labels = labels.to_vec();
         let timed_only: Vec<String> = if !time_reference || labels.iter().any(|l| is_reference(l)) {
             Vec::new()
@@ -148,45 +146,62 @@ impl<'a> BlockGpu<'a> {
             labels.push("reference".into());
             vec!["reference".into()]
         };
-        let mut methods = labels
-            .iter()
-            .map(|label| self.create_timed(label, warmup))
-            .collect::<Result<Vec<_>>>()?;
         let plan = WarmUpPlan::new(scene, warmup);
-        for m in methods.iter_mut() {
-            self.warm_up(m, &plan, progress)?;
-            m.driver.reset();
+        let mut methods = Vec::with_capacity(labels.len());
+        for label in &labels {
+            let mut m = self.create_timed(label, warmup)?;
+            self.warm_up(
+                (&m.label, m.method.as_mut(), &mut m.driver),
+                &plan,
+                progress,
+            )?;
+            methods.push(m);
         }
-        let rounds = rounds.clamp(1, frames.max(1));
-        let mut rng = SplitMix64::new(seed);
-        let mut info = BlockRounds {
-            scene: scene.name().to_string(),
-            count: scene.count,
-            seed,
-            warmup_transition_frames: plan.transition_frames.clone(),
-            timed_only,
-            rounds: Vec::with_capacity(rounds as usize),
-        };
-        for r in 0..rounds {
-            let (lo, hi) = round_frames(r, rounds, frames);
-            let order = shuffled_order(methods.len(), &mut rng);
-            for &i in &order {
-                self.time_segment(&mut methods[i], r, lo..hi, progress)?;
-            }
-            info.rounds.push(Round {
-                round: r,
-                frames: [lo, hi],
-                order: order.iter().map(|&i| methods[i].label.clone()).collect(),
-            });
+        Ok(Prepared {
+            methods,
+            info: BlockRounds {
+                scene: scene.name().to_string(),
+                count: scene.count,
+                seed,
+                warmup_transition_frames: plan.transition_frames.clone(),
+                timed_only,
+                rounds: Vec::new(),
+            },
+            plan,
+        })
+    }
+
+    /// Round `r` of `rounds`: every method timed over the frames [`round_frames`]`(r)`, in an order shuffled
+    /// from `rng`, each continuing its own walk along the path; returns the order (indices into `methods`).
+    pub fn time_round(
+        &self,
+        p: &mut Prepared<'a>,
+        (r, rounds): (u32, u32),
+        rng: &mut SplitMix64,
+        progress: &ProgressBar,
+    ) -> Result<Vec<usize>> {
+        let (lo, hi) = round_frames(r, rounds, self.scene.frames);
+        let order = shuffled_order(p.methods.len(), rng);
+        for &i in &order {
+            self.time_segment(&mut p.methods[i], r, lo..hi, progress)?;
         }
+        p.info.rounds.push(Round {
+            round: r,
+            frames: [lo, hi],
+            order: order.iter().map(|&i| p.methods[i].label.clone()).collect(),
+        });
+        Ok(order)
+    }
+
+    /// After the last round: every method's GPU timestamps, read once.
+    pub fn read_timers(&self, methods: &mut [TimedMethod<'a>]) -> Result<()> {
         for m in methods.iter_mut() {
             m.gpu_ms = match &m.timer {
                 Some(t) => t.read(self.ctx)?,
                 None => Vec::new(),
             };
         }
-        self.ctx.check_errors()?;
-        Ok((methods, info))
+        self.ctx.check_errors()
     }
 
     /// The method `label`, created, with an empty record of its timed frames.
@@ -205,6 +220,7 @@ impl<'a> BlockGpu<'a> {
             round: Vec::with_capacity(frames),
             gpu_ms: Vec::new(),
             wall_ms: 0.0,
+            segment_ms: Vec::new(),
             uploads: Uploads::default(),
             warmup,
         })
@@ -212,10 +228,12 @@ impl<'a> BlockGpu<'a> {
 
     /// `plan`'s warm-up frames, untimed, then frame 0 as the frame before the first timed frame (frame 0 of
     /// round 0): drawn, then handed to `Method::replay_as_previous`, so that the first timed frame follows a
-    /// frame as every other does (FSI renders one LOD buffer there, not both).
-    fn warm_up(
+    /// frame as every other does (FSI renders one LOD buffer there, not both). The walk `driver` is left reset,
+    /// at the start of the path. The quality pass's own instance of a method is warmed up the same way, so that
+    /// its frames are the timed frames (the method's state included).
+    pub(super) fn warm_up(
         &self,
-        m: &mut TimedMethod<'_>,
+        (label, method, driver): (&str, &mut dyn Method, &mut FrameDriver<'_>),
         plan: &WarmUpPlan,
         progress: &ProgressBar,
     ) -> Result<()> {
@@ -223,36 +241,37 @@ impl<'a> BlockGpu<'a> {
         for w in 0..plan.warmup {
             let f = w % scene.frames;
             if f == 0 {
-                m.driver.reset();
+                driver.reset();
             }
-            m.driver.advance(f);
-            self.render_untimed(m, f)?;
+            driver.advance(f);
+            self.render_untimed((label, &mut *method), driver, f)?;
             progress.inc(1);
         }
-        m.driver.reset();
+        driver.reset();
         let last = plan.transition_frames.last().copied();
         for f in 0..last.map_or(0, |l| l + 1) {
-            m.driver.advance(f);
+            driver.advance(f);
             if plan.transition_frames.binary_search(&f).is_ok() {
-                self.render_untimed(m, f)?;
+                self.render_untimed((label, &mut *method), driver, f)?;
             }
         }
-        m.driver.reset();
+        driver.reset();
         if scene.frames > 0 {
-            m.driver.advance(0);
-            self.render_untimed(m, 0)?;
-            m.method.replay_as_previous();
+            driver.advance(0);
+            self.render_untimed((label, &mut *method), driver, 0)?;
+            method.replay_as_previous();
         }
+        driver.reset();
         Ok(())
     }
 
     /// `--shadows on`, outside the quality pass: what `m` casts this frame, into the method's shadow map.
     fn own_shadow(
         &self,
-        m: &TimedMethod<'_>,
+        (label, method): (&str, &dyn Method),
         input: &FrameInput<'_>,
     ) -> Option<wgpu::CommandBuffer> {
-        let casters = if is_reference(&m.label) {
+        let casters = if is_reference(label) {
             Casters::Reference
         } else {
             Casters::Method
@@ -260,22 +279,26 @@ impl<'a> BlockGpu<'a> {
         let shadows = self.shadows.as_ref()?;
         Some(shadows.commands(
             &self.gpu,
-            m.method.as_ref(),
+            method,
             input,
             input.states,
             (ShadowRole::Method, casters),
         ))
     }
 
-    fn render_untimed(&self, m: &mut TimedMethod<'_>, f: u32) -> Result<()> {
+    fn render_untimed(
+        &self,
+        (label, method): (&str, &mut dyn Method),
+        driver: &FrameDriver<'_>,
+        f: u32,
+    ) -> Result<()> {
         check_interrupt()?;
         let ctx = self.ctx;
         self.write_frame(f);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let input = m.driver.input(f);
-        m.method
-            .encode(&self.gpu, &input, &mut encoder, &self.timing_target);
-        let shadow = self.own_shadow(m, &input);
+        let input = driver.input(f);
+        method.encode(&self.gpu, &input, &mut encoder, &self.timing_target);
+        let shadow = self.own_shadow((label, &*method), &input);
         ctx.queue
             .submit(shadow.into_iter().chain([encoder.finish()]));
         ctx.wait_idle()
@@ -316,7 +339,7 @@ impl<'a> BlockGpu<'a> {
             if let Some(t) = &m.timer {
                 t.end(&mut encoder, f);
             }
-            let shadow = self.own_shadow(m, &input);
+            let shadow = self.own_shadow((&m.label, m.method.as_ref()), &input);
             ctx.queue.submit(
                 [first.finish()]
                     .into_iter()
@@ -328,7 +351,9 @@ impl<'a> BlockGpu<'a> {
             m.round.push(round);
             progress.inc(1);
         }
-        m.wall_ms += start.elapsed().as_secs_f64() * 1e3;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        m.wall_ms += ms;
+        m.segment_ms.push(ms);
         let after = self.gpu.uploads.get();
         m.uploads.listed += after.0 - uploads_before.0;
         m.uploads.written += after.1 - uploads_before.1;

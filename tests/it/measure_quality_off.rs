@@ -84,7 +84,8 @@ fn quality_off_leaves_the_image_figures_empty_and_times() {
     assert_eq!(run["config"]["quality"], "off");
     for b in run["blocks"].as_array().unwrap() {
         for k in ["quality_pass_ms_per_frame", "quality_to_timing_ratio", "quality_to_renders_ratio",
-                  "metric_gpu_ms_median"] {
+                  "quality_to_renders_ratio_ci95_lo", "quality_to_renders_ratio_ci95_hi",
+                  "quality_to_renders_by_round", "metric_gpu_ms_median"] {
             assert!(b[k].is_null(), "run.json {k}: {}", b[k]);
         }
         assert!(b["timing_pass_ms_per_frame"].as_f64().unwrap() > 0.0);

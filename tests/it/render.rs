@@ -632,12 +632,22 @@ fn a_method_listed_twice_runs_twice() {
         .map(|b| b["method"].as_str().unwrap())
         .collect();
     assert_eq!(blocks, ["discrete", "discrete#2"]);
-    assert!(
-        run["blocks"][0]["quality_to_renders_ratio"]
-            .as_f64()
+    // q/r is paired round by round: a ratio per round, their geometric mean inside its interval.
+    for b in run["blocks"].as_array().unwrap() {
+        let q = b["quality_to_renders_ratio"].as_f64().unwrap();
+        let lo = b["quality_to_renders_ratio_ci95_lo"].as_f64().unwrap();
+        let hi = b["quality_to_renders_ratio_ci95_hi"].as_f64().unwrap();
+        assert!(q > 0.0 && lo <= q && q <= hi, "{q} [{lo}, {hi}]");
+        let by_round: Vec<f64> = b["quality_to_renders_by_round"]
+            .as_array()
             .unwrap()
-            > 0.0
-    );
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        assert_eq!(by_round.len(), 4);
+        let geomean = (by_round.iter().map(|x| x.ln()).sum::<f64>() / 4.0).exp();
+        assert!((geomean - q).abs() < 1e-9 * q, "{geomean} against {q}");
+    }
 }
 
 /// `--max-transitions` reaches the run: on windmills (ci, timing only) with time fades a cap of 1 holds instances back (run.json's
@@ -762,4 +772,71 @@ fn shader_work_runs_and_leaves_the_image_alone() {
             .collect::<Vec<_>>()
     };
     assert_eq!(run("0"), run("32"));
+}
+
+/// The quality pass is made round by round, each method's by an instance of its own with its own stage (targets,
+/// kernels, TAA streams) while the other methods' segments run in between: every image figure is the same in 1
+/// round as in 4, and with `--quality-schedule after` (every timing round first), for methods whose frame
+/// carries state (FSI's buffers, TAA's history, ROAM's triangulation).
+#[test]
+fn the_quality_pass_does_not_depend_on_the_rounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let figures = [
+        "rmse",
+        "pop",
+        "lodpop",
+        "lag_rmse",
+        "uncovered_px",
+        "crack_px",
+        "triangles",
+    ];
+    for (name, args) in [
+        (
+            "simple",
+            &[
+                "--scene",
+                "simple",
+                "--profile",
+                "regress",
+                "--frames",
+                "24",
+                "--taa",
+                "on",
+                "--method",
+                "alpha,fsi,dither",
+            ][..],
+        ),
+        (
+            "terrain",
+            &[
+                "--scene",
+                "terrain",
+                "--profile",
+                "regress",
+                "--frames",
+                "16",
+                "--method",
+                "roam,blocks",
+            ][..],
+        ),
+    ] {
+        let run = |rounds: &str, schedule: &str| {
+            let out = dir.path().join(format!("{name}-{rounds}-{schedule}"));
+            let mut argv = args.to_vec();
+            argv.extend_from_slice(&["--rounds", rounds, "--quality-schedule", schedule]);
+            read_csv(&crate::common::run_into(&out, &argv).join("frames.csv"))
+        };
+        let (one, four) = (run("1", "rounds"), run("4", "rounds"));
+        let after = run("4", "after");
+        assert_eq!(one.len(), four.len());
+        let rounds: Vec<&str> = four.iter().map(|r| r["round"].as_str()).collect();
+        assert!(rounds.contains(&"3"), "{name}: four rounds ran");
+        for ((a, b), c) in one.iter().zip(&four).zip(&after) {
+            for f in figures {
+                let at = format!("{name} {} frame {} {f}", a["method"], a["frame"]);
+                assert_eq!(a[f], b[f], "{at}");
+                assert_eq!(a[f], c[f], "{at} (after)");
+            }
+        }
+    }
 }
