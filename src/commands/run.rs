@@ -440,7 +440,8 @@ pub fn summary_table(s: &RunSummary) -> String {
     let baseline = s.summaries.iter().find_map(|r| r.baseline.clone());
     out.push_str(&format!(
         "gpu_ms and cpu_ms are medians; q/r = quality-pass time per frame / the timing-pass time of the \
-         renders it makes (method, reference where drawn, lodpop's counterfactual where drawn); ratio = time over {}'s, paired by timing round, geometric mean and 95 % t interval over rounds \
+         renders it makes (method, reference where drawn, lodpop's counterfactual where drawn), paired by round \
+         (geometric mean; its interval in run.json); ratio = time over {}'s, paired by timing round, geometric mean and 95 % t interval over rounds \
          (every other pair: pairs.csv, lodbench compare DIR A B); '-' = not measured (no timestamps; --quality off: \
          no image figures)\n",
         baseline.as_deref().unwrap_or("the baseline (none run)")
