@@ -147,27 +147,21 @@ impl<'a> BlockRunner<'a> {
         base.ctx.check_errors()?;
         let mut rng = SplitMix64::new(seed);
         let mut orders = Vec::with_capacity(rounds as usize);
-        let after = self.quality.schedule == QualitySchedule::After;
         for r in 0..rounds {
             orders.push(base.time_round(&mut p, (r, rounds), &mut rng, progress)?);
-            if !after {
+            // The quality rounds due once timing round r is done: round r itself, or with `after` every round
+            // once the last is timed.
+            let due = match self.quality.schedule {
+                QualitySchedule::Rounds => r..r + 1,
+                QualitySchedule::After if r + 1 == rounds => 0..rounds,
+                QualitySchedule::After => 0..0,
+            };
+            for q in due {
                 self.quality_round(
                     &p,
                     (&mut runs, cache.as_mut()),
-                    (r, rounds),
-                    &orders[r as usize],
-                    progress,
-                    &mut on_frames,
-                )?;
-            }
-        }
-        if after {
-            for r in 0..rounds {
-                self.quality_round(
-                    &p,
-                    (&mut runs, cache.as_mut()),
-                    (r, rounds),
-                    &orders[r as usize],
+                    (q, rounds),
+                    &orders[q as usize],
                     progress,
                     &mut on_frames,
                 )?;

@@ -197,8 +197,6 @@ pub struct QualityStage {
     targets: QualityTargets,
     kernels: QualityKernels,
     reference: Box<dyn Method>,
-    /// `--metrics de2000`: the kernel computes CIEDE2000 (else de2000_mean is empty).
-    pub de2000: bool,
     /// Read back every quality-pass frame and compute FLIP on it.
     flip: bool,
     /// The method's and the reference's read-back, with `--metrics flip` or dumps.
@@ -355,7 +353,6 @@ impl QualityStage {
             targets,
             kernels,
             reference,
-            de2000: quality.metrics.contains(&Metric::De2000),
             region: quality.region,
             flip,
             readback,
@@ -455,18 +452,6 @@ impl QualityStage {
             reference_copied: walk.reference_copied - before.1,
         });
         Ok(())
-    }
-
-    /// After the last segment: every kernel's per-frame figures, read back once.
-    pub fn finish(
-        &self,
-        base: &BlockGpu<'_>,
-        method: &dyn Method,
-        walk: Walk,
-    ) -> Result<QualityPass> {
-        let frames = base.scene.frames.max(1) as f64;
-        let ms_per_frame = walk.segments.iter().map(|s| s.ms).sum::<f64>() / frames;
-        self.read_figures(base, method, walk, ms_per_frame)
     }
 
     /// One frame of the quality pass, through every stage.
@@ -946,15 +931,13 @@ impl QualityStage {
         Ok(())
     }
 
-    /// After the last frame: every kernel's per-frame figures, read back once.
-    fn read_figures(
+    /// After the last segment: every kernel's per-frame figures, read back once.
+    pub fn finish(
         &self,
         base: &BlockGpu<'_>,
         method: &dyn Method,
         walk: Walk,
-        ms_per_frame: f64,
     ) -> Result<QualityPass> {
-        let segments = walk.segments.clone();
         let (ctx, k, frames) = (base.ctx, &self.kernels, base.scene.frames);
         let pixels = base.scene.width as f64 * base.scene.height as f64;
         let metric_tile_share =
@@ -992,13 +975,13 @@ impl QualityStage {
             },
             shadow,
             stage_ms: method.stage_gpu_ms(ctx)?,
-            ms_per_frame,
             metric_gpu_ms_median,
             metric_tile_share,
             counterfactual_pixel_share,
             counterfactual_frames: drawn_frames,
             reference_frames_copied: walk.reference_copied,
-            segments,
+            ms_per_frame: walk.segments.iter().map(|s| s.ms).sum::<f64>() / frames.max(1) as f64,
+            segments: walk.segments,
         })
     }
 }

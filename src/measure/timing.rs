@@ -50,8 +50,6 @@ pub struct TimedMethod<'s> {
     pub(super) round: Vec<u32>,
     /// GPU time per frame, read after the last round (None without timestamp queries).
     pub(super) gpu_ms: Vec<Option<f64>>,
-    /// Wall time of the method's timed segments, ms.
-    wall_ms: f64,
     /// Wall time of each timed segment (one per round, in round order), ms.
     pub(super) segment_ms: Vec<f64>,
     pub(super) uploads: Uploads,
@@ -62,7 +60,7 @@ pub struct TimedMethod<'s> {
 impl TimedMethod<'_> {
     /// Wall time per timed frame (render + wait), ms.
     pub fn ms_per_frame(&self) -> f64 {
-        self.wall_ms / self.cpu_ms.len().max(1) as f64
+        self.segment_ms.iter().sum::<f64>() / self.cpu_ms.len().max(1) as f64
     }
 }
 
@@ -219,7 +217,6 @@ impl<'a> BlockGpu<'a> {
             stats: Vec::with_capacity(frames),
             round: Vec::with_capacity(frames),
             gpu_ms: Vec::new(),
-            wall_ms: 0.0,
             segment_ms: Vec::new(),
             uploads: Uploads::default(),
             warmup,
@@ -351,9 +348,7 @@ impl<'a> BlockGpu<'a> {
             m.round.push(round);
             progress.inc(1);
         }
-        let ms = start.elapsed().as_secs_f64() * 1e3;
-        m.wall_ms += ms;
-        m.segment_ms.push(ms);
+        m.segment_ms.push(start.elapsed().as_secs_f64() * 1e3);
         let after = self.gpu.uploads.get();
         m.uploads.listed += after.0 - uploads_before.0;
         m.uploads.written += after.1 - uploads_before.1;
