@@ -1,7 +1,7 @@
 // FSI combination pass (Scherzer & Wimmer 2008 sections 3.4-3.5), a compute pass over the pixels (a full-screen-triangle
 // render pass was recompiled by llvmpipe on every draw, costing milliseconds and ~1 MB of memory per frame). The newer LOD buffer is read at
 // the pixel; the older one through reprojection by eq. 2, p_old = P_old V_old V_new^-1 P_new^-1 p_new, using
-// the newer buffer's stored depth (or at the same pixel when `mode` = 1, the `fsi-noreproject` ablation).
+// the newer buffer's stored depth (or at the same pixel with SAME_PIXEL, the `fsi-noreproject` ablation).
 // A pixel that reprojects outside the older buffer takes the newer colour. Then per pixel:
 //   both ids 0 (two n-instances)              -> the newer colour;
 //   the same t-instance id in both            -> the average of the two colours (no depth test: coplanar LODs
@@ -19,14 +19,23 @@
 // Colours are read and written as the stored sRGB-encoded bytes (Rgba8Unorm views), so a pixel that takes one
 // buffer's colour is copied bit for bit; only averaged pixels are decoded, mixed and re-encoded.
 
+// The variant is fixed per pipeline (pipeline-overridable constants, one pipeline per FSI variant), not read
+// from the uniform: with a uniform-selected branch, llvmpipe (Mesa 22.3) ran every variant's code for every
+// pixel and its memory grew by about a frame's bytes per dispatch (docs/findings/timing.md, "FSI's combination
+// pass on lavapipe").
+// The older buffer read at the same pixel (`fsi-noreproject`, `fsi-sameframe`, lodpop's counterfactuals at one
+// pose), not through eq. 2.
+override SAME_PIXEL: bool = false;
+// The combination: 0 the paper's, 1 with the forward check, 2 frame-sequential blending (`fsi-blend`).
+override COMBINATION: u32 = 0u;
+
 struct Combine {
     // P_old * V_old * V_new^-1 * P_new^-1 (clip space of the newer frame to clip space of the older one).
     reproject: mat4x4<f32>,
     // P_new * V_new * V_old^-1 * P_old^-1 (clip space of the older frame to clip space of the newer one).
     forward: mat4x4<f32>,
-    // Viewport size in pixels (x, y); z: mode, 0 = reproject, 1 = same pixel; w: the combination, 0 = the
-    // paper's, 1 = with the forward check, 2 = frame-sequential blending (`fsi-blend`).
-    size_mode: vec4<f32>,
+    // Viewport size in pixels (x, y); z, w unused.
+    size: vec4<f32>,
 };
 
 @group(0) @binding(0) var new_color: texture_2d<f32>;
@@ -54,7 +63,7 @@ fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
 // Where pixel position `pos` of one frame, at depth `depth`, lies in the other frame by the clip-to-clip matrix
 // `m`: (x, y) in pixels (possibly outside the viewport), z its depth there; w < 0 when behind the camera.
 fn map_pixel(m: mat4x4<f32>, pos: vec2<f32>, depth: f32) -> vec4<f32> {
-    let size = combine.size_mode.xy;
+    let size = combine.size.xy;
     let ndc = vec4<f32>(pos.x / size.x * 2.0 - 1.0, 1.0 - pos.y / size.y * 2.0, depth, 1.0);
     let c = m * ndc;
     if (c.w <= 0.0) {
@@ -68,7 +77,7 @@ fn map_pixel(m: mat4x4<f32>, pos: vec2<f32>, depth: f32) -> vec4<f32> {
 // falls outside the older viewport or behind its camera.
 fn reproject(pos: vec2<f32>, depth: f32) -> vec4<f32> {
     let r = map_pixel(combine.reproject, pos, depth);
-    if (any(r.xy < vec2<f32>(0.0)) || any(r.xy >= combine.size_mode.xy)) {
+    if (any(r.xy < vec2<f32>(0.0)) || any(r.xy >= combine.size.xy)) {
         return vec4<f32>(0.0, 0.0, 0.0, -1.0);
     }
     return r;
@@ -85,7 +94,7 @@ const FORWARD_TOLERANCE: f32 = 1.0;
 // lookup) and moves the lookup by how far the fragment missed, rounded, at most FORWARD_STEPS texels in all;
 // (-1, -1) when none lands near `p`.
 fn forward_match(p: vec2<i32>, q0: vec2<i32>) -> vec2<i32> {
-    let size = vec2<i32>(combine.size_mode.xy);
+    let size = vec2<i32>(combine.size.xy);
     let centre = vec2<f32>(p) + vec2<f32>(0.5);
     var q = q0;
     for (var i = 0; i < FORWARD_STEPS; i++) {
@@ -107,7 +116,7 @@ fn forward_match(p: vec2<i32>, q0: vec2<i32>) -> vec2<i32> {
 
 @compute @workgroup_size(8, 8)
 fn cs_combine(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = vec2<u32>(combine.size_mode.xy);
+    let size = vec2<u32>(combine.size.xy);
     if (id.x >= size.x || id.y >= size.y) {
         return;
     }
@@ -121,14 +130,14 @@ fn combine_pixel(p: vec2<i32>, pos: vec2<f32>) -> vec4<f32> {
     let idn = textureLoad(new_id, p, 0).r;
     var q = p;
     var dn_old = dn;
-    if (combine.size_mode.z < 0.5) {
+    if (!SAME_PIXEL) {
         let r = reproject(pos, dn);
         if (r.w < 0.0) {
             return cn;
         }
         q = vec2<i32>(floor(r.xy));
         dn_old = r.z;
-        if (combine.size_mode.w > 0.5 && combine.size_mode.w < 1.5) {
+        if (COMBINATION == 1u) {
             q = forward_match(p, q);
             if (q.x < 0) {
                 return cn;
@@ -140,7 +149,7 @@ fn combine_pixel(p: vec2<i32>, pos: vec2<f32>) -> vec4<f32> {
     if (idn == 0u && ido == 0u) {
         return cn;
     }
-    if (combine.size_mode.w > 1.5) {
+    if (COMBINATION == 2u) {
         // Frame-sequential blending: the two finished buffers mixed by the weight of the t-instance's LOD in
         // the newer buffer (its alpha), or, where only the older shows a t-instance, by that LOD's own weight.
         let w_new = select(1.0 - co.a, cn.a, idn != 0u);

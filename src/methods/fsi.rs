@@ -361,6 +361,8 @@ struct Scratch {
     buffers: [LodBuffer; 2],
     /// Holds the same-pixel uniform (kept alive by the bind group).
     group: wgpu::BindGroup,
+    /// The combination at one pose: the older buffer read at the same pixel.
+    pipeline: wgpu::ComputePipeline,
     instances: InstanceBuffer,
     lists: [DrawList; 4],
 }
@@ -374,7 +376,8 @@ type Started = (i64, (u32, u32), u32);
 struct CombineRaw {
     reproject: [[f32; 4]; 4],
     forward: [[f32; 4]; 4],
-    size_mode: [f32; 4],
+    /// Viewport size in pixels (x, y); z, w unused.
+    size: [f32; 4],
 }
 
 pub struct Fsi {
@@ -387,7 +390,11 @@ pub struct Fsi {
     n_pipeline: wgpu::RenderPipeline,
     t_pipeline: wgpu::RenderPipeline,
     vis_group: wgpu::BindGroup,
+    /// The variant's combination (fsi_combine.wgsl's SAME_PIXEL and COMBINATION).
     combine_pipeline: wgpu::ComputePipeline,
+    /// The combination's module and layout, for the scratch pipeline of lodpop's counterfactuals.
+    combine_module: wgpu::ShaderModule,
+    combine_pipeline_layout: wgpu::PipelineLayout,
     /// The combination pass writes here (storage textures cannot be sRGB); copied into the frame's target.
     combined: wgpu::Texture,
     combine_uniform: wgpu::Buffer,
@@ -530,14 +537,14 @@ impl Fsi {
             bind_group_layouts: &[Some(&combine_layout)],
             immediate_size: 0,
         });
-        let combine_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("fsi combine"),
-            layout: Some(&layout),
-            module: &module,
-            entry_point: Some("cs_combine"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let forward_check =
+            variant == Variant::Sequential && options.fsi_check == FsiCheck::Forward;
+        let combine_pipeline = combine_pipeline(
+            device,
+            (&module, &layout),
+            !matches!(variant, Variant::Sequential | Variant::Blend),
+            combination(variant, forward_check),
+        );
         let combined = texture_2d(
             device,
             "fsi combined frame",
@@ -564,7 +571,7 @@ impl Fsi {
         });
         Fsi {
             variant,
-            forward_check: variant == Variant::Sequential && options.fsi_check == FsiCheck::Forward,
+            forward_check,
             buffers,
             lists: [DrawList::default(), DrawList::default()],
             instances: gpu
@@ -573,6 +580,8 @@ impl Fsi {
             t_pipeline,
             vis_group,
             combine_pipeline,
+            combine_module: module,
+            combine_pipeline_layout: layout,
             combined,
             combine_uniform,
             combine_groups,
@@ -768,22 +777,47 @@ impl Fsi {
     }
 }
 
-impl Fsi {
-    /// The combination the pass makes (`size_mode.w` of fsi_combine.wgsl): 0 the paper's, 1 with the forward
-    /// check, 2 frame-sequential blending.
-    fn combination(&self) -> f32 {
-        match (self.variant, self.forward_check) {
-            (Variant::Blend, _) => 2.0,
-            (_, true) => 1.0,
-            _ => 0.0,
-        }
+/// The combination the pass makes (fsi_combine.wgsl's COMBINATION): 0 the paper's, 1 with the forward check,
+/// 2 frame-sequential blending.
+fn combination(variant: Variant, forward_check: bool) -> u32 {
+    match (variant, forward_check) {
+        (Variant::Blend, _) => 2,
+        (_, true) => 1,
+        _ => 0,
     }
+}
 
-    /// The combination pass over the LOD buffers of `group`, into `target`.
+/// The combination pass's pipeline for one variant: `same_pixel` reads the older buffer at the pixel (no
+/// reprojection), `combination` as [`combination`]. Constants, not uniforms: each pipeline holds only its own
+/// variant's code (fsi_combine.wgsl says why).
+fn combine_pipeline(
+    device: &wgpu::Device,
+    (module, layout): (&wgpu::ShaderModule, &wgpu::PipelineLayout),
+    same_pixel: bool,
+    combination: u32,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("fsi combine"),
+        layout: Some(layout),
+        module,
+        entry_point: Some("cs_combine"),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants: &[
+                ("SAME_PIXEL", if same_pixel { 1.0 } else { 0.0 }),
+                ("COMBINATION", combination as f64),
+            ],
+            ..Default::default()
+        },
+        cache: None,
+    })
+}
+
+impl Fsi {
+    /// The combination pass over the LOD buffers of `group`, into `target`, by `pipeline`.
     fn combine(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        group: &wgpu::BindGroup,
+        (pipeline, group): (&wgpu::ComputePipeline, &wgpu::BindGroup),
         target: &RenderTarget,
     ) {
         {
@@ -791,7 +825,7 @@ impl Fsi {
                 label: Some("fsi combine pass"),
                 timestamp_writes: None,
             });
-            pass.set_pipeline(&self.combine_pipeline);
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, group, &[]);
             pass.dispatch_workgroups(target.width.div_ceil(8), target.height.div_ceil(8), 1);
         }
@@ -810,8 +844,8 @@ impl Fsi {
         // Both buffers at one pose: no reprojection, no forward check (fsi-sameframe's combination), fsi-blend's
         // blending.
         let combination = match self.variant {
-            Variant::Blend => self.combination(),
-            _ => 0.0,
+            Variant::Blend => combination(self.variant, self.forward_check),
+            _ => 0,
         };
         let (device, layout, view, format) = (
             &gpu.device,
@@ -819,6 +853,7 @@ impl Fsi {
             &self.combined_view,
             self.id_format,
         );
+        let module = (&self.combine_module, &self.combine_pipeline_layout);
         self.scratch.get_or_insert_with(|| {
             let buffers = [
                 LodBuffer::new(gpu, "fsi lodpop buffer 0", w, h, format),
@@ -833,12 +868,13 @@ impl Fsi {
             let raw = CombineRaw {
                 reproject: Mat4::IDENTITY.to_cols_array_2d(),
                 forward: Mat4::IDENTITY.to_cols_array_2d(),
-                size_mode: [w as f32, h as f32, 1.0, combination],
+                size: [w as f32, h as f32, 0.0, 0.0],
             };
             gpu.queue
                 .write_buffer(&uniform, 0, bytemuck::bytes_of(&raw));
             Scratch {
                 group: combine_group(device, layout, &buffers, 0, &uniform, view),
+                pipeline: combine_pipeline(device, module, true, combination),
                 buffers,
                 instances: InstanceBuffer::new(device, "fsi lodpop instances", 4 * n),
                 lists: Default::default(),
@@ -876,7 +912,7 @@ impl Fsi {
                 slot as u32 * n,
             );
         }
-        self.combine(encoder, &scratch.group, target);
+        self.combine(encoder, (&scratch.pipeline, &scratch.group), target);
         self.scratch = Some(scratch);
     }
 
@@ -1005,16 +1041,10 @@ impl Method for Fsi {
             });
         }
 
-        let same_pixel = !matches!(self.variant, Variant::Sequential | Variant::Blend);
         let raw = CombineRaw {
             reproject: reprojection(&camera, &old_camera).to_cols_array_2d(),
             forward: reprojection(&old_camera, &camera).to_cols_array_2d(),
-            size_mode: [
-                target.width as f32,
-                target.height as f32,
-                if same_pixel { 1.0 } else { 0.0 },
-                self.combination(),
-            ],
+            size: [target.width as f32, target.height as f32, 0.0, 0.0],
         };
         gpu.queue
             .write_buffer(&self.combine_uniform, 0, bytemuck::bytes_of(&raw));
@@ -1023,7 +1053,11 @@ impl Method for Fsi {
         if let Some(t) = timer {
             t.begin(encoder, f);
         }
-        self.combine(encoder, &self.combine_groups[newer], target);
+        self.combine(
+            encoder,
+            (&self.combine_pipeline, &self.combine_groups[newer]),
+            target,
+        );
         if let Some(t) = timer {
             t.end(encoder, f);
         }
