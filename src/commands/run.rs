@@ -15,7 +15,7 @@ use crate::results::csv::{
     write_pairs, write_rounds, write_summary, write_transitions, FramesWriter,
 };
 use crate::results::files::{stale_run_files, WRITE_PROBE};
-use crate::results::manifest::{now_rfc3339, RunManifest, RunStatus};
+use crate::results::manifest::{now_rfc3339, peak_resident_bytes, RunManifest, RunStatus};
 use crate::results::png::{DumpImages, FrameDumper, FrameId};
 use crate::scene::{Scene, SceneDef};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -114,6 +114,7 @@ pub fn run_with(cfg: &RunConfig, registry: &Registry) -> Result<RunSummary> {
 
     let result = run_blocks(cfg, registry, &defs, &out_dir, &mut manifest);
     manifest.end_time = Some(now_rfc3339());
+    manifest.peak_resident_bytes = peak_resident_bytes();
     match &result {
         Ok(_) => manifest.status = RunStatus::Complete,
         Err(Error::Interrupted) => {

@@ -47,6 +47,9 @@ pub struct RunManifest {
     pub blocks: Vec<BlockInfo>,
     /// Per scene block: the timing rounds' frames and method orders (`--rounds`, shuffled from `--seed`).
     pub timing_rounds: Vec<BlockRounds>,
+    /// The process's peak resident memory when the run ended, in bytes (`VmHWM` of /proc/self/status; null
+    /// where the system does not say). On a CPU adapter such as lavapipe it includes what a GPU would hold.
+    pub peak_resident_bytes: Option<u64>,
 }
 
 /// This build's `git describe --always --dirty` (None when not built from a checkout).
@@ -60,6 +63,22 @@ const SOURCE_DIFF_HASH: Option<&str> = match option_env!("LODBENCH_SOURCE_DIFF_H
     Some(h) if !h.is_empty() => Some(h),
     _ => None,
 };
+
+/// This process's peak resident memory so far, in bytes: `VmHWM` of /proc/self/status (None where there is
+/// no such file, as on systems other than Linux).
+pub fn peak_resident_bytes() -> Option<u64> {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| vm_hwm_bytes(&s))
+}
+
+/// The `VmHWM:` line of a /proc/PID/status text, in bytes (the kernel writes it in kB).
+fn vm_hwm_bytes(status: &str) -> Option<u64> {
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let mut words = line.split_whitespace().skip(1);
+    let kb: u64 = words.next()?.parse().ok()?;
+    (words.next() == Some("kB")).then_some(kb * 1024)
+}
 
 pub fn now_rfc3339() -> String {
     humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()
@@ -84,6 +103,7 @@ impl RunManifest {
             scenes: Vec::new(),
             blocks: Vec::new(),
             timing_rounds: Vec::new(),
+            peak_resident_bytes: None,
         }
     }
 
@@ -346,6 +366,15 @@ mod tests {
             first_difference(&c, &a).as_deref(),
             Some("resolved: null against [{\"frames\":12,\"scene\":\"s\"}]")
         );
+    }
+
+    #[test]
+    fn peak_resident_memory_is_read_from_vm_hwm() {
+        let status = "Name:\tlodbench\nVmPeak:\t  900 kB\nVmHWM:\t  123456 kB\nVmRSS:\t  100 kB\n";
+        assert_eq!(vm_hwm_bytes(status), Some(123456 * 1024));
+        assert_eq!(vm_hwm_bytes("VmRSS:\t100 kB\n"), None);
+        assert_eq!(vm_hwm_bytes("VmHWM:\t12 MB\n"), None);
+        assert_eq!(vm_hwm_bytes("VmHWM:\tmany kB\n"), None);
     }
 
     #[test]
