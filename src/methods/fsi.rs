@@ -382,8 +382,6 @@ struct CombineRaw {
 
 pub struct Fsi {
     variant: Variant,
-    /// `--fsi-check forward`, on `fsi` (the only variant that reprojects).
-    forward_check: bool,
     buffers: [LodBuffer; 2],
     lists: [DrawList; 2],
     instances: InstanceBuffer,
@@ -571,7 +569,6 @@ impl Fsi {
         });
         Fsi {
             variant,
-            forward_check,
             buffers,
             lists: [DrawList::default(), DrawList::default()],
             instances: gpu
@@ -843,10 +840,7 @@ impl Fsi {
         let n = scene.instances.len() as u32;
         // Both buffers at one pose: no reprojection, no forward check (fsi-sameframe's combination), fsi-blend's
         // blending.
-        let combination = match self.variant {
-            Variant::Blend => combination(self.variant, self.forward_check),
-            _ => 0,
-        };
+        let combination = combination(self.variant, false);
         let (device, layout, view, format) = (
             &gpu.device,
             &self.combine_layout,

@@ -11,7 +11,9 @@ use lodbench::methods::fsi::{reprojection, Fsi, FsiCheck, LodBufferImage, Varian
 use lodbench::methods::{Method, MethodOptions};
 use lodbench::scene::{Scene, SceneDef, SceneKind};
 
-use crate::common::{near_distance, scene_config as scene_cfg, srgb_to_linear, static_scene, H, W};
+use crate::common::{
+    lodbench, near_distance, scene_config as scene_cfg, srgb_to_linear, static_scene, H, W,
+};
 
 struct Frame {
     out: Vec<u8>,
@@ -610,18 +612,27 @@ fn h_frame_sequential_blending_mixes_by_k() {
 /// for any FRAMES); a process of its own, so that no other test's memory is in it.
 fn peak_resident_mib(methods: &str, frames: u32, dir: &std::path::Path) -> f64 {
     let out = dir.join(format!("frames-{frames}"));
-    let rounds = (frames / 10).to_string();
-    let frames = frames.to_string();
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_lodbench"))
-        .args(["run", "--scene", "bunny-sweep", "--method", methods])
-        .args(["--profile", "ci", "--frames", &frames, "--rounds", &rounds])
-        .arg("--out")
-        .arg(&out)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .status()
-        .unwrap();
-    assert!(status.success(), "lodbench run failed: {status}");
+    let (rounds, frames) = ((frames / 10).to_string(), frames.to_string());
+    let run = lodbench(
+        &[
+            "run",
+            "--scene",
+            "bunny-sweep",
+            "--method",
+            methods,
+            "--profile",
+            "ci",
+            "--frames",
+            &frames,
+            "--rounds",
+            &rounds,
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "lodbench run failed: {stderr}");
     let run: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
     run["peak_resident_bytes"]
