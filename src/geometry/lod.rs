@@ -191,24 +191,25 @@ impl LodChain {
     }
 }
 
-/// Keeps only the vertices `indices` reference (in first-use order), with LOD0's normals.
+/// Keeps only the vertices `indices` reference (in first-use order), with LOD0's normals, shading extras and
+/// every other per-vertex channel ([`crate::geometry::attributes::VertexData::gather`]).
 pub(crate) fn compact(name: &str, src: &Mesh, indices: &[u32]) -> Result<Mesh> {
     let mut remap = vec![u32::MAX; src.positions.len()];
-    let mut positions = Vec::new();
-    let mut normals = Vec::new();
-    let mut aux = Vec::new();
+    let mut order: Vec<u32> = Vec::new();
     let mut out = Vec::with_capacity(indices.len());
     for &i in indices {
         let slot = &mut remap[i as usize];
         if *slot == u32::MAX {
-            *slot = positions.len() as u32;
-            positions.push(src.positions[i as usize]);
-            normals.push(src.normals[i as usize]);
-            aux.push(src.aux[i as usize]);
+            *slot = order.len() as u32;
+            order.push(i);
         }
         out.push(*slot);
     }
-    Mesh::new(name, positions, Some(normals), out)?.with_aux(name, aux)
+    let pick = |v: &[[f32; 3]]| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
+    let aux = order.iter().map(|&i| src.aux[i as usize]).collect();
+    Mesh::new(name, pick(&src.positions), Some(pick(&src.normals)), out)?
+        .with_aux(name, aux)?
+        .with_data(name, src.data.gather(&order))
 }
 
 /// Distance at which an object-space error `error_abs` (at instance scale `scale`) projects to `pixel_error`

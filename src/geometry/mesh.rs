@@ -1,7 +1,8 @@
-//! Validated triangle meshes, and loading them from OBJ (tobj) and glTF 2.0 (.gltf / .glb, `gltf_read.rs`).
+//! Validated triangle meshes, and loading them from OBJ (tobj) and glTF 2.0 (.gltf / .glb, `gltf/`).
 
 use crate::error::{Error, Result};
-use crate::geometry::gltf_read;
+use crate::geometry::attributes::VertexData;
+use crate::geometry::gltf;
 use glam::Vec3;
 use std::path::Path;
 
@@ -21,6 +22,9 @@ pub struct Mesh {
     /// alpha-test mask over (u, v) or the blade rotation about the object-space axis parallel to +z through
     /// (0, hub_y, z); see shaders/mesh.wgsl.
     pub aux: Vec<[f32; 4]>,
+    /// Texture coordinates, tangents, colours, skin and morph targets, where the source has them
+    /// ([`Mesh::with_data`]); simplification keeps them ([`VertexData::gather`]).
+    pub data: VertexData,
 }
 
 /// `aux` kinds (the shader reads them as floats).
@@ -100,6 +104,7 @@ impl Mesh {
             normals,
             indices,
             aux,
+            data: VertexData::default(),
         })
     }
 
@@ -120,6 +125,17 @@ impl Mesh {
             return Err(bad("has a non-finite aux value".into()));
         }
         self.aux = aux;
+        Ok(self)
+    }
+
+    /// Sets the optional per-vertex channels (each one entry per vertex, finite).
+    pub fn with_data(mut self, name: &str, data: VertexData) -> Result<Mesh> {
+        data.check(self.positions.len())
+            .map_err(|problem| Error::Mesh {
+                path: name.to_string(),
+                problem,
+            })?;
+        self.data = data;
         Ok(self)
     }
 
@@ -209,7 +225,7 @@ impl Mesh {
     }
 
     /// Loads a glTF 2.0 file, JSON (`.gltf`) or binary (`.glb`; the content decides, not the extension), read by
-    /// [`gltf_read`].
+    /// [`gltf`].
     ///
     /// The geometry taken is every triangle primitive of every mesh placement in the default scene (scene 0
     /// when the file names no default; every mesh, untransformed, when the file has no scenes), merged into
@@ -226,11 +242,13 @@ impl Mesh {
     ///   KHR_meshopt_compression) are decoded.
     /// - Normals: the file's when every merged primitive has NORMALs (and no transform is singular), otherwise
     ///   all are computed as [`Mesh::new`] does, as for OBJ files.
+    /// - Accessors: sparse ones are read (their values substituted into the base data or zeros).
+    /// - Skins and morph targets: a skinned mesh is placed by its joints at rest (its node's own transform
+    ///   ignored, as glTF specifies), morph targets at the node's weights, else the mesh's, else 0.
     /// - Refused with the reason: a file holding an authored LOD chain (MSFT_lod, or `NAME_LODn` siblings:
     ///   merging its levels would draw them over each other), Draco compression (with the command that rewrites
-    ///   the file with meshopt compression), any other required extension that changes geometry, sparse
-    ///   accessors. Not read: morph targets and skins (the base, unskinned geometry is used), materials, UVs and
-    ///   images (never decoded).
+    ///   the file with meshopt compression), any other required extension that changes geometry. Not read:
+    ///   animations (the scene at rest), materials, UVs and images (never decoded).
     /// - Buffers: the GLB binary chunk, base64 `data:` URIs, or files named by relative (percent-encoded)
     ///   URIs, read from the .gltf file's folder; only buffers the merged primitives use are read.
     pub fn load_gltf(path: &Path) -> Result<Mesh> {
@@ -317,11 +335,11 @@ pub(crate) fn read_mesh_file(path: &Path, name: &str) -> Result<Vec<u8>> {
 /// Reads the glTF (JSON or GLB) in `bytes` as one mesh (see [`Mesh::load_gltf`]); external buffers are looked up
 /// in `dir`. Errors are the problem text of an [`Error::Mesh`].
 fn parse_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
-    let mut content = gltf_read::read(bytes, dir)?;
+    let mut content = gltf::read(bytes, dir)?;
     if let Some(c) = content.chains.first() {
         let source = match c.source {
-            gltf_read::ChainSource::MsftLod => "MSFT_lod",
-            gltf_read::ChainSource::LodNames => "nodes named _LOD0, _LOD1, ...",
+            gltf::ChainSource::MsftLod => "MSFT_lod",
+            gltf::ChainSource::LodNames => "nodes named _LOD0, _LOD1, ...",
         };
         return Err(format!(
             "holds an authored LOD chain ('{}': {} levels, {source}); --mesh takes one mesh and builds its own LOD \
@@ -330,54 +348,46 @@ fn parse_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
             c.nodes.len()
         ));
     }
-    let mut meshes: std::collections::HashMap<usize, Vec<gltf_read::Triangles>> =
+    let mut meshes: std::collections::HashMap<usize, gltf::MeshPrimitives> =
         std::collections::HashMap::new();
-    let mut merged = gltf_read::Merged::default();
+    let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+    let mut all_normals = true;
     let placements = std::mem::take(&mut content.placements);
     for p in &placements {
         if let std::collections::hash_map::Entry::Vacant(e) = meshes.entry(p.mesh) {
-            e.insert(content.mesh_triangles(p.mesh)?);
+            e.insert(content.mesh_primitives(p.mesh)?);
         }
-        merged.add(&meshes[&p.mesh], p.world)?;
+        let part = content.placed(p, &meshes[&p.mesh], glam::Mat4::IDENTITY)?;
+        let base = u32::try_from(positions.len())
+            .ok()
+            .filter(|b| b.checked_add(part.positions.len() as u32).is_some())
+            .ok_or("has more vertices than 32-bit indices can address")?;
+        indices.extend(part.indices.iter().map(|&i| base + i));
+        match part.normals {
+            Some(n) if all_normals => normals.extend(n),
+            _ => all_normals = false,
+        }
+        positions.extend(part.positions);
     }
-    if merged.indices.is_empty() {
+    if indices.is_empty() {
         return Err(match content.scene {
             Some(s) => format!("has no triangle primitives in scene {s}"),
             None => "has no triangle primitives".to_string(),
         });
     }
-    // lodbench's own shading extras are not read here: --mesh takes the shape alone.
-    let normals = merged.normals();
-    Mesh::new("", merged.positions, normals, merged.indices).map_err(|e| match e {
+    // lodbench's own shading extras and the other channels are not read here: --mesh takes the shape alone.
+    Mesh::new("", positions, all_normals.then_some(normals), indices).map_err(|e| match e {
         Error::Mesh { problem, .. } => problem,
         other => other.to_string(),
     })
 }
 
-/// Area-weighted vertex normals; a vertex with no non-degenerate face gets +Y.
-pub fn vertex_normals(positions: &[[f32; 3]], indices: &[u32]) -> Vec<[f32; 3]> {
-    let mut acc = vec![Vec3::ZERO; positions.len()];
-    for t in indices.chunks_exact(3) {
-        let (a, b, c) = (t[0] as usize, t[1] as usize, t[2] as usize);
-        let (pa, pb, pc) = (
-            Vec3::from(positions[a]),
-            Vec3::from(positions[b]),
-            Vec3::from(positions[c]),
-        );
-        let n = (pb - pa).cross(pc - pa); // length = 2 * area
-        acc[a] += n;
-        acc[b] += n;
-        acc[c] += n;
-    }
-    acc.into_iter()
-        .map(|n| n.try_normalize().unwrap_or(Vec3::Y).to_array())
-        .collect()
-}
+pub use crate::geometry::attributes::vertex_normals;
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::gltf_read::{decode_base64, percent_decode};
+    use crate::geometry::gltf::{decode_base64, percent_decode};
 
     fn tri() -> (Vec<[f32; 3]>, Vec<u32>) {
         (
@@ -791,7 +801,7 @@ mod tests {
                     j["nodes"][1]["children"] = serde_json::json!([0]);
                     j
                 },
-                "node 0 is reached twice from scene 0",
+                "node 0 is its own ancestor",
             ),
             (
                 {
@@ -806,12 +816,12 @@ mod tests {
                     let mut j = fixture_json();
                     j["accessors"][0]["sparse"] = serde_json::json!({
                         "count": 1,
-                        "indices": {"bufferView": 2, "componentType": 5123},
+                        "indices": {"bufferView": 1, "componentType": 5123},
                         "values": {"bufferView": 0}
                     });
                     j
                 },
-                "accessor 0 is sparse",
+                "accessor 0's sparse substitutes element",
             ),
         ];
         for (json, want) in cases {

@@ -1,10 +1,12 @@
 //! Meshes and what is computed from them on the CPU: loading (OBJ, glTF), LOD chains, morph targets, the
 //! procedural models and terrain, Blow's blocks with seams, and meshoptimizer's cluster DAG.
 
+pub mod attributes;
 pub mod block_tree;
 pub mod blocks;
 pub mod cluster_dag;
-pub mod gltf_read;
+pub mod deform;
+pub mod gltf;
 pub mod lod;
 pub mod mesh;
 pub mod morph;

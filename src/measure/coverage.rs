@@ -317,6 +317,7 @@ mod tests {
             normals: vec![[0.0, 0.0, 1.0]; 3],
             indices: vec![0, 1, 2],
             aux: vec![[0.0, 0.0, AUX_BLADE, 1.0]; 3],
+            data: Default::default(),
         };
         let chain = LodChain {
             lods: vec![Lod {

@@ -285,6 +285,7 @@ fn ground_model(bunny: &Model, far: f32) -> (Model, Vec3) {
         aux: vec![[0.0; 4]; 4],
         indices: vec![0, 2, 1, 0, 3, 2],
         positions,
+        data: Default::default(),
     };
     let model = Model {
         name: "ground".into(),

@@ -17,7 +17,7 @@
 //! camera moves.
 
 use crate::error::{Error, Result};
-use crate::geometry::gltf_read::{self, ChainSource};
+use crate::geometry::gltf::{self, ChainSource};
 use crate::geometry::lod::{self, LodChain};
 use crate::geometry::mesh::{read_mesh_file, Mesh};
 use crate::scene::bunny::{fit_distance, USER_SWITCH_FIT_MULTIPLES};
@@ -109,7 +109,7 @@ pub fn def(
     };
     let bytes = read_mesh_file(path, name)?;
     let dir = path.parent().unwrap_or(Path::new(""));
-    let mut content = gltf_read::read(&bytes, dir).map_err(bad)?;
+    let mut content = gltf::read(&bytes, dir).map_err(bad)?;
     // The file's camera animation, unless --camera-path replaces it; its field of view replaces --fov before
     // the switch distances are computed.
     let animated = match cfg.camera_path {
@@ -158,12 +158,11 @@ pub fn def(
 
     // Authored chains: one model each, placed by its LOD0 node.
     for chain in &chains {
-        let level_placements: Vec<&gltf_read::Placement> = chain
+        let level_placements: Vec<&gltf::Placement> = chain
             .nodes
             .iter()
             .map(|&n| {
-                let p: Vec<&gltf_read::Placement> =
-                    placements.iter().filter(|p| p.node == n).collect();
+                let p: Vec<&gltf::Placement> = placements.iter().filter(|p| p.node == n).collect();
                 match p.as_slice() {
                     [one] if one.instance.is_none() => Ok(*one),
                     _ => Err(bad(format!(
@@ -193,7 +192,13 @@ pub fn def(
         let to_model = Mat4::from_rotation_translation(rotation, translation).inverse();
         let mut meshes = Vec::new();
         for p in &level_placements {
-            meshes.push(placed_mesh(&mut content, name, p.mesh, to_model * p.world)?);
+            meshes.push(placed_mesh(
+                &mut content,
+                name,
+                p,
+                to_model * p.world,
+                to_model,
+            )?);
         }
         let model_name = if chain.name.is_empty() {
             format!("chain{}", built.len())
@@ -268,7 +273,7 @@ pub fn def(
             // Exact as written (the round trip through the pixel error may move the last bit), unless
             // --switch-distances or --switch-screen-sizes replaced them.
             cfg.schedule.check_switches(&model_name, d)?;
-            model.switches = d.clone();
+            model.switches = d.to_vec();
         }
         model.spin_per_frame = chain.spin_per_frame;
         chain_descriptions.push(ChainDescription {
@@ -307,7 +312,8 @@ pub fn def(
         {
             Some(i) => i,
             None => {
-                let mesh = placed_mesh(&mut content, name, p.mesh, Mat4::from_scale(scale))?;
+                let to_frame = Mat4::from_scale(scale) * p.world.inverse();
+                let mesh = placed_mesh(&mut content, name, p, Mat4::from_scale(scale), to_frame)?;
                 let (center, radius) = mesh.bounding_sphere();
                 let fit = fit_distance(radius, pv.width, pv.height, fov_y);
                 let errors: Vec<f32> = USER_SWITCH_FIT_MULTIPLES
@@ -450,7 +456,7 @@ pub fn layout(parts: &UserParts) -> Layout {
 
 /// A placement's world transform as scale, rotation, translation; refused when it shears (no such
 /// decomposition reproduces it).
-fn decompose(name: &str, p: &gltf_read::Placement) -> Result<(Vec3, Quat, Vec3)> {
+fn decompose(name: &str, p: &gltf::Placement) -> Result<(Vec3, Quat, Vec3)> {
     let (s, r, t) = p.world.to_scale_rotation_translation();
     let again = Mat4::from_scale_rotation_translation(s, r, t);
     let tol = 1e-4
@@ -472,28 +478,31 @@ fn decompose(name: &str, p: &gltf_read::Placement) -> Result<(Vec3, Quat, Vec3)>
     Ok((s, r, t))
 }
 
-/// Mesh `mesh`'s triangle primitives merged under `transform` ([`gltf_read::Merged`]).
+/// Placement `p`'s mesh at rest ([`gltf::Content::placed_as`]): unskinned under `mesh_to_frame`, skinned by its
+/// joints into the frame `to_frame` maps world space to.
 fn placed_mesh(
-    content: &mut gltf_read::Content<'_>,
+    content: &mut gltf::Content<'_>,
     name: &str,
-    mesh: usize,
-    transform: Mat4,
+    p: &gltf::Placement,
+    mesh_to_frame: Mat4,
+    to_frame: Mat4,
 ) -> Result<Mesh> {
     let bad = |problem: String| Error::Mesh {
         path: name.to_string(),
         problem,
     };
-    let prims = content.mesh_triangles(mesh).map_err(bad)?;
-    let mut merged = gltf_read::Merged::default();
-    merged.add(&prims, transform).map_err(bad)?;
-    if merged.indices.is_empty() {
-        return Err(bad(format!("mesh {mesh} has no triangle primitives")));
+    let prims = content.mesh_primitives(p.mesh).map_err(bad)?;
+    let parts = content
+        .placed_as(p, &prims, mesh_to_frame, to_frame)
+        .map_err(bad)?;
+    if parts.indices.is_empty() {
+        return Err(bad(format!("mesh {} has no triangle primitives", p.mesh)));
     }
-    let (normals, aux) = (merged.normals(), merged.aux());
-    let mut m = Mesh::new(name, merged.positions, normals, merged.indices)?;
-    if let Some(aux) = aux {
+    let mut m = Mesh::new(name, parts.positions, parts.normals, parts.indices)?;
+    if let Some(aux) = parts.aux {
         m = m.with_aux(name, aux)?;
     }
+    m = m.with_data(name, parts.data)?;
     m.check_area(name)?;
     Ok(m)
 }
