@@ -3,10 +3,12 @@
 // instance's animation angle in radians) and the transition parameters (x = k, y = alpha, z = LOD,
 // w = instance id) that the methods read.
 //
-// Per-vertex `aux` = (u, v, kind, hub_y) (src/mesh.rs): kind 1 and 2 are alpha-tested leaf cards (masks over
-// (u, v) below), kind 3 a windmill blade vertex, rotated about the axis parallel to +z through (0, hub_y) by the
-// instance's animation angle. Animation happens after the object-space position is taken (`object`), which is
-// what FSI's visibility texture reads (Scherzer & Wimmer 2008 section 3.3, Fig. 5).
+// Per-vertex `aux` = (u, v, kind, hub_y) (src/geometry/mesh.rs): kind 1 and 2 are alpha-tested leaf cards (masks
+// over (u, v) below), kind 3 a windmill blade vertex, rotated about the axis parallel to +z through (0, hub_y) by
+// the instance's animation angle. Animation happens after the object-space position is taken (`object`), which is
+// what FSI's visibility texture reads (Scherzer & Wimmer 2008 section 3.3, Fig. 5). Kind 4 is a vertex of a mesh
+// deformed on the CPU each frame (a skin, morph weights): its position is the frame's, and aux = (x, y, 4, z) its
+// rest position, which is its `object` position.
 
 // Set per scene when its models have alpha-tested geometry (every fragment entry then applies the mask), so
 // scenes without it keep shaders with no discard.
@@ -63,6 +65,7 @@ struct VsOut {
 const KIND_LEAF: f32 = 1.0;
 const KIND_LEAF_CLUSTER: f32 = 2.0;
 const KIND_BLADE: f32 = 3.0;
+const KIND_DEFORMED: f32 = 4.0;
 
 fn transform(position: vec3<f32>, normal: vec3<f32>, aux: vec4<f32>, inst: InstanceIn) -> VsOut {
     var p = position;
@@ -85,7 +88,7 @@ fn transform(position: vec3<f32>, normal: vec3<f32>, aux: vec4<f32>, inst: Insta
     out.params = inst.params;
     out.uv = aux.xy;
     out.kind = aux.z;
-    out.object = position;
+    out.object = select(position, aux.xyw, aux.z == KIND_DEFORMED);
     out.world = world.xyz;
     return out;
 }

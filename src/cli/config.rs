@@ -112,6 +112,12 @@ impl SceneConfig {
                 Some(a.count.clone())
             },
             fov_deg,
+            animation: a
+                .animation
+                .as_deref()
+                .map(crate::scene::config::AnimationChoice::parse)
+                .unwrap_or_default(),
+            simplify: a.simplify,
             shader_work: a.shader_work,
             schedule,
             camera: a.camera,
@@ -200,6 +206,14 @@ impl RunConfig {
             return Err(Error::Config("--rounds must be at least 1".into()));
         }
         let methods_given = !a.method.is_empty();
+        if let Some(anim) = &a.scene_args.animation {
+            if !scenes.iter().any(|k| k.is_user()) {
+                return Err(Error::Config(format!(
+                    "--animation {anim}: only glTF scenes (--scene FILE.glb) have animations, and none is among \
+                     the scenes"
+                )));
+            }
+        }
         if a.scene_args.shadow.shadows == OnOff::On {
             if let Some(scene) = scenes.iter().find(|k| k.is_unified()) {
                 return Err(Error::Config(format!(

@@ -229,6 +229,15 @@ pub struct SceneArgs {
     #[arg(long, value_delimiter = ',')]
     #[serde(deserialize_with = "one_or_many")]
     pub count: Vec<u32>,
+    /// How a user's mesh (`--scene FILE.glb`, `--mesh`) is simplified into its LOD chain: `attributes`
+    /// (meshoptimizer's attribute-aware simplifier, normals and texture coordinates weighted, hard edges
+    /// collapsible, texture seams protected) or `positions` (positions alone: split vertices keep their seams).
+    #[arg(long, value_enum, default_value_t = crate::geometry::lod::Simplify::Attributes)]
+    pub simplify: crate::geometry::lod::Simplify,
+    /// glTF scenes (`--scene FILE.glb`): the animation that plays over the frames, by index or name, or `none`
+    /// (the scene at rest). Default: the file's first animation, 60 frames a second of clip time, looped.
+    #[arg(long)]
+    pub animation: Option<String>,
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = 60.0)]
     pub fov: f32,

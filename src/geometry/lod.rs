@@ -4,6 +4,73 @@ use crate::error::{Error, Result};
 use crate::geometry::mesh::Mesh;
 use serde::Serialize;
 
+/// `--simplify`: how a chain of a user's mesh is made by error ([`LodChain::build_by_error`]).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, serde::Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Simplify {
+    /// meshoptimizer's attribute-aware simplifier over the mesh's vertices, welded by position: normals (and
+    /// texture coordinates and colours, where the mesh has them) weighted in the error, collapses allowed across
+    /// hard edges (`Permissive`), texture seams protected (the way meshoptimizer's own tools and Godot simplify).
+    #[default]
+    Attributes,
+    /// Positions alone: every vertex split by a normal or texture seam keeps its seam, so a mesh of split
+    /// vertices barely simplifies (the chain before attributes were weighed).
+    Positions,
+}
+
+/// Weight of normals, texture coordinates and colours in the simplifier's error, against positions (which
+/// meshoptimizer scales to the mesh's extent): meshoptimizer's suggested order of magnitude.
+pub const ATTRIBUTE_WEIGHT: f32 = 0.5;
+
+/// What the attribute-aware simplifier is given: per vertex its attributes (normal, texture coordinates,
+/// colour), their weights, and a Protect flag on texture seams (a position whose vertices differ in texture
+/// coordinates).
+struct AttributeSeams {
+    values: Vec<f32>,
+    weights: Vec<f32>,
+    locks: Vec<meshopt::SimplifyVertex>,
+}
+
+impl AttributeSeams {
+    fn of(mesh: &Mesh, adapter: &meshopt::VertexDataAdapter<'_>) -> AttributeSeams {
+        let uv = mesh.data.uv0.as_deref();
+        let colors = mesh.data.colors.as_deref();
+        let width = 3 + uv.map_or(0, |_| 2) + colors.map_or(0, |_| 3);
+        let mut values = Vec::with_capacity(mesh.vertex_count() * width);
+        for v in 0..mesh.vertex_count() {
+            values.extend_from_slice(&mesh.normals[v]);
+            if let Some(uv) = uv {
+                values.extend_from_slice(&uv[v]);
+            }
+            if let Some(c) = colors {
+                values.extend_from_slice(&c[v][..3]);
+            }
+        }
+        let mut locks = vec![meshopt::SimplifyVertex::empty(); mesh.vertex_count()];
+        if let Some(uv) = uv {
+            let remap = meshopt::generate_position_remap(adapter);
+            let mut seam = vec![false; mesh.vertex_count()];
+            for (v, &r) in remap.iter().enumerate() {
+                if uv[v] != uv[r as usize] {
+                    seam[r as usize] = true;
+                }
+            }
+            for (v, &r) in remap.iter().enumerate() {
+                if seam[r as usize] {
+                    locks[v] = meshopt::SimplifyVertex::Protect;
+                }
+            }
+        }
+        AttributeSeams {
+            values,
+            weights: vec![ATTRIBUTE_WEIGHT; width],
+            locks,
+        }
+    }
+}
+
 /// Default triangle targets, as fractions of LOD0 (100 / 50 / 25 / 10 %).
 pub const DEFAULT_TARGETS: [f32; 4] = [1.0, 0.5, 0.25, 0.1];
 
@@ -98,10 +165,17 @@ impl LodChain {
     }
 
     /// Simplifies `mesh` until each error in `errors_abs` (object-space units, increasing): LOD i + 1 is the
-    /// coarsest simplification of LOD0 whose error stays within `errors_abs[i]` (meshoptimizer's `simplify`
-    /// with no triangle target and that error bound). A level that keeps more than 95 % of the previous one's
-    /// triangles ends the chain (the mesh cannot lose detail at that error), so the chain may be shorter.
-    pub fn build_by_error(name: &str, mesh: &Mesh, errors_abs: &[f32]) -> Result<LodChain> {
+    /// coarsest simplification of LOD0 whose error stays within the i-th bound (meshoptimizer's simplifier with no
+    /// triangle target and that error bound, `how` it is told to). A bound at which the mesh keeps more than 95 %
+    /// of the previous level's triangles gives no level (the mesh cannot lose detail at that error), and the
+    /// larger bounds are still tried, so the chain may be shorter than the bounds. A chain of LOD0 alone comes
+    /// with a note saying why.
+    pub fn build_by_error(
+        name: &str,
+        mesh: &Mesh,
+        errors_abs: &[f32],
+        how: Simplify,
+    ) -> Result<(LodChain, Option<String>)> {
         let increasing = errors_abs.iter().all(|e| e.is_finite() && *e > 0.0)
             && errors_abs.windows(2).all(|w| w[1] > w[0]);
         if !increasing {
@@ -114,6 +188,10 @@ impl LodChain {
             path: name.to_string(),
             problem: format!("meshopt rejected the vertices: {e}"),
         })?;
+        let seams = match how {
+            Simplify::Attributes => Some(AttributeSeams::of(mesh, &adapter)),
+            Simplify::Positions => None,
+        };
         let t0 = mesh.triangle_count();
         let mut lods = vec![Lod {
             mesh: mesh.clone(),
@@ -122,17 +200,31 @@ impl LodChain {
         }];
         for &bound in errors_abs {
             let mut error = 0.0f32;
-            let indices = meshopt::simplify(
-                &mesh.indices,
-                &adapter,
-                3,
-                bound,
-                meshopt::SimplifyOptions::ErrorAbsolute,
-                Some(&mut error),
-            );
+            let indices = match &seams {
+                None => meshopt::simplify(
+                    &mesh.indices,
+                    &adapter,
+                    3,
+                    bound,
+                    meshopt::SimplifyOptions::ErrorAbsolute,
+                    Some(&mut error),
+                ),
+                Some(s) => meshopt::simplify_with_attributes_and_locks(
+                    &mesh.indices,
+                    &adapter,
+                    &s.values,
+                    &s.weights,
+                    s.weights.len() * 4,
+                    &s.locks,
+                    3,
+                    bound,
+                    meshopt::SimplifyOptions::ErrorAbsolute | meshopt::SimplifyOptions::Permissive,
+                    Some(&mut error),
+                ),
+            };
             let previous = lods.last().map_or(t0, |l| l.mesh.triangle_count());
             if indices.is_empty() || indices.len() / 3 * 100 > previous * 95 {
-                break;
+                continue;
             }
             lods.push(Lod {
                 mesh: compact(name, mesh, &indices)?,
@@ -140,7 +232,18 @@ impl LodChain {
                 error_abs: error,
             });
         }
-        Ok(LodChain { lods })
+        let note = (lods.len() == 1).then(|| {
+            format!(
+                "{name}: no simplification within {:.3e} (the largest error its switches allow) removes 5 % of its \
+                 {t0} triangles ({}); it has LOD0 alone and cannot pop",
+                errors_abs.last().copied().unwrap_or(0.0),
+                match how {
+                    Simplify::Attributes => "texture seams protected, normals and texture coordinates weighted",
+                    Simplify::Positions => "--simplify positions: every split vertex is a seam it keeps",
+                }
+            )
+        });
+        Ok((LodChain { lods }, note))
     }
 
     /// A hand-made ("artist-style") chain: LOD0 first, each next mesh coarser. `error_abs[i]` is LOD i's
@@ -269,11 +372,14 @@ mod tests {
     }
 
     /// Each LOD is the coarsest within its error bound: error at most the bound, fewer triangles at each
-    /// larger bound; a bound the mesh cannot simplify within (under 5 % fewer triangles) ends the chain.
+    /// larger bound; a bound the mesh cannot simplify within (under 5 % fewer triangles) gives no level, and the
+    /// larger bounds are still tried.
     #[test]
     fn chain_by_error_stays_within_each_bound() {
         let bounds = [0.03, 0.07, 0.15];
-        let chain = LodChain::build_by_error("bunny", &bunny(), &bounds).unwrap();
+        let (chain, note) =
+            LodChain::build_by_error("bunny", &bunny(), &bounds, Simplify::Positions).unwrap();
+        assert!(note.is_none());
         assert_eq!(chain.lods.len(), 4);
         for (lod, bound) in chain.lods[1..].iter().zip(bounds) {
             assert!(
@@ -285,10 +391,19 @@ mod tests {
         for w in chain.lods.windows(2) {
             assert!(w[1].mesh.triangle_count() < w[0].mesh.triangle_count());
         }
-        let stuck = LodChain::build_by_error("bunny", &bunny(), &[1e-7, 0.15]).unwrap();
+        let (skipped, _) =
+            LodChain::build_by_error("bunny", &bunny(), &[1e-7, 0.15], Simplify::Positions)
+                .unwrap();
+        assert_eq!(skipped.lods.len(), 2, "{:?}", skipped.info());
+        assert_eq!(skipped.lods[1].mesh, chain.lods[3].mesh);
+        let (stuck, note) =
+            LodChain::build_by_error("bunny", &bunny(), &[1e-7], Simplify::Positions).unwrap();
         assert_eq!(stuck.lods.len(), 1, "{:?}", stuck.info());
-        assert!(LodChain::build_by_error("bunny", &bunny(), &[0.1, 0.05]).is_err());
-        assert!(LodChain::build_by_error("bunny", &bunny(), &[f32::NAN]).is_err());
+        assert!(note.is_some_and(|n| n.contains("LOD0 alone")));
+        for how in [Simplify::Positions, Simplify::Attributes] {
+            assert!(LodChain::build_by_error("bunny", &bunny(), &[0.1, 0.05], how).is_err());
+            assert!(LodChain::build_by_error("bunny", &bunny(), &[f32::NAN], how).is_err());
+        }
     }
 
     #[test]

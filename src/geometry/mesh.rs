@@ -18,7 +18,8 @@ pub struct Mesh {
     pub normals: Vec<[f32; 3]>,
     pub indices: Vec<u32>,
     /// Per-vertex shading extras, one per vertex (zeros unless set with [`Mesh::with_aux`]):
-    /// `[u, v, kind, hub_y]`. kind ([`AUX_SOLID`], [`AUX_LEAF`], [`AUX_LEAF_CLUSTER`], [`AUX_BLADE`]) selects the
+    /// `[u, v, kind, hub_y]`. kind ([`AUX_SOLID`], [`AUX_LEAF`], [`AUX_LEAF_CLUSTER`], [`AUX_BLADE`],
+    /// [`AUX_DEFORMED`]) selects the
     /// alpha-test mask over (u, v) or the blade rotation about the object-space axis parallel to +z through
     /// (0, hub_y, z); see shaders/mesh.wgsl.
     pub aux: Vec<[f32; 4]>,
@@ -36,6 +37,10 @@ pub const AUX_LEAF_CLUSTER: f32 = 2.0;
 /// A windmill blade vertex: rotated about the hub by the instance's animation angle after the object-space
 /// position FSI's visibility texture reads (Scherzer & Wimmer 2008 section 3.3).
 pub const AUX_BLADE: f32 = 3.0;
+/// A vertex of a mesh deformed per frame (a skin, animated morph weights): its position is the frame's, and
+/// `aux` holds its rest position as `(x, y, kind, z)`, the object-space position before animation that FSI's
+/// visibility texture reads (set by the GPU layer, `gpu/scene_gpu.rs`).
+pub const AUX_DEFORMED: f32 = 4.0;
 
 impl Mesh {
     /// Builds and validates a mesh. `name` is used in error messages (a file path or a generator's name).

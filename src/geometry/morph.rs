@@ -38,6 +38,36 @@ pub enum Correspondence {
 pub struct MorphTargets {
     pub positions: Vec<[f32; 3]>,
     pub normals: Vec<[f32; 3]>,
+    /// Per fine vertex, the coarse vertices its target is made of and their weights (a nearest vertex: itself
+    /// with weight 1; a surface point: its triangle's corners with barycentric weights), so that a target
+    /// follows the coarse mesh when it deforms ([`MorphTargets::follow`]).
+    pub sources: Vec<[(u32, f32); 3]>,
+}
+
+impl MorphTargets {
+    /// The targets on the coarse mesh posed at `positions` and `normals` (normals interpolated and
+    /// normalised, the undeformed target's normal where they cancel), into `out_positions`, `out_normals`.
+    pub fn follow(
+        &self,
+        positions: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        out_positions: &mut Vec<[f32; 3]>,
+        out_normals: &mut Vec<[f32; 3]>,
+    ) {
+        out_positions.clear();
+        out_normals.clear();
+        for (k, src) in self.sources.iter().enumerate() {
+            let (mut p, mut n) = (Vec3::ZERO, Vec3::ZERO);
+            for &(i, w) in src {
+                if w != 0.0 {
+                    p += v(&positions[i as usize]) * w;
+                    n += v(&normals[i as usize]) * w;
+                }
+            }
+            out_positions.push(p.to_array());
+            out_normals.push(n.try_normalize().map_or(self.normals[k], |n| n.to_array()));
+        }
+    }
 }
 
 type MorphCache = Mutex<HashMap<(u64, u64, Correspondence), Arc<MorphTargets>>>;
@@ -97,6 +127,7 @@ pub fn nearest_vertex_weighted(fine: &Mesh, coarse: &Mesh, lambda: f32) -> Morph
     kd_build(&pts, &mut idx, 0);
     let mut positions = Vec::with_capacity(fine.positions.len());
     let mut normals = Vec::with_capacity(fine.positions.len());
+    let mut sources = Vec::with_capacity(fine.positions.len());
     for (p, n) in fine.positions.iter().zip(&fine.normals) {
         let (p, n) = (v(p), v(n));
         let metric = |j: u32| {
@@ -108,8 +139,13 @@ pub fn nearest_vertex_weighted(fine: &Mesh, coarse: &Mesh, lambda: f32) -> Morph
         let j = best.1 as usize;
         positions.push(coarse.positions[j]);
         normals.push(coarse.normals[j]);
+        sources.push([(j as u32, 1.0), (j as u32, 0.0), (j as u32, 0.0)]);
     }
-    MorphTargets { positions, normals }
+    MorphTargets {
+        positions,
+        normals,
+        sources,
+    }
 }
 
 fn kd_build(pts: &[Vec3], idx: &mut [u32], depth: usize) {
@@ -165,6 +201,7 @@ pub fn closest_surface(fine: &Mesh, coarse: &Mesh) -> MorphTargets {
     let bvh = Bvh::new(coarse);
     let mut positions = Vec::with_capacity(fine.positions.len());
     let mut normals = Vec::with_capacity(fine.positions.len());
+    let mut sources = Vec::with_capacity(fine.positions.len());
     for p in &fine.positions {
         let (tri, point, bary) = bvh.closest(coarse, v(p));
         let t = &coarse.indices[tri * 3..tri * 3 + 3];
@@ -179,8 +216,13 @@ pub fn closest_surface(fine: &Mesh, coarse: &Mesh) -> MorphTargets {
             .unwrap_or(Vec3::Y);
         positions.push(point.to_array());
         normals.push(n.to_array());
+        sources.push([0, 1, 2].map(|k| (t[k], bary[k])));
     }
-    MorphTargets { positions, normals }
+    MorphTargets {
+        positions,
+        normals,
+        sources,
+    }
 }
 
 struct BvhNode {

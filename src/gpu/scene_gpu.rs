@@ -7,7 +7,8 @@ use crate::gpu::draw_list::{DrawList, DrawStats, PipelineIndex};
 use crate::gpu::instances::{InstanceBuffer, UploadCounters};
 use crate::gpu::pipelines::{mesh_pipeline, MeshPipeline, Vertex, MESH_WGSL};
 use crate::gpu::targets::{texture_2d, RenderTarget, ATTACHMENT_READ};
-use crate::scene::{Camera, Scene, BACKGROUND};
+use crate::scene::animated::Posed;
+use crate::scene::{Camera, Motion, Scene, BACKGROUND};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -103,6 +104,33 @@ pub struct SceneGpu {
     /// none elsewhere.
     pub cull: Option<wgpu::Face>,
     pub uploads: UploadCounters,
+    /// The deformed models' LODs as the last [`SceneGpu::write_pose`] posed them (empty when nothing deforms).
+    posed: std::cell::RefCell<Posed>,
+    /// Scratch for their vertices, reused every frame.
+    pose_vertices: std::cell::RefCell<Vec<Vertex>>,
+}
+
+/// The models a scene deforms per frame.
+fn deformed_models(scene: &Scene) -> Vec<u32> {
+    match &scene.motion {
+        Motion::Animated(a) => a.deformers.iter().map(|d| d.model).collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// A deformed vertex: its position and normal on the frame, its rest position in `aux` (kind
+/// [`crate::geometry::mesh::AUX_DEFORMED`]) for FSI's visibility texture.
+fn deformed_vertex(position: [f32; 3], normal: [f32; 3], rest: [f32; 3]) -> Vertex {
+    Vertex {
+        position,
+        normal,
+        aux: [
+            rest[0],
+            rest[1],
+            crate::geometry::mesh::AUX_DEFORMED,
+            rest[2],
+        ],
+    }
 }
 
 impl SceneGpu {
@@ -148,7 +176,8 @@ impl SceneGpu {
         let mut vertices: Vec<Vertex> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
         let mut lods = Vec::new();
-        for model in scene.models.iter() {
+        let deformed = deformed_models(scene);
+        for (mi, model) in scene.models.iter().enumerate() {
             let mut ranges = Vec::new();
             for lod in &model.chain.lods {
                 let m = &lod.mesh;
@@ -158,13 +187,22 @@ impl SceneGpu {
                     first_index: indices.len() as u32,
                     index_count: m.indices.len() as u32,
                 });
-                vertices.extend(m.positions.iter().zip(&m.normals).zip(&m.aux).map(
-                    |((p, n), a)| Vertex {
-                        position: *p,
-                        normal: *n,
-                        aux: *a,
-                    },
-                ));
+                if deformed.contains(&(mi as u32)) {
+                    vertices.extend(
+                        m.positions
+                            .iter()
+                            .zip(&m.normals)
+                            .map(|(p, n)| deformed_vertex(*p, *n, *p)),
+                    );
+                } else {
+                    vertices.extend(m.positions.iter().zip(&m.normals).zip(&m.aux).map(
+                        |((p, n), a)| Vertex {
+                            position: *p,
+                            normal: *n,
+                            aux: *a,
+                        },
+                    ));
+                }
                 indices.extend_from_slice(&m.indices);
             }
             lods.push(ranges);
@@ -191,7 +229,11 @@ impl SceneGpu {
         let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene vertices"),
             contents: bytemuck::cast_slice(&vertices),
-            usage: wgpu::BufferUsages::VERTEX,
+            usage: if deformed.is_empty() {
+                wgpu::BufferUsages::VERTEX
+            } else {
+                wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST
+            },
         });
         let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene indices"),
@@ -333,6 +375,8 @@ impl SceneGpu {
             alpha_test,
             cull,
             uploads: UploadCounters::default(),
+            posed: Default::default(),
+            pose_vertices: Default::default(),
         };
         gpu.write_work(scene.shader_work, scene.shader_work_weight);
         Ok(gpu)
@@ -365,6 +409,51 @@ impl SceneGpu {
         let bytes = bytemuck::bytes_of(&raw);
         self.queue
             .write_buffer(&self.camera_buffer, 0, &bytes[..LIGHT_OFFSET as usize]);
+    }
+
+    /// The deformed models' vertices on `frame` (skins and morph weights of a user scene's animation, posed on
+    /// the CPU), written over their LODs' ranges of the vertex buffer before the frame's draws; nothing when no
+    /// model deforms.
+    pub fn write_pose(&self, scene: &Scene, frame: u32) {
+        let Motion::Animated(a) = &scene.motion else {
+            return;
+        };
+        if a.deformers.is_empty() {
+            return;
+        }
+        let mut posed = self.posed.borrow_mut();
+        let chains: Vec<&crate::geometry::lod::LodChain> =
+            scene.models.iter().map(|m| &m.chain).collect();
+        a.pose(
+            &chains,
+            frame,
+            &|i| scene.instance_matrix(i, frame),
+            &mut posed,
+        );
+        let mut scratch = self.pose_vertices.borrow_mut();
+        for p in &posed.lods {
+            let (m, l) = (p.model as usize, p.lod as usize);
+            let rest = &scene.models[m].chain.lods[l].mesh.positions;
+            scratch.clear();
+            scratch.extend(
+                p.positions
+                    .iter()
+                    .zip(&p.normals)
+                    .zip(rest)
+                    .map(|((p, n), r)| deformed_vertex(*p, *n, *r)),
+            );
+            let at = self.lods[m][l].base_vertex as u64 * std::mem::size_of::<Vertex>() as u64;
+            self.queue
+                .write_buffer(&self.vertex_buffer, at, bytemuck::cast_slice(&scratch));
+        }
+    }
+
+    /// The posed vertices (positions, normals) of `model`'s LOD `lod` on the frame last written by
+    /// [`SceneGpu::write_pose`], when the model deforms.
+    pub fn posed(&self, model: u32, lod: u32) -> Option<std::cell::Ref<'_, Posed>> {
+        let posed = self.posed.borrow();
+        posed.of(model, lod)?;
+        Some(posed)
     }
 
     /// `--shader-work`: every shaded fragment runs `iterations` dependent ALU iterations and adds their result

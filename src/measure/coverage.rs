@@ -185,7 +185,11 @@ impl Coverage {
             tiles_x: scene.width.div_ceil(TILE),
             tiles_y: scene.height.div_ceil(TILE),
             boxes: if bounded {
-                scene.models.iter().map(|m| reach_box(&m.chain)).collect()
+                scene
+                    .models
+                    .iter()
+                    .map(|m| m.deformed_reach.unwrap_or_else(|| reach_box(&m.chain)))
+                    .collect()
             } else {
                 Vec::new()
             },

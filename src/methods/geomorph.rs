@@ -6,12 +6,13 @@
 //! once per LOD pair and cached.
 
 use super::common::{instance_raw, FrameInput, Method};
-use crate::geometry::morph::morph_targets;
 use crate::geometry::morph::Correspondence;
+use crate::geometry::morph::{morph_targets, MorphTargets};
 use crate::gpu::{
     DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu, Vertex,
 };
 use crate::scene::Scene;
+use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 const STEADY: u8 = 0;
@@ -39,17 +40,30 @@ pub struct Geomorph {
     /// LOD's vertices target themselves and are never morphed).
     targets: wgpu::Buffer,
     morph: wgpu::RenderPipeline,
+    /// The deformed models' LODs (model, LOD, first vertex, their targets): their targets follow the coarser
+    /// LOD's pose every frame.
+    deformed: Vec<(u32, u32, u64, Arc<MorphTargets>)>,
+    /// Scratch of the followed targets.
+    scratch: (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<Vertex>),
 }
 
 impl Geomorph {
     pub fn new(gpu: &SceneGpu, scene: &Scene, options: &GeomorphOptions) -> Self {
         let mut targets: Vec<Vertex> = Vec::new();
-        for model in scene.models.iter() {
+        let mut deformed = Vec::new();
+        let deforms = |m: usize| match &scene.motion {
+            crate::scene::Motion::Animated(a) => a.deformers.iter().any(|d| d.model as usize == m),
+            _ => false,
+        };
+        for (m, model) in scene.models.iter().enumerate() {
             let lods = &model.chain.lods;
             for (i, lod) in lods.iter().enumerate() {
                 match lods.get(i + 1) {
                     Some(coarse) => {
                         let t = morph_targets(&lod.mesh, &coarse.mesh, options.correspondence);
+                        if deforms(m) {
+                            deformed.push((m as u32, i as u32, targets.len() as u64, t.clone()));
+                        }
                         targets.extend(t.positions.iter().zip(&t.normals).map(|(p, n)| Vertex {
                             position: *p,
                             normal: *n,
@@ -74,12 +88,45 @@ impl Geomorph {
                 .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("geomorph targets"),
                     contents: bytemuck::cast_slice(&targets),
-                    usage: wgpu::BufferUsages::VERTEX,
+                    usage: if deformed.is_empty() {
+                        wgpu::BufferUsages::VERTEX
+                    } else {
+                        wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST
+                    },
                 }),
+            deformed,
+            scratch: Default::default(),
             morph: gpu.mesh_pipeline(&MeshPipeline {
                 morph: true,
                 ..MeshPipeline::opaque("geomorph")
             }),
+        }
+    }
+}
+
+impl Geomorph {
+    /// The deformed models' targets on this frame's pose of their coarser LODs ([`SceneGpu::write_pose`]).
+    fn follow_poses(&mut self, gpu: &SceneGpu) {
+        let (ps, ns, vs) = &mut self.scratch;
+        for (model, lod, first, t) in &self.deformed {
+            let Some(posed) = gpu.posed(*model, lod + 1) else {
+                continue;
+            };
+            let Some(coarse) = posed.of(*model, lod + 1) else {
+                continue;
+            };
+            t.follow(&coarse.positions, &coarse.normals, ps, ns);
+            vs.clear();
+            vs.extend(ps.iter().zip(ns.iter()).map(|(p, n)| Vertex {
+                position: *p,
+                normal: *n,
+                aux: [0.0; 4],
+            }));
+            gpu.queue.write_buffer(
+                &self.targets,
+                first * std::mem::size_of::<Vertex>() as u64,
+                bytemuck::cast_slice(vs),
+            );
         }
     }
 }
@@ -122,6 +169,7 @@ impl Method for Geomorph {
         }
         self.list.build();
         gpu.upload(&self.buffer, &self.list);
+        self.follow_poses(gpu);
         let mut pass = gpu.begin_clear_pass(encoder, target, "geomorph pass");
         pass.set_vertex_buffer(2, self.targets.slice(..));
         gpu.draw(

@@ -178,7 +178,7 @@ pub fn def(
             BUILT_IN.to_string(),
         ),
     };
-    let model = bunny_model(kind, &file, &mesh, cfg, pv, fov_y)?;
+    let (model, note) = bunny_model(kind, &file, &mesh, cfg, pv, fov_y)?;
     let path = BunnyPath::new(
         &model,
         &cfg.schedule,
@@ -203,6 +203,7 @@ pub fn def(
         models,
         mesh_source,
         lod_generation_ms,
+        notes: note.into_iter().collect(),
     };
     Ok((set, BunnyParts { path, ground }))
 }
@@ -215,7 +216,7 @@ fn bunny_model(
     cfg: &SceneConfig,
     pv: &ProfileValues,
     fov_y: f32,
-) -> Result<Model> {
+) -> Result<(Model, Option<String>)> {
     let height = pv.height;
     mesh.check_area(file)?;
     let (center, radius) = mesh.bounding_sphere();
@@ -225,8 +226,8 @@ fn bunny_model(
             problem: "has zero extent".into(),
         });
     }
-    let chain = match cfg.mesh {
-        None => LodChain::build(file, mesh, &DEFAULT_TARGETS)?,
+    let (chain, note) = match cfg.mesh {
+        None => (LodChain::build(file, mesh, &DEFAULT_TARGETS)?, None),
         Some(_) => {
             let fit = fit_distance(radius, pv.width, height, fov_y);
             let pixel_error = cfg.pixel_error(kind, height);
@@ -234,7 +235,7 @@ fn bunny_model(
                 .iter()
                 .map(|m| lod::error_at_distance(m * fit, 1.0, pixel_error, height, fov_y))
                 .collect();
-            LodChain::build_by_error(file, mesh, &errors)?
+            LodChain::build_by_error(file, mesh, &errors, cfg.simplify)?
         }
     };
     let scale = 1.0;
@@ -247,18 +248,22 @@ fn bunny_model(
             ),
         };
     cfg.schedule.check_switches("bunny", &switches)?;
-    Ok(Model {
-        name: "bunny".into(),
-        color: BUNNY_COLOR,
-        lod_colors: Vec::new(),
-        spin_per_frame: 0.0,
-        chain,
-        switches,
-        switch_source,
-        center,
-        radius: radius * scale,
-        scale,
-    })
+    Ok((
+        Model {
+            name: "bunny".into(),
+            color: BUNNY_COLOR,
+            lod_colors: Vec::new(),
+            spin_per_frame: 0.0,
+            chain,
+            switches,
+            switch_source,
+            center,
+            radius: radius * scale,
+            scale,
+            deformed_reach: None,
+        },
+        note,
+    ))
 }
 
 /// The bunny scenes' ground with `--shadows on`: a grey quad under the bunny's lowest point, from behind the
@@ -304,6 +309,7 @@ fn ground_model(bunny: &Model, far: f32) -> (Model, Vec3) {
         center: Vec3::ZERO,
         radius: (hx * hx + hz * hz).sqrt(),
         scale: 1.0,
+        deformed_reach: None,
     };
     (model, Vec3::new(x_mid, lowest, 0.0))
 }

@@ -30,6 +30,10 @@ pub struct SceneConfig {
     pub blocks: Option<u32>,
     pub counts: Option<Vec<u32>>,
     pub fov_deg: f32,
+    /// `--animation`: which of a glTF scene's animations plays.
+    pub animation: AnimationChoice,
+    /// `--simplify`: how a user's mesh is simplified into its LOD chain.
+    pub simplify: crate::geometry::lod::Simplify,
     /// `--shader-work`: extra ALU iterations per shaded fragment (0: none).
     pub shader_work: u32,
     pub schedule: ScheduleParams,
@@ -37,6 +41,32 @@ pub struct SceneConfig {
     pub taa: Option<crate::effects::taa::Taa>,
     /// `--shadows on`: the shadow map (and a ground under the bunny scenes).
     pub shadows: Option<crate::effects::shadow::Shadows>,
+}
+
+/// `--animation`: which of a glTF scene's animations plays over the frames.
+#[derive(Debug, Clone, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AnimationChoice {
+    /// The file's first animation (none when it has none).
+    #[default]
+    First,
+    /// The scene at rest.
+    None,
+    Index(usize),
+    Name(String),
+}
+
+impl AnimationChoice {
+    /// `none`, an index, or an animation's name.
+    pub fn parse(text: &str) -> AnimationChoice {
+        match text {
+            "none" => AnimationChoice::None,
+            t => t
+                .parse()
+                .map(AnimationChoice::Index)
+                .unwrap_or_else(|_| AnimationChoice::Name(t.to_string())),
+        }
+    }
 }
 
 impl SceneConfig {

@@ -36,6 +36,8 @@ pub struct SceneDef {
     pub shader_work: u32,
     /// `--camera-path`: replaces the family's camera.
     pub camera_path: Option<Arc<crate::scene::camera_path::CameraPath>>,
+    /// What the family's builder noticed about its models.
+    pub model_notes: Vec<String>,
 }
 
 /// The scene families and what each has beyond its models.
@@ -88,6 +90,7 @@ impl SceneDef {
             shadows: cfg.shadows,
             shader_work: cfg.shader_work,
             camera_path: cfg.camera_path.clone().map(Arc::new),
+            model_notes: set.notes,
         })
     }
 
@@ -120,42 +123,19 @@ impl SceneDef {
         }
     }
 
-    /// What a user should know before trusting the scene: switches the bunny path never reaches. One line each
-    /// scene (empty when there is nothing to say).
+    /// What a user should know before trusting the scene: switches the path never reaches; for a user scene,
+    /// what its file holds that is not drawn as written. One line each (empty when there is nothing to say).
     pub fn notes(&self) -> Vec<String> {
-        let user_camera = self.user().is_some_and(|u| u.camera.is_some());
-        if self.camera_path.is_some() || user_camera {
-            return self.unreached_on_the_path();
+        let mut notes = self.model_notes.clone();
+        if let Family::User(u) = &self.family {
+            notes.extend(u.notes.iter().cloned());
+            notes.extend(self.unreached_on_the_path());
+        } else if self.camera_path.is_some() {
+            notes.extend(self.unreached_on_the_path());
+        } else if let (Family::Bunny(b), Some(m)) = (&self.family, self.models.first()) {
+            notes.extend(b.path.notes(self.kind, m));
         }
-        match (&self.family, self.models.first()) {
-            (Family::Bunny(b), Some(m)) => b.path.notes(self.kind, m),
-            (Family::User(u), _) => {
-                let Some(inst) = u.instances.get(u.followed) else {
-                    return Vec::new();
-                };
-                let m = &self.models[inst.model as usize];
-                let (b, h) = (self.schedule.band, self.schedule.hysteresis);
-                let lods: Vec<String> = m
-                    .switches
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, s)| *s * (1.0 - h) * (1.0 - b) < u.start)
-                    .map(|(j, s)| format!("LOD{} at {s:.4}", j + 1))
-                    .collect();
-                if lods.is_empty() {
-                    return Vec::new();
-                }
-                vec![format!(
-                    "{}: the switch to {} of model {} lies nearer than the flight's start ({:.4}, 1.1 times \
-                     its bounding sphere's radius): not reached",
-                    self.kind.name(),
-                    lods.join(", "),
-                    m.name,
-                    u.start
-                )]
-            }
-            _ => Vec::new(),
-        }
+        notes
     }
 
     /// A camera path's switches never crossed: per model, the switches that no instance of it crosses on the

@@ -175,7 +175,7 @@ impl SceneDef {
             pixel_error: cfg.pixel_error(self.kind, self.height),
             schedule: self.schedule,
             models: self.models.iter().map(|m| self.describe_model(m)).collect(),
-            motion: first.motion,
+            motion: first.motion.clone(),
             camera: self.camera_mode,
             lod_generation_ms: self.lod_generation_ms,
             instance_build_ms,

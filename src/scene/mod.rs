@@ -9,6 +9,7 @@
 //! - `model.rs`: the data model (models, instances, motion, the camera, the unified scenes' seams and DAG).
 //! - `describe.rs`: what `lodbench describe` prints; `schedule.rs`: the LOD schedule every method shares.
 
+pub mod animated;
 pub mod bunny;
 pub mod camera_path;
 pub mod config;

@@ -42,6 +42,9 @@ pub struct Model {
     pub center: Vec3,
     pub radius: f32,
     pub scale: f32,
+    /// A deformed model's reach: the model-space box holding every vertex on every frame (None: its LODs'
+    /// vertices are where they are drawn).
+    pub deformed_reach: Option<(Vec3, Vec3)>,
 }
 
 impl Model {
@@ -62,6 +65,8 @@ pub struct ModelSet {
     pub mesh_source: String,
     /// Milliseconds spent building the models' LOD chains (once per scene, never per instance).
     pub lod_generation_ms: f64,
+    /// What the builder noticed about the models (a mesh that cannot be simplified, ...), one line each.
+    pub notes: Vec<String>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -76,7 +81,7 @@ pub struct Instance {
 }
 
 /// How instances move over the frames.
-#[derive(Debug, Clone, Copy, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Motion {
     Static,
@@ -86,6 +91,9 @@ pub enum Motion {
         near: f32,
         far: f32,
     },
+    /// A user scene's animation: its moving instances' matrices and deformed models per frame
+    /// (`scene/animated.rs`).
+    Animated(Arc<crate::scene::animated::Animated>),
 }
 
 /// Constant-speed distance along the sweep: out from `near` to `far` over the first half of the frames, back
@@ -218,6 +226,10 @@ impl Scene {
         }
         match self.motion {
             Motion::Static => inst.position,
+            Motion::Animated(ref a) => match a.instance_matrix(i, frame) {
+                Some(m) => m.transform_point3(self.models[inst.model as usize].center),
+                None => inst.position,
+            },
             Motion::SweepX { near, far } => {
                 let d = match self.camera_mode {
                     CameraMode::Dolly => near,
@@ -234,6 +246,11 @@ impl Scene {
         if self.unified.is_some() {
             // Blocks and seams are in world space: every block shares one exact transform with its seams.
             return Mat4::IDENTITY;
+        }
+        if let Motion::Animated(a) = &self.motion {
+            if let Some(m) = a.instance_matrix(i, frame) {
+                return m;
+            }
         }
         let inst = &self.instances[i];
         let m = &self.models[inst.model as usize];
@@ -311,7 +328,7 @@ impl Scene {
                     Motion::SweepX { near, far } => {
                         self.eye - Vec3::X * (sweep_distance(near, far, self.frames, frame) - near)
                     }
-                    Motion::Static => self.eye,
+                    Motion::Static | Motion::Animated(_) => self.eye,
                 };
                 (eye, Mat4::look_at_rh(eye, eye + self.forward, Vec3::Y))
             }

@@ -48,11 +48,13 @@ pub fn def(kind: SceneKind, cfg: &SceneConfig, height: u32, fov_y: f32) -> Resul
         center,
         radius: radius * scale,
         scale,
+        deformed_reach: None,
     };
     Ok(ModelSet {
         models: vec![model],
         mesh_source: source.to_string(),
         lod_generation_ms,
+        notes: Vec::new(),
     })
 }
 

@@ -121,6 +121,7 @@ pub fn def(
         models,
         mesh_source,
         lod_generation_ms: started.elapsed().as_secs_f64() * 1e3,
+        notes: Vec::new(),
     };
     Ok((set, parts))
 }
@@ -433,6 +434,7 @@ fn block_model(
         center,
         radius,
         scale: 1.0,
+        deformed_reach: None,
     };
     Ok((model, bytes))
 }

@@ -165,8 +165,28 @@ fn bunny_glb() -> Vec<u8> {
     glb
 }
 
+/// `a` and `b` hold the same JSON, numbers within `rel` of each other (integers exactly).
+fn assert_close(a: &serde_json::Value, b: &serde_json::Value, rel: f64) {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) if x.is_f64() || y.is_f64() => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            assert!((x - y).abs() <= rel * x.abs().max(y.abs()), "{x} vs {y}");
+        }
+        (Value::Array(x), Value::Array(y)) => {
+            assert_eq!(x.len(), y.len(), "{a} vs {b}");
+            x.iter().zip(y).for_each(|(x, y)| assert_close(x, y, rel));
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            assert_eq!(x.keys().collect::<Vec<_>>(), y.keys().collect::<Vec<_>>());
+            x.iter().for_each(|(k, v)| assert_close(v, &y[k], rel));
+        }
+        _ => assert_eq!(a, b),
+    }
+}
+
 /// `--mesh` takes glTF: the bunny as a .glb gives the scene the same bunny as an OBJ gives (same LODs, switch
-/// distances and path; the node's translation moves the mesh, not its bounding sphere's size), and the committed fixtures of
+/// distances and path to float rounding; the node's translation moves the mesh, not its bounding sphere's size), and the committed fixtures of
 /// tests/data/ load.
 #[test]
 fn gltf_mesh_gives_the_scene_the_obj_gives() {
@@ -198,8 +218,10 @@ fn gltf_mesh_gives_the_scene_the_obj_gives() {
         describe(Some(glb.to_str().unwrap())),
         describe(Some(obj.to_str().unwrap())),
     );
-    assert_eq!(from_glb["models"], from_obj["models"]);
-    assert_eq!(from_glb["path"], from_obj["path"]);
+    // The node's translation moves every position by float rounding, and the attribute-aware simplifier weighs
+    // normals computed from them: the same chain, its errors (and so the switches and the path) to 1e-4.
+    assert_close(&from_glb["models"], &from_obj["models"], 1e-4);
+    assert_close(&from_glb["path"], &from_obj["path"], 1e-4);
     // A user's mesh gets a chain chosen by error (its switches on the path), the built-in bunny the paper's
     // triangle fractions: the same mesh, other LODs.
     let built_in = describe(None);

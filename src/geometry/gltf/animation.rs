@@ -203,6 +203,46 @@ impl Animation {
     }
 }
 
+/// A node hierarchy with (at most) one animation: every node's world matrix and a node's morph weights at a
+/// time of the animation.
+#[derive(Debug, Clone)]
+pub struct Rig {
+    pub nodes: super::nodes::Nodes,
+    pub animation: Option<Animation>,
+    rest: Vec<Mat4>,
+}
+
+impl Rig {
+    pub fn new(nodes: super::nodes::Nodes, animation: Option<Animation>) -> Rig {
+        Rig {
+            rest: nodes.rest_locals(),
+            nodes,
+            animation,
+        }
+    }
+
+    /// Every node's world matrix at time `t` of the animation (at rest without one).
+    pub fn worlds_at(&self, t: f32) -> Vec<Mat4> {
+        match &self.animation {
+            Some(a) => {
+                let locals = a.locals_at(t, &self.rest, &|n| self.nodes.local[n].trs());
+                self.nodes.worlds(&locals)
+            }
+            None => self.nodes.worlds(&self.rest),
+        }
+    }
+
+    /// Every node's world matrix at rest.
+    pub fn rest_worlds(&self) -> Vec<Mat4> {
+        self.nodes.worlds(&self.rest)
+    }
+
+    /// `node`'s animated morph weights at time `t` (`count` of them), when the animation drives them.
+    pub fn weights_at(&self, node: usize, t: f32, count: usize) -> Option<Vec<f32>> {
+        self.animation.as_ref()?.weights_at(node, t, count)
+    }
+}
+
 /// The names of the file's animations ("" where unnamed), in order.
 pub fn animation_names(json: &serde_json::Value) -> Vec<String> {
     array(json, "animations")

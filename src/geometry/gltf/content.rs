@@ -2,7 +2,7 @@
 //! hierarchy, and access to meshes, skins and animations.
 
 use super::accessors::Doc;
-use super::animation::{animation_names, Animation};
+use super::animation::{animation_names, Animation, Rig};
 use super::chains::{chains, AuthoredChain};
 use super::container::{check_required, container};
 use super::json::{array, floats, uint};
@@ -236,6 +236,12 @@ impl Content<'_> {
     /// Animation `i`.
     pub fn animation(&mut self, i: usize) -> Result<Animation, String> {
         self.doc.animation(i)
+    }
+
+    /// The node hierarchy with animation `i` (None: at rest).
+    pub fn rig(&mut self, i: Option<usize>) -> Result<Rig, String> {
+        let animation = i.map(|i| self.doc.animation(i)).transpose()?;
+        Ok(Rig::new(self.nodes.clone(), animation))
     }
 }
 

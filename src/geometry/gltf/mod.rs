@@ -32,6 +32,7 @@ pub mod nodes;
 pub mod primitives;
 mod skins;
 
+pub use animation::{Animation, Rig};
 pub use camera::AnimatedCamera;
 pub use chains::{AuthoredChain, ChainSource};
 pub use container::{decode_base64, percent_decode};

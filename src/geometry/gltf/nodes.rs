@@ -21,6 +21,18 @@ impl Local {
             Local::Trs { t, r, s } => Mat4::from_scale_rotation_translation(s, r, t),
         }
     }
+
+    /// Translation, rotation and scale (a matrix decomposed: glTF forbids animating a node given by one, so
+    /// this is only read for nodes an invalid file animates anyway).
+    pub fn trs(&self) -> (Vec3, Quat, Vec3) {
+        match *self {
+            Local::Matrix(m) => {
+                let (s, r, t) = m.to_scale_rotation_translation();
+                (t, r, s)
+            }
+            Local::Trs { t, r, s } => (t, r, s),
+        }
+    }
 }
 
 /// Every node of the file: local transforms, parents, children, names; and the scene read.

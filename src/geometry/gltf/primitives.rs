@@ -352,6 +352,48 @@ pub struct MergedParts {
     pub data: VertexData,
 }
 
+impl MergedParts {
+    /// Appends `other` (its indices moved past this mesh's vertices). Channels one side lacks get defaults
+    /// ((0, 0), +x, white, zeros); the deformable parts are dropped (a mesh joined from several is drawn at rest).
+    pub fn append(&mut self, other: MergedParts) -> Result<(), String> {
+        let (base, n) = (self.positions.len(), other.positions.len());
+        let offset = u32::try_from(base)
+            .ok()
+            .filter(|b| b.checked_add(n as u32).is_some())
+            .ok_or_else(|| "has more vertices than 32-bit indices can address".to_string())?;
+        self.indices
+            .extend(other.indices.iter().map(|&i| offset + i));
+        self.positions.extend(other.positions);
+        self.normals = match (self.normals.take(), other.normals) {
+            (Some(mut a), Some(b)) => {
+                a.extend(b);
+                Some(a)
+            }
+            _ => None,
+        };
+        fn join<T: Copy>(a: &mut Option<Vec<T>>, b: Option<Vec<T>>, base: usize, n: usize, d: T) {
+            if a.is_none() && b.is_none() {
+                return;
+            }
+            let mut all = a.take().unwrap_or_else(|| vec![d; base]);
+            all.extend(b.unwrap_or_else(|| vec![d; n]));
+            *a = Some(all);
+        }
+        join(&mut self.aux, other.aux, base, n, [0.0; 4]);
+        join(&mut self.data.uv0, other.data.uv0, base, n, [0.0; 2]);
+        join(
+            &mut self.data.tangents,
+            other.data.tangents,
+            base,
+            n,
+            [1.0, 0.0, 0.0, 1.0],
+        );
+        join(&mut self.data.colors, other.data.colors, base, n, [1.0; 4]);
+        self.data.deform = None;
+        Ok(())
+    }
+}
+
 /// Extends an optional channel with `n` entries of `prim` (or `default`), filling earlier vertices with
 /// `default` the first time a primitive has it.
 fn extend<T: Copy>(

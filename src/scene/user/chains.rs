@@ -1,0 +1,197 @@
+//! A user scene's LOD chains and switch distances: an authored chain's levels as they are, its thresholds from
+//! the file (lodbench's exact distances, else MSFT_screencoverage, else an error estimated per level); every
+//! other mesh gets meshoptimizer's chain by error, its levels the coarsest within errors that project to
+//! `--pixel-error` at multiples of the distance the model is first seen from, so that its switches fall on the
+//! camera's path.
+
+use crate::error::{Error, Result};
+use crate::geometry::gltf::ChainSource;
+use crate::geometry::lod::{self, LodChain};
+use crate::geometry::mesh::Mesh;
+use crate::scene::bunny::USER_SWITCH_FIT_MULTIPLES;
+use crate::scene::config::{screen_size_distance, SceneConfig};
+use crate::scene::kind::ProfileValues;
+use crate::scene::model::Model;
+use crate::scene::user::models::PendingModel;
+use crate::scene::user::parts::ChainDescription;
+
+/// What a model's switch distances depend on besides its chain.
+pub struct View<'a> {
+    pub cfg: &'a SceneConfig,
+    pub pv: &'a ProfileValues,
+    pub fov_y: f32,
+    pub pixel_error: f32,
+}
+
+/// The model of `pending` (file `file`): its chain and switch distances. `seen_from`: the nearest distance the
+/// camera sees it from at the start of its path (a generated chain's levels are chosen at multiples of it), and
+/// the chain's description when the file authored it.
+pub fn build(
+    file: &str,
+    pending: PendingModel,
+    view: &View<'_>,
+    seen_from: f32,
+) -> Result<(Model, Option<ChainDescription>, Option<String>)> {
+    let bad = |problem: String| Error::Mesh {
+        path: file.to_string(),
+        problem,
+    };
+    let (center, radius) = pending.levels[0].bounding_sphere();
+    let Some(info) = &pending.authored else {
+        let errors: Vec<f32> = USER_SWITCH_FIT_MULTIPLES
+            .iter()
+            .map(|m| {
+                lod::error_at_distance(
+                    m * seen_from,
+                    1.0,
+                    view.pixel_error,
+                    view.pv.height,
+                    view.fov_y,
+                )
+            })
+            .collect();
+        let mesh = pending
+            .levels
+            .into_iter()
+            .next()
+            .ok_or_else(|| bad("a model without a mesh".into()))?;
+        let (chain, note) =
+            LodChain::build_by_error(&pending.name, &mesh, &errors, view.cfg.simplify)?;
+        let mut model = finish(
+            view,
+            pending.name,
+            chain,
+            (center, radius),
+            "pixel-error",
+            pending.color,
+        )?;
+        model.lod_colors = pending.lod_colors;
+        return Ok((model, None, note.map(|n| format!("{file}: mesh {n}"))));
+    };
+    let chain = &info.chain;
+    let meshes = pending.levels;
+    let exact = chain
+        .switch_distances
+        .as_ref()
+        .filter(|d| d.len() + 1 == meshes.len());
+    let to_errors = |d: &[f32]| -> Vec<f32> {
+        std::iter::once(0.0)
+            .chain(d.iter().map(|&d| {
+                lod::error_at_distance(d, 1.0, view.pixel_error, view.pv.height, view.fov_y)
+            }))
+            .collect()
+    };
+    let (errors, thresholds, source) = match (&chain.screen_coverage, exact) {
+        (_, Some(d)) => (
+            to_errors(d),
+            format!("extras.lodbench_switch_distances {d:?} (lodbench export's exact distances)"),
+            "lodbench_switch_distances",
+        ),
+        (Some(c), None) if c.len() + 1 >= meshes.len() && meshes.len() > 1 => {
+            let d: Vec<f32> = c[..meshes.len() - 1]
+                .iter()
+                .map(|&c| screen_size_distance(radius, c as f32, view.fov_y))
+                .collect();
+            (
+                to_errors(&d),
+                format!("MSFT_screencoverage {c:?} (the last value, the cull threshold, not used)"),
+                "MSFT_screencoverage",
+            )
+        }
+        _ => (
+            estimated_errors(file, &meshes)?,
+            "meshopt's error at each level's triangle count, projected to --pixel-error"
+                .to_string(),
+            "pixel-error (estimated)",
+        ),
+    };
+    let levels = meshes.len();
+    let lod_chain = LodChain::from_meshes(&pending.name, meshes, &errors)
+        .map_err(|e| bad(format!("LOD chain '{}': {e}", chain.name)))?;
+    let mut model = finish(
+        view,
+        pending.name.clone(),
+        lod_chain,
+        (center, radius),
+        source,
+        pending.color,
+    )?;
+    model.lod_colors = pending.lod_colors;
+    if let (Some(d), false) = (exact, model.switch_source == "override") {
+        // Exact as written (the round trip through the pixel error may move the last bit), unless
+        // --switch-distances or --switch-screen-sizes replaced them.
+        view.cfg.schedule.check_switches(&pending.name, d)?;
+        model.switches = d.to_vec();
+    }
+    model.spin_per_frame = chain.spin_per_frame;
+    Ok((
+        model,
+        Some(ChainDescription {
+            model: pending.name,
+            source: match chain.source {
+                ChainSource::MsftLod => "MSFT_lod",
+                ChainSource::LodNames => "NAME_LODn node names",
+            },
+            levels,
+            thresholds,
+        }),
+        None,
+    ))
+}
+
+/// An authored chain's errors without thresholds: for each level after LOD0, the error meshopt reaches when it
+/// simplifies LOD0 to that level's triangle count (an estimate of what the level gives up).
+fn estimated_errors(name: &str, meshes: &[Mesh]) -> Result<Vec<f32>> {
+    let t0 = meshes[0].triangle_count() as f32;
+    let targets: Vec<f32> = std::iter::once(1.0)
+        .chain(meshes[1..].iter().map(|m| m.triangle_count() as f32 / t0))
+        .collect();
+    if targets.windows(2).any(|w| w[1] >= w[0]) {
+        return Err(Error::Mesh {
+            path: name.to_string(),
+            problem: "an authored LOD chain's levels must have fewer triangles each".into(),
+        });
+    }
+    let estimate = LodChain::build(name, &meshes[0], &targets)?;
+    let mut errors: Vec<f32> = estimate.lods.iter().map(|l| l.error_abs).collect();
+    for i in 1..errors.len() {
+        errors[i] = errors[i].max(errors[i - 1] * 1.0001 + f32::MIN_POSITIVE);
+    }
+    Ok(errors)
+}
+
+/// The model of a chain: its switch distances (`--switch-distances` overrides them).
+fn finish(
+    view: &View<'_>,
+    name: String,
+    chain: LodChain,
+    (center, radius): (glam::Vec3, f32),
+    source: &'static str,
+    color: [f32; 3],
+) -> Result<Model> {
+    let (switches, switch_source) =
+        match view
+            .cfg
+            .switch_override(&name, chain.lods.len(), radius, view.fov_y)?
+        {
+            Some(s) => (s, "override"),
+            None => (
+                lod::switch_distances(&chain, 1.0, view.pixel_error, view.pv.height, view.fov_y),
+                source,
+            ),
+        };
+    view.cfg.schedule.check_switches(&name, &switches)?;
+    Ok(Model {
+        color,
+        name,
+        lod_colors: Vec::new(),
+        spin_per_frame: 0.0,
+        chain,
+        switches,
+        switch_source,
+        center,
+        radius,
+        scale: 1.0,
+        deformed_reach: None,
+    })
+}

@@ -1,0 +1,101 @@
+//! A user scene's camera: the file's animated camera (its first, keys resampled to the frames, its vertical fov
+//! replacing `--fov`) when it has one and no `--camera-path` is given; otherwise a flight that shows the whole
+//! scene on its first frame and moves out until every model has passed its last switch.
+
+use crate::error::{Error, Result};
+use crate::geometry::gltf::{AnimatedCamera, Content};
+use crate::scene::bunny::fit_distance;
+use crate::scene::camera_path::CameraPath;
+use crate::scene::config::SceneConfig;
+use crate::scene::kind::ProfileValues;
+use glam::Vec3;
+use std::sync::Arc;
+
+/// The file's animated camera, checked, and the path made of it (None with `--camera-path`, or when the file
+/// animates no camera).
+pub fn file_camera(
+    file: &str,
+    content: &mut Content<'_>,
+    cfg: &SceneConfig,
+) -> Result<Option<(AnimatedCamera, Arc<CameraPath>)>> {
+    let bad = |problem: String| Error::Mesh {
+        path: file.to_string(),
+        problem,
+    };
+    if cfg.camera_path.is_some() {
+        return Ok(None);
+    }
+    let Some(a) = content.animated_camera().map_err(bad)? else {
+        return Ok(None);
+    };
+    if let Some(f) = a.yfov {
+        if !(1.0..170.0).contains(&f.to_degrees()) {
+            return Err(bad(format!(
+                "the animated camera's yfov {f} rad ({:.1} deg) is not between 1 and 170 degrees",
+                f.to_degrees()
+            )));
+        }
+    }
+    if let (Some(n), Some(f)) = (a.znear, a.zfar) {
+        if n >= f {
+            return Err(bad(format!(
+                "the animated camera's znear {n} is not below its zfar {f}"
+            )));
+        }
+    }
+    let path = Arc::new(CameraPath::from_orientations(
+        file,
+        &a.keys,
+        a.yfov.map(f32::to_degrees),
+    )?);
+    Ok(Some((a, path)))
+}
+
+/// The smallest sphere around the box of the `spheres` (centre, radius): what the default flight shows whole.
+pub fn bounding_sphere(spheres: &[(Vec3, f32)]) -> (Vec3, f32) {
+    let (lo, hi) = spheres.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &(c, r)| (lo.min(c - Vec3::splat(r)), hi.max(c + Vec3::splat(r))),
+    );
+    let centre = (lo + hi) * 0.5;
+    let radius = spheres
+        .iter()
+        .map(|&(c, r)| c.distance(centre) + r)
+        .fold(0.0f32, f32::max);
+    (centre, radius)
+}
+
+/// The default flight's first eye: on +z (glTF's front) of the scene sphere's centre, looking along -z, where
+/// the sphere fits the view.
+pub fn start(sphere: (Vec3, f32), pv: &ProfileValues, fov_y: f32) -> (Vec3, f32) {
+    let d = fit_distance(sphere.1.max(f32::MIN_POSITIVE), pv.width, pv.height, fov_y);
+    (sphere.0 + Vec3::Z * d, d)
+}
+
+/// How far out the flight goes: every instance (`(position on the last frame, the last switch of its model)`)
+/// beyond its model's last switch by the band, the hysteresis and 15 %, and at least 1.25 times the start.
+pub fn end(cfg: &SceneConfig, centre: Vec3, start: f32, instances: &[(Vec3, Option<f32>)]) -> f32 {
+    let (b, h) = (cfg.schedule.band, cfg.schedule.hysteresis);
+    instances
+        .iter()
+        .filter_map(|&(p, last)| {
+            last.map(|s| s * (1.0 + h) * (1.0 + b) * 1.15 + p.distance(centre))
+        })
+        .fold(start * 1.25, f32::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_sphere_holds_every_sphere() {
+        let spheres = [(Vec3::ZERO, 1.0), (Vec3::new(10.0, 0.0, 0.0), 2.0)];
+        let (c, r) = bounding_sphere(&spheres);
+        assert_eq!(c, Vec3::new(5.5, 0.0, 0.0));
+        assert_eq!(r, 6.5);
+        for (s, sr) in spheres {
+            assert!(s.distance(c) + sr <= r + 1e-6);
+        }
+    }
+}

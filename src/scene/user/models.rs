@@ -1,0 +1,495 @@
+//! A user scene's models and instances at rest: every placement of the scene drawn as glTF places it, placements
+//! of the same mesh at the same scale and weights sharing one model (drawn instanced), an authored LOD chain one
+//! model whose levels are its node hierarchies, a skinned or morph-animated placement a model of its own.
+
+use crate::error::{Error, Result};
+use crate::geometry::gltf::{self, Content, MeshPrimitives, Placement};
+use crate::geometry::mesh::Mesh;
+use crate::scene::animated::SkinBinding;
+use glam::{Mat4, Quat, Vec3};
+use std::collections::HashMap;
+
+/// Colours of models whose material has no base colour factor, in turn.
+const PALETTE: [[f32; 3]; 6] = [
+    [0.72, 0.45, 0.28],
+    [0.30, 0.55, 0.75],
+    [0.45, 0.70, 0.35],
+    [0.80, 0.70, 0.30],
+    [0.65, 0.40, 0.70],
+    [0.55, 0.55, 0.55],
+];
+
+/// What makes two placements one model.
+#[derive(Debug, Clone, PartialEq)]
+enum ModelKey {
+    /// Meshes (one per level), scale (to 1e-6, sign kept: a mirror is its own model) and rest weights.
+    Rigid(Vec<Vec<usize>>, [i64; 3], Vec<u32>),
+    /// A skinned mesh posed at rest by its skin (its node's transform ignored), and its weights.
+    Skinned(usize, usize, Vec<u32>),
+    /// A placement deformed per frame: a model of its own.
+    Own(usize),
+}
+
+/// An authored chain's thresholds and extras, as the file gives them.
+#[derive(Debug, Clone)]
+pub struct ChainInfo {
+    pub chain: gltf::AuthoredChain,
+}
+
+/// How a deformed model is driven.
+#[derive(Debug, Clone)]
+pub struct DeformSpec {
+    pub node: usize,
+    pub rest_weights: Vec<f32>,
+    pub targets: usize,
+    pub skin: Option<SkinBinding>,
+}
+
+/// A model before its LOD chain: its LOD0 mesh (or an authored chain's level meshes), in model space.
+#[derive(Debug)]
+pub struct PendingModel {
+    key: ModelKey,
+    pub name: String,
+    pub color: [f32; 3],
+    /// Per level, when an authored chain's levels differ in colour.
+    pub lod_colors: Vec<[f32; 3]>,
+    /// LOD0 alone (lodbench builds the chain), or an authored chain's levels.
+    pub levels: Vec<Mesh>,
+    pub authored: Option<ChainInfo>,
+    pub deform: Option<DeformSpec>,
+}
+
+/// How an instance moves when the animation moves it.
+#[derive(Debug, Clone, Copy)]
+pub enum Anchor {
+    /// By its node: model-to-world = the node's world matrix x `local` (the instance's own transform, then
+    /// the inverse of the scale baked into the model).
+    Node { node: usize, local: Mat4 },
+    /// A skinned model: by the rigid part of its skeleton root's motion since rest.
+    Skeleton { root: usize },
+}
+
+/// An instance at rest: its model, the rotation and translation of its model space, and what moves it.
+#[derive(Debug, Clone, Copy)]
+pub struct PendingInstance {
+    pub model: usize,
+    pub rotation: Quat,
+    pub translation: Vec3,
+    pub anchor: Anchor,
+}
+
+/// The models and instances of a file, and what the reader noticed.
+#[derive(Debug, Default)]
+pub struct Collected {
+    pub models: Vec<PendingModel>,
+    pub instances: Vec<PendingInstance>,
+    pub notes: Vec<String>,
+}
+
+/// A scale as a model's key: to 1e-6, so the same scale decomposed from differently rotated placements (which
+/// differ in the last bits) shares one model.
+fn scale_key(scale: Vec3) -> [i64; 3] {
+    scale
+        .to_array()
+        .map(|s| (f64::from(s) * 1e6).round() as i64)
+}
+
+fn weights_key(w: &[f32]) -> Vec<u32> {
+    w.iter().map(|x| x.to_bits()).collect()
+}
+
+/// A world transform as scale, rotation, translation; refused (naming `what`) when it shears or is singular (no
+/// such decomposition reproduces it). A mirroring transform decomposes with a negative scale, which the model
+/// bakes in (its winding reversed, as glTF specifies).
+fn decompose(file: &str, what: &str, world: Mat4) -> Result<(Vec3, Quat, Vec3)> {
+    let (s, r, t) = world.to_scale_rotation_translation();
+    let again = Mat4::from_scale_rotation_translation(s, r, t);
+    let tol = 1e-4
+        * world
+            .abs()
+            .to_cols_array()
+            .iter()
+            .fold(1.0f32, |a, &b| a.max(b));
+    if !again.abs_diff_eq(world, tol) || !s.is_finite() || s.abs().min_element() <= 0.0 {
+        return Err(Error::Mesh {
+            path: file.to_string(),
+            problem: format!(
+                "{what} has a transform that shears or is singular, which a user scene does not place; apply \
+                 the transform to the mesh in the tool that wrote it (in Blender: Object > Apply > All \
+                 Transforms, then export again)"
+            ),
+        });
+    }
+    Ok((s, r, t))
+}
+
+/// The joint at the top of a skin's joints (its `skeleton` when the file names one): what moves a skinned
+/// model's frame.
+fn skeleton_root(content: &Content<'_>, skin: &gltf::Skin) -> usize {
+    if let Some(s) = skin.skeleton {
+        return s;
+    }
+    let mut j = skin.joints[0];
+    while let Some(p) = content.nodes.parent[j] {
+        if !skin.joints.contains(&p) {
+            break;
+        }
+        j = p;
+    }
+    j
+}
+
+/// Reads the models of a file: `rig` says what the chosen animation moves (a skinned placement whose joints
+/// move, or whose weights the clip drives, is deformed per frame).
+pub struct Collector<'c, 'a> {
+    file: &'c str,
+    content: &'c mut Content<'a>,
+    rig: &'c gltf::Rig,
+    prims: HashMap<usize, MeshPrimitives>,
+    out: Collected,
+    noted: Vec<usize>,
+}
+
+impl<'c, 'a> Collector<'c, 'a> {
+    pub fn new(file: &'c str, content: &'c mut Content<'a>, rig: &'c gltf::Rig) -> Self {
+        Collector {
+            file,
+            content,
+            rig,
+            prims: HashMap::new(),
+            out: Collected::default(),
+            noted: Vec::new(),
+        }
+    }
+
+    fn bad(&self, problem: String) -> Error {
+        Error::Mesh {
+            path: self.file.to_string(),
+            problem,
+        }
+    }
+
+    /// Mesh `mesh`'s primitives (read once), with a note the first time a mesh has points or lines.
+    fn primitives(&mut self, mesh: usize) -> Result<MeshPrimitives> {
+        if !self.prims.contains_key(&mesh) {
+            let p = self
+                .content
+                .mesh_primitives(mesh)
+                .map_err(|e| self.bad(e))?;
+            if !p.skipped.is_empty() && !self.noted.contains(&mesh) {
+                self.noted.push(mesh);
+                let name = self.content.mesh_name(mesh);
+                self.out.notes.push(format!(
+                    "{}: mesh {mesh}{} has {} primitive(s) of points or lines (modes {:?}), not drawn: lodbench \
+                     draws triangles",
+                    self.file,
+                    if name.is_empty() { String::new() } else { format!(" ('{name}')") },
+                    p.skipped.len(),
+                    p.skipped.iter().map(|s| s.1).collect::<Vec<_>>()
+                ));
+            }
+            self.prims.insert(mesh, p);
+        }
+        Ok(self.prims[&mesh].clone())
+    }
+
+    /// Whether the animation moves `node` or a node above it.
+    fn moves(&self, node: usize) -> bool {
+        let Some(a) = &self.rig.animation else {
+            return false;
+        };
+        let mut n = Some(node);
+        while let Some(i) = n {
+            if a.moves(i) {
+                return true;
+            }
+            n = self.content.nodes.parent[i];
+        }
+        false
+    }
+
+    fn weighs(&self, node: usize) -> bool {
+        self.rig.animation.as_ref().is_some_and(|a| a.weighs(node))
+    }
+
+    /// Every model and instance: the authored chains first, then every other placement.
+    pub fn collect(mut self) -> Result<Collected> {
+        let chains = self.content.chains.clone();
+        for chain in &chains {
+            self.chain(chain)?;
+        }
+        let placements = std::mem::take(&mut self.content.placements);
+        for (i, p) in placements.iter().enumerate() {
+            if !self.content.in_chain(p.node) {
+                self.placement(i, p)?;
+            }
+        }
+        self.content.placements = placements;
+        if self.out.instances.is_empty() {
+            return Err(self.bad(match self.content.scene {
+                Some(s) => format!("has no triangle primitives in scene {s}"),
+                None => "has no triangle primitives".to_string(),
+            }));
+        }
+        Ok(self.out)
+    }
+
+    /// The model of `key`, made by `make` the first time.
+    fn model(
+        &mut self,
+        key: ModelKey,
+        make: impl FnOnce(&mut Self) -> Result<Option<PendingModel>>,
+    ) -> Result<Option<usize>> {
+        if let Some(i) = self.out.models.iter().position(|m| m.key == key) {
+            return Ok(Some(i));
+        }
+        match make(self)? {
+            Some(mut m) => {
+                m.key = key;
+                self.out.models.push(m);
+                Ok(Some(self.out.models.len() - 1))
+            }
+            None => Ok(None),
+        }
+    }
+
+    fn color(&self, mesh: usize) -> [f32; 3] {
+        self.content
+            .mesh_color(mesh)
+            .unwrap_or(PALETTE[self.out.models.len() % PALETTE.len()])
+    }
+
+    /// One placement outside the chains: a model shared by mesh, scale and weights (skinned: by mesh, skin and
+    /// weights), or its own when deformed per frame.
+    fn placement(&mut self, index: usize, p: &Placement) -> Result<()> {
+        let prims = self.primitives(p.mesh)?;
+        if prims.triangles.is_empty() {
+            self.out.notes.push(format!(
+                "{}: node {} ('{}') places mesh {}, which has no triangles: not drawn",
+                self.file, p.node, p.name, p.mesh
+            ));
+            return Ok(());
+        }
+        let weights = Content::rest_weights(p, &prims);
+        let animated_weights = self.weighs(p.node) && prims.target_count() > 0;
+        let what = format!("node {} ('{}')", p.node, p.name);
+        if let (true, Some(s)) = (Content::is_skinned(p, &prims), p.skin) {
+            let skin = self
+                .content
+                .skin_of(s, p.mesh, &prims)
+                .map_err(|e| self.bad(e))?;
+            let root = skeleton_root(self.content, &skin);
+            let deformed = animated_weights || skin.joints.iter().any(|&j| self.moves(j));
+            let key = if deformed {
+                ModelKey::Own(index)
+            } else {
+                ModelKey::Skinned(p.mesh, s, weights_key(&weights))
+            };
+            let spec = deformed.then(|| DeformSpec {
+                node: p.node,
+                rest_weights: weights.clone(),
+                targets: prims.target_count(),
+                skin: Some(SkinBinding {
+                    joints: skin.joints.clone(),
+                    inverse_bind: skin.inverse_bind.clone(),
+                }),
+            });
+            // Posed at rest in world space: the model's space is the world's at rest.
+            let model = self.model(key, |c| {
+                let mesh = c.mesh_of(p, &prims, Mat4::IDENTITY, Mat4::IDENTITY, deformed)?;
+                Ok(Some(c.pending(p.mesh, vec![mesh], spec)))
+            })?;
+            if let Some(model) = model {
+                self.out.instances.push(PendingInstance {
+                    model,
+                    rotation: Quat::IDENTITY,
+                    translation: Vec3::ZERO,
+                    anchor: Anchor::Skeleton { root },
+                });
+            }
+            return Ok(());
+        }
+        let (scale, rotation, translation) = decompose(self.file, &what, p.world)?;
+        let key = if animated_weights {
+            ModelKey::Own(index)
+        } else {
+            ModelKey::Rigid(vec![vec![p.mesh]], scale_key(scale), weights_key(&weights))
+        };
+        let spec = animated_weights.then(|| DeformSpec {
+            node: p.node,
+            rest_weights: weights.clone(),
+            targets: prims.target_count(),
+            skin: None,
+        });
+        let bake = Mat4::from_scale(scale);
+        let model = self.model(key, |c| {
+            let mesh = c.mesh_of(p, &prims, bake, Mat4::IDENTITY, animated_weights)?;
+            Ok(Some(c.pending(p.mesh, vec![mesh], spec)))
+        })?;
+        if let Some(model) = model {
+            self.out.instances.push(PendingInstance {
+                model,
+                rotation,
+                translation,
+                anchor: Anchor::Node {
+                    node: p.node,
+                    local: p.instance_local * bake.inverse(),
+                },
+            });
+        }
+        Ok(())
+    }
+
+    fn pending(&self, mesh: usize, levels: Vec<Mesh>, deform: Option<DeformSpec>) -> PendingModel {
+        PendingModel {
+            key: ModelKey::Own(usize::MAX),
+            name: match self.content.mesh_name(mesh) {
+                "" => format!("mesh{mesh}"),
+                n => n.to_string(),
+            },
+            color: self.color(mesh),
+            lod_colors: Vec::new(),
+            levels,
+            authored: None,
+            deform,
+        }
+    }
+
+    /// Placement `p`'s mesh at rest ([`Content::placed_as`]): unskinned under `mesh_to_frame`, skinned by its
+    /// joints into the frame `to_frame` maps world space to; its deformable part kept when `deformed`.
+    fn mesh_of(
+        &mut self,
+        p: &Placement,
+        prims: &MeshPrimitives,
+        mesh_to_frame: Mat4,
+        to_frame: Mat4,
+        deformed: bool,
+    ) -> Result<Mesh> {
+        let mut parts = self
+            .content
+            .placed_as(p, prims, mesh_to_frame, to_frame)
+            .map_err(|e| self.bad(e))?;
+        if !deformed {
+            parts.data.deform = None;
+        }
+        let name = self.file;
+        let mut m = Mesh::new(name, parts.positions, parts.normals, parts.indices)?;
+        if let Some(aux) = parts.aux {
+            m = m.with_aux(name, aux)?;
+        }
+        m = m.with_data(name, parts.data)?;
+        m.check_area(name)?;
+        Ok(m)
+    }
+
+    /// An authored chain: one model whose levels are its level nodes' hierarchies, placed by the LOD0 node.
+    fn chain(&mut self, chain: &gltf::AuthoredChain) -> Result<()> {
+        let root = chain.nodes[0];
+        let what = format!("LOD chain '{}' (node {root})", chain.name);
+        let root_world = self.level_world(chain, 0);
+        let (scale, rotation, translation) = decompose(self.file, &what, root_world)?;
+        let to_model = Mat4::from_rotation_translation(rotation, translation).inverse();
+        let placements = self.content.placements.clone();
+        let mut level_meshes = Vec::new();
+        let mut level_placements = Vec::new();
+        for (l, &level) in chain.nodes.iter().enumerate() {
+            let mine: Vec<&Placement> = placements
+                .iter()
+                .filter(|p| p.node != usize::MAX && self.content.nodes.is_under(p.node, level))
+                .collect();
+            if mine.is_empty() {
+                return Err(self.bad(format!(
+                    "{what}: level {l} (node {level}) places no mesh; every level of a chain needs geometry"
+                )));
+            }
+            level_meshes.push(mine.iter().map(|p| p.mesh).collect::<Vec<_>>());
+            level_placements.push(mine.into_iter().cloned().collect::<Vec<_>>());
+        }
+        let key = ModelKey::Rigid(level_meshes, scale_key(scale), Vec::new());
+        let model = self.model(key, |c| {
+            let mut levels = Vec::new();
+            let mut colors = Vec::new();
+            for (l, ps) in level_placements.iter().enumerate() {
+                let mut merged: Option<gltf::MergedParts> = None;
+                for p in ps {
+                    let prims = c.primitives(p.mesh)?;
+                    if Content::is_skinned(p, &prims) || c.weighs(p.node) {
+                        c.out.notes.push(format!(
+                            "{}: {what}: level {l}'s mesh {} is skinned or has animated weights; drawn at rest \
+                             (lodbench animates the skins and morph targets of meshes without authored chains)",
+                            c.file, p.mesh
+                        ));
+                    }
+                    let part = c
+                        .content
+                        .placed_as(p, &prims, to_model * p.world, to_model)
+                        .map_err(|e| c.bad(e))?;
+                    match &mut merged {
+                        Some(m) => m.append(part).map_err(|e| c.bad(e))?,
+                        None => merged = Some(part),
+                    }
+                }
+                let mut parts = merged.ok_or_else(|| c.bad(format!("{what}: level {l} is empty")))?;
+                parts.data.deform = None;
+                if parts.indices.is_empty() {
+                    return Err(c.bad(format!("{what}: level {l} has no triangles")));
+                }
+                let name = c.file;
+                let mut m = Mesh::new(name, parts.positions, parts.normals, parts.indices)?;
+                if let Some(aux) = parts.aux {
+                    m = m.with_aux(name, aux)?;
+                }
+                m = m.with_data(name, parts.data)?;
+                m.check_area(name)?;
+                levels.push(m);
+                colors.push(c.content.mesh_color(ps[0].mesh));
+            }
+            let color = colors[0].unwrap_or(PALETTE[c.out.models.len() % PALETTE.len()]);
+            let lod_colors: Vec<[f32; 3]> = colors.iter().map(|k| k.unwrap_or(color)).collect();
+            Ok(Some(PendingModel {
+                key: ModelKey::Own(usize::MAX),
+                name: if chain.name.is_empty() {
+                    format!("chain{}", c.out.models.len())
+                } else {
+                    chain.name.clone()
+                },
+                color,
+                lod_colors: if lod_colors.iter().any(|k| *k != color) {
+                    lod_colors
+                } else {
+                    Vec::new()
+                },
+                levels,
+                authored: Some(ChainInfo {
+                    chain: chain.clone(),
+                }),
+                deform: None,
+            }))
+        })?;
+        if let Some(model) = model {
+            self.out.instances.push(PendingInstance {
+                model,
+                rotation,
+                translation,
+                anchor: Anchor::Node {
+                    node: root,
+                    local: Mat4::from_scale(scale).inverse(),
+                },
+            });
+        }
+        Ok(())
+    }
+
+    /// Where level `l` of `chain` stands at rest: its node's world matrix, or, for an MSFT_lod level outside the
+    /// scene, where it replaces the LOD0 node (under the LOD0 node's parent).
+    fn level_world(&self, chain: &gltf::AuthoredChain, l: usize) -> Mat4 {
+        let n = chain.nodes[l];
+        let nodes = &self.content.nodes;
+        if nodes.scene_order.contains(&n) {
+            return self.content.rest_worlds[n];
+        }
+        let parent =
+            nodes.parent[chain.nodes[0]].map_or(Mat4::IDENTITY, |p| self.content.rest_worlds[p]);
+        parent * nodes.local[n].matrix()
+    }
+}
