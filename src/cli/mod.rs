@@ -420,12 +420,17 @@ pub struct DescribeArgs {
 
 #[derive(Debug, Clone, Args)]
 pub struct ExportArgs {
-    /// The built-in scene to export (the unified scenes are not exported).
+    /// The scene to export (the unified scenes are not exported; a glTF scene only as .obj).
     #[arg(long)]
     pub scene: String,
-    /// The .glb file to write.
+    /// The file to write: `.glb`, a built-in scene with its LOD chains and camera; `.obj`, the geometry
+    /// lodbench draws on `--frame`, every instance at LOD0 in world space, a group per instance (for a glTF scene
+    /// named by its node: `node<N>`, `node<N>.<I>`).
     #[arg(long)]
     pub out: PathBuf,
+    /// The frame `--out FILE.obj` shows (its animation's pose, its camera ignored).
+    #[arg(long, default_value_t = 0)]
+    pub frame: u32,
     #[command(flatten)]
     pub scene_args: SceneArgs,
 }

@@ -1,4 +1,5 @@
-//! `lodbench export --scene NAME --out FILE.glb`: a built-in scene as glTF 2.0 (`scene/export.rs`).
+//! `lodbench export --scene NAME --out FILE.glb|FILE.obj`: a built-in scene as glTF 2.0 (`scene/export.rs`), or
+//! any non-unified scene's geometry on one frame as OBJ (`scene/export_obj.rs`).
 
 use crate::cli::ExportArgs;
 use crate::error::{Error, Result};
@@ -7,26 +8,55 @@ use crate::scene::{SceneConfig, SceneDef, SceneKind};
 /// Writes the scene `args` names (its first instance count) to `args.out`.
 pub fn execute(args: &ExportArgs) -> Result<()> {
     let kind = SceneKind::from_name(&args.scene)?;
-    if kind.is_user() {
+    let obj = args
+        .out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if kind.is_user() && !obj {
         return Err(Error::Config(format!(
-            "export: {} is already a glTF file; export writes the built-in scenes",
+            "export: {} is already a glTF file; export writes the built-in scenes as .glb, and any scene's \
+             geometry on one frame as .obj (--out FILE.obj)",
             args.scene
         )));
     }
     let cfg = SceneConfig::from_args(&args.scene_args)?;
     let def = SceneDef::new(kind, &cfg)?;
+    if kind.is_unified() {
+        return Err(Error::Config(format!(
+            "export: {} is a unified scene; its blocks and seams have no glTF or OBJ form, so it is not exported",
+            def.name()
+        )));
+    }
+    if args.frame >= def.frames {
+        return Err(Error::Config(format!(
+            "export --frame {}: the scene has {} frames (0 to {})",
+            args.frame,
+            def.frames,
+            def.frames - 1
+        )));
+    }
     let count = def.counts[0];
-    let glb = crate::scene::export::glb(&def.instantiate(count))?;
-    std::fs::write(&args.out, &glb).map_err(|e| Error::Output {
+    let scene = def.instantiate(count);
+    let bytes = match obj {
+        true => crate::scene::export_obj::obj(&def, &scene, args.frame).into_bytes(),
+        false => crate::scene::export::glb(&scene)?,
+    };
+    std::fs::write(&args.out, &bytes).map_err(|e| Error::Output {
         path: args.out.clone(),
         problem: format!("cannot be written ({e})"),
     })?;
+    for note in def.notes() {
+        eprintln!("note: {note}");
+    }
     outln!(
-        "{}: {} (count {count}, {} frames) written, {} bytes",
+        "{}: {} (count {count}, {}) written, {} bytes",
         args.out.display(),
         def.name(),
-        def.frames,
-        glb.len()
+        match obj {
+            true => format!("frame {}", args.frame),
+            false => format!("{} frames", def.frames),
+        },
+        bytes.len()
     );
     Ok(())
 }

@@ -238,7 +238,7 @@ impl LodChain {
                  {t0} triangles ({}); it has LOD0 alone and cannot pop",
                 errors_abs.last().copied().unwrap_or(0.0),
                 match how {
-                    Simplify::Attributes => "texture seams protected, normals and texture coordinates weighted",
+                    Simplify::Attributes => "attribute-aware: hard edges may collapse, texture seams are kept",
                     Simplify::Positions => "--simplify positions: every split vertex is a seam it keeps",
                 }
             )

@@ -405,6 +405,53 @@ mod tests {
         LodChain::build("bunny", &m, &DEFAULT_TARGETS).unwrap()
     }
 
+    /// A target follows its coarse mesh: posed as it is, every correspondence gives back its own targets;
+    /// moved and turned, the targets move and turn with it (a deformed model's LODs each frame).
+    #[test]
+    fn targets_follow_the_coarse_mesh() {
+        let c = chain();
+        let (fine, coarse) = (&c.lods[1].mesh, &c.lods[2].mesh);
+        let turn = glam::Mat4::from_rotation_y(0.7)
+            * glam::Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0));
+        let moved: Vec<[f32; 3]> = coarse
+            .positions
+            .iter()
+            .map(|p| turn.transform_point3(v(p)).to_array())
+            .collect();
+        let turned: Vec<[f32; 3]> = coarse
+            .normals
+            .iter()
+            .map(|n| turn.transform_vector3(v(n)).to_array())
+            .collect();
+        for how in [
+            Correspondence::Nearest,
+            Correspondence::NearestPosition,
+            Correspondence::Surface,
+        ] {
+            let t = morph_targets(fine, coarse, how);
+            let (mut p, mut n) = (Vec::new(), Vec::new());
+            t.follow(&coarse.positions, &coarse.normals, &mut p, &mut n);
+            for (a, b) in p.iter().zip(&t.positions) {
+                assert!(v(a).abs_diff_eq(v(b), 1e-5), "{how:?}: {a:?} vs {b:?}");
+            }
+            t.follow(&moved, &turned, &mut p, &mut n);
+            for k in 0..p.len() {
+                let want = turn.transform_point3(v(&t.positions[k]));
+                assert!(
+                    v(&p[k]).abs_diff_eq(want, 1e-4),
+                    "{how:?}: {:?} vs {want}",
+                    p[k]
+                );
+                let want_n = turn.transform_vector3(v(&t.normals[k]));
+                assert!(
+                    v(&n[k]).abs_diff_eq(want_n, 1e-4),
+                    "{how:?}: normal {:?} vs {want_n}",
+                    n[k]
+                );
+            }
+        }
+    }
+
     #[test]
     fn vertices_on_the_coarse_mesh_map_to_themselves() {
         let c = chain();

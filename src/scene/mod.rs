@@ -16,6 +16,7 @@ pub mod config;
 pub mod def;
 pub mod describe;
 pub mod export;
+pub mod export_obj;
 pub mod kind;
 pub mod model;
 pub mod procedural;

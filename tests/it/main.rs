@@ -32,7 +32,8 @@ mod measure_timing;
 mod methods_fsi;
 mod methods_registry;
 mod methods_variants;
-// src/scene: the scenes' paths and the unified scenes.
+// src/scene: the scenes' paths, animation and the unified scenes.
+mod scene_animation;
 mod scene_fidelity;
 mod scene_unified;
 mod scene_user;

@@ -1,5 +1,6 @@
-//! User scenes (`--scene PATH.glb`, src/scene/user.rs) from the files real tools write (tests/data/tools/):
-//! instances drawn instanced, authored chains kept as chains, every method run with transitions, bad files
+//! User scenes (`--scene PATH.glb`, src/scene/user/) from the files real tools write (tests/data/tools/) and the
+//! public test assets (tests/data/gltf/): instances drawn instanced, authored chains kept as chains, a chain for
+//! every mesh, every layout read, a camera that sees the scene, every method run with transitions, bad files
 //! refused by name.
 
 use crate::common::{col, fails_with, lodbench, read_csv, run_into, scene_config};
@@ -10,6 +11,22 @@ fn tools(file: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data/tools")
         .join(file)
+}
+
+fn assets(file: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/gltf")
+        .join(file)
+}
+
+/// The scene of `path` (a glTF file) with the scene flags `args`.
+fn def_at(path: &Path, args: &[&str]) -> SceneDef {
+    let path = path.to_str().unwrap();
+    SceneDef::new(
+        SceneKind::from_name(path).unwrap(),
+        &scene_config(path, args),
+    )
+    .unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
 fn def(file: &str, args: &[&str]) -> SceneDef {
@@ -376,4 +393,186 @@ fn switches_in_engine_terms_are_screen_sizes() {
     );
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot be used with"));
+}
+
+/// Meshes whose vertices are all split (hard edges everywhere, texture seams: Fox, and the faceted sphere made
+/// by tests/data/gltf/make_own.py) get a chain of at least three levels from the attribute-aware simplifier;
+/// the position-only simplifier (`--simplify positions`) leaves them LOD0 alone, and a note says so.
+#[test]
+fn split_vertices_get_a_chain() {
+    for file in ["faceted-sphere.gltf", "Fox.glb"] {
+        let d = def_at(
+            &assets(file),
+            &["--profile", "quick", "--animation", "none"],
+        );
+        let tris: Vec<usize> = d.models[0]
+            .chain
+            .lods
+            .iter()
+            .map(|l| l.mesh.triangle_count())
+            .collect();
+        assert!(tris.len() >= 3, "{file}: {tris:?}");
+        assert!(tris.windows(2).all(|w| w[1] < w[0]), "{file}: {tris:?}");
+        assert!(
+            d.notes().iter().all(|n| !n.contains("LOD0 alone")),
+            "{file}: {:?}",
+            d.notes()
+        );
+        let before = def_at(
+            &assets(file),
+            &[
+                "--profile",
+                "quick",
+                "--animation",
+                "none",
+                "--simplify",
+                "positions",
+            ],
+        );
+        assert_eq!(before.models[0].chain.lods.len(), 1, "{file}");
+        assert!(
+            before.notes().iter().any(|n| n.contains("LOD0 alone")),
+            "{file}: {:?}",
+            before.notes()
+        );
+    }
+}
+
+/// MSFT_lod as Microsoft's glTF-Toolkit writes it: the levels are node hierarchies (LOD0: a root with two
+/// tetrahedra as children; LOD1, outside the scene: one tetrahedron), one model of 8 and 4 triangles, one
+/// instance.
+#[test]
+fn msft_lod_levels_may_be_node_hierarchies() {
+    let d = def_at(&assets("lod-hierarchy.gltf"), &["--profile", "quick"]);
+    assert_eq!(d.models.len(), 1);
+    let tris: Vec<usize> = d.models[0]
+        .chain
+        .lods
+        .iter()
+        .map(|l| l.mesh.triangle_count())
+        .collect();
+    assert_eq!(tris, [8, 4]);
+    assert_eq!(d.models[0].switch_source, "MSFT_screencoverage");
+    assert_eq!(d.instantiate(1).instances.len(), 1);
+}
+
+/// Layouts real tools write, read rather than refused: integers as integral floats, a sparse accessor, points and
+/// lines beside triangles (skipped with a note naming the mesh), mirrored nodes (their own models, the scale's
+/// sign kept). Their geometry is checked against an independent decoder by scripts/tests/test_check_gltf.py.
+#[test]
+fn layouts_real_tools_write_are_read() {
+    let d = def_at(&assets("integral-floats.gltf"), &["--profile", "quick"]);
+    assert_eq!(d.models[0].chain.lods[0].mesh.triangle_count(), 4);
+    let d = def_at(
+        &assets("SimpleSparseAccessor.gltf"),
+        &["--profile", "quick"],
+    );
+    assert_eq!(d.instantiate(1).instances.len(), 1);
+    let d = def_at(&assets("MeshPrimitiveModes.gltf"), &["--profile", "quick"]);
+    let notes = d.notes();
+    for mesh in [
+        "mesh with POINTS",
+        "mesh with LINES",
+        "mesh with LINE_LOOP",
+        "mesh with LINE_STRIP",
+    ] {
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.contains(mesh) && n.contains("not drawn")),
+            "{mesh}: {notes:?}"
+        );
+    }
+    assert_eq!(
+        d.instantiate(1).instances.len(),
+        3,
+        "triangles, strip and fan"
+    );
+    // NegativeScaleTest places one icosphere mesh under positive and negative scales: the mirrored placements are
+    // models of their own whose vertices are the mirror image of another's, every one wound outwards (a
+    // mirror without the winding reversed would enclose a negative volume).
+    let d = def_at(&assets("NegativeScaleTest.glb"), &["--profile", "quick"]);
+    let spheres: Vec<&lodbench::geometry::mesh::Mesh> = d
+        .models
+        .iter()
+        .filter(|m| m.name == "Icosphere")
+        .map(|m| &m.chain.lods[0].mesh)
+        .collect();
+    assert!(spheres.len() >= 2);
+    assert!(spheres.iter().all(|m| signed_volume(m) > 0.0));
+    let mirror = |a: &lodbench::geometry::mesh::Mesh, b: &lodbench::geometry::mesh::Mesh| {
+        (0..3).any(|axis| {
+            a.positions.iter().zip(&b.positions).all(|(p, q)| {
+                (0..3).all(|k| {
+                    let want = if k == axis { -p[k] } else { p[k] };
+                    (q[k] - want).abs() <= 1e-4 * (1.0 + want.abs())
+                })
+            })
+        })
+    };
+    let mirrored = spheres.iter().any(|a| spheres.iter().any(|b| mirror(a, b)));
+    assert!(
+        mirrored,
+        "a mirrored placement is a model with the mirror baked in"
+    );
+}
+
+/// Twice the signed volume enclosed by a mesh's triangles (negative when its winding is reversed).
+fn signed_volume(m: &lodbench::geometry::mesh::Mesh) -> f64 {
+    m.indices
+        .chunks_exact(3)
+        .map(|t| {
+            let [a, b, c] =
+                [0, 1, 2].map(|k| glam::Vec3::from(m.positions[t[k] as usize]).as_dvec3());
+            a.dot(b.cross(c))
+        })
+        .sum()
+}
+
+/// The default camera shows every instance whole on frame 0 (every vertex lodbench draws then, deformed meshes
+/// posed, projects inside the view: `lodbench export --out FILE.obj`'s geometry) and ends beyond every model's
+/// last switch.
+#[test]
+fn the_default_camera_sees_every_instance_on_frame_0() {
+    let files = [
+        assets("NegativeScaleTest.glb"),
+        assets("BoxAnimated.glb"),
+        assets("still-and-moving.gltf"),
+        assets("Fox.glb"),
+        tools("bunny-six-nodes.glb"),
+    ];
+    for path in files {
+        let d = def_at(&path, &["--profile", "quick"]);
+        let scene = d.instantiate(1);
+        let view_proj = scene.camera(0).view_proj();
+        let obj = lodbench::scene::export_obj::obj(&d, &scene, 0);
+        let vertices: Vec<glam::Vec3> = obj
+            .lines()
+            .filter_map(|l| l.strip_prefix("v "))
+            .map(|v| {
+                let c: Vec<f32> = v.split(' ').map(|x| x.parse().unwrap()).collect();
+                glam::Vec3::new(c[0], c[1], c[2])
+            })
+            .collect();
+        assert!(!vertices.is_empty());
+        for v in vertices {
+            let p = view_proj * v.extend(1.0);
+            let ndc = p.truncate() / p.w;
+            assert!(
+                p.w > 0.0 && ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0,
+                "{}: vertex {v} is outside the view on frame 0 ({ndc})",
+                path.display()
+            );
+        }
+        let last = scene.frames - 1;
+        for (i, inst) in scene.instances.iter().enumerate() {
+            if let Some(&s) = scene.models[inst.model as usize].switches.last() {
+                assert!(
+                    scene.instance_distance(i, last) > s,
+                    "{}: instance {i}",
+                    path.display()
+                );
+            }
+        }
+    }
 }

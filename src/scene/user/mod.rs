@@ -25,7 +25,7 @@ mod models;
 mod motion;
 mod parts;
 
-pub use parts::{ChainDescription, UserParts};
+pub use parts::{ChainDescription, InstanceSource, UserParts};
 
 use crate::error::{Error, Result};
 use crate::geometry::gltf;
@@ -80,13 +80,34 @@ pub fn def(
             .map_or(rest[i], |t| t[(f as usize).min(t.len().saturating_sub(1))])
     };
 
-    // The default flight's start: the whole scene on frame 0.
+    // The default flight's start: the whole scene on frame 0, deformed models as the clip poses them there.
+    let deform_specs: Vec<Option<models::DeformSpec>> =
+        collected.models.iter().map(|p| p.deform.clone()).collect();
+    let first_poses = match &clip {
+        Some(c) => motion::first_poses(
+            c,
+            &rig,
+            &collected
+                .models
+                .iter()
+                .map(|m| &m.levels[0])
+                .collect::<Vec<_>>(),
+            &deform_specs,
+            &collected.instances,
+            &|k| matrix_at(k, 0),
+        ),
+        None => vec![None; collected.models.len()],
+    };
     let spheres: Vec<(Vec3, f32)> = collected
         .instances
         .iter()
         .enumerate()
         .map(|(k, i)| {
-            let (c, r) = collected.models[i.model].levels[0].bounding_sphere();
+            let mesh = &collected.models[i.model].levels[0];
+            let (c, r) = match &first_poses[i.model] {
+                Some(p) => bounding_sphere_of(p),
+                None => mesh.bounding_sphere(),
+            };
             let m = matrix_at(k, 0);
             let s = m.to_scale_rotation_translation().0.abs().max_element();
             (m.transform_point3(c), r * s)
@@ -108,8 +129,6 @@ pub fn def(
     let mut chain_descriptions = Vec::new();
     let pending = collected.models;
     let mut collected_notes = collected.notes;
-    let deform_specs: Vec<Option<models::DeformSpec>> =
-        pending.iter().map(|p| p.deform.clone()).collect();
     for (m, p) in pending.into_iter().enumerate() {
         let radius = p.levels[0].bounding_sphere().1;
         let fit = fit_distance(radius, pv.width, pv.height, fov_y);
@@ -237,6 +256,12 @@ pub fn def(
         animation,
         animations: content.animation_names(),
         notes,
+        sources: collected
+            .instances
+            .iter()
+            .map(|i| i.source.clone())
+            .collect(),
+        skipped: collected.skipped,
     };
     let set = ModelSet {
         models,
@@ -245,6 +270,20 @@ pub fn def(
         notes: Vec::new(),
     };
     Ok((set, parts))
+}
+
+/// The centre of the box of `points` and the radius of the sphere around it that holds them all.
+fn bounding_sphere_of(points: &[[f32; 3]]) -> (Vec3, f32) {
+    let (lo, hi) = points.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(Vec3::from(*p)), hi.max(Vec3::from(*p))),
+    );
+    let c = (lo + hi) * 0.5;
+    let r = points
+        .iter()
+        .map(|p| Vec3::from(*p).distance(c))
+        .fold(0.0f32, f32::max);
+    (c, r)
 }
 
 /// The instances and camera of a user scene.

@@ -6,6 +6,7 @@ use crate::error::{Error, Result};
 use crate::geometry::gltf::{self, Content, MeshPrimitives, Placement};
 use crate::geometry::mesh::Mesh;
 use crate::scene::animated::SkinBinding;
+use crate::scene::user::parts::InstanceSource;
 use glam::{Mat4, Quat, Vec3};
 use std::collections::HashMap;
 
@@ -69,13 +70,15 @@ pub enum Anchor {
     Skeleton { root: usize },
 }
 
-/// An instance at rest: its model, the rotation and translation of its model space, and what moves it.
-#[derive(Debug, Clone, Copy)]
+/// An instance at rest: its model, the rotation and translation of its model space, what moves it, and the node
+/// it is.
+#[derive(Debug, Clone)]
 pub struct PendingInstance {
     pub model: usize,
     pub rotation: Quat,
     pub translation: Vec3,
     pub anchor: Anchor,
+    pub source: InstanceSource,
 }
 
 /// The models and instances of a file, and what the reader noticed.
@@ -84,6 +87,8 @@ pub struct Collected {
     pub models: Vec<PendingModel>,
     pub instances: Vec<PendingInstance>,
     pub notes: Vec<String>,
+    /// Nodes with a mesh that are no instance, and why.
+    pub skipped: Vec<(usize, String)>,
 }
 
 /// A scale as a model's key: to 1e-6, so the same scale decomposed from differently rotated placements (which
@@ -176,7 +181,7 @@ impl<'c, 'a> Collector<'c, 'a> {
                 .content
                 .mesh_primitives(mesh)
                 .map_err(|e| self.bad(e))?;
-            if !p.skipped.is_empty() && !self.noted.contains(&mesh) {
+            if !p.skipped.is_empty() && !p.triangles.is_empty() && !self.noted.contains(&mesh) {
                 self.noted.push(mesh);
                 let name = self.content.mesh_name(mesh);
                 self.out.notes.push(format!(
@@ -226,9 +231,16 @@ impl<'c, 'a> Collector<'c, 'a> {
         }
         self.content.placements = placements;
         if self.out.instances.is_empty() {
-            return Err(self.bad(match self.content.scene {
-                Some(s) => format!("has no triangle primitives in scene {s}"),
-                None => "has no triangle primitives".to_string(),
+            let scene = match self.content.scene {
+                Some(s) => format!(" in scene {s}"),
+                None => String::new(),
+            };
+            return Err(self.bad(match self.out.skipped.is_empty() {
+                true => format!("has no triangle primitives{scene}"),
+                false => format!(
+                    "has no triangle primitives{scene}: its meshes hold only points or lines, and lodbench draws \
+                     triangles"
+                ),
             }));
         }
         Ok(self.out)
@@ -265,11 +277,28 @@ impl<'c, 'a> Collector<'c, 'a> {
         let prims = self.primitives(p.mesh)?;
         if prims.triangles.is_empty() {
             self.out.notes.push(format!(
-                "{}: node {} ('{}') places mesh {}, which has no triangles: not drawn",
-                self.file, p.node, p.name, p.mesh
+                "{}: node {} ('{}') places mesh {}{}, which holds only points or lines (modes {:?}): not drawn, \
+                 lodbench draws triangles",
+                self.file,
+                p.node,
+                p.name,
+                p.mesh,
+                match self.content.mesh_name(p.mesh) {
+                    "" => String::new(),
+                    n => format!(" ('{n}')"),
+                },
+                prims.skipped.iter().map(|s| s.1).collect::<Vec<_>>()
             ));
+            self.out
+                .skipped
+                .push((p.node, format!("mesh {} has no triangles", p.mesh)));
             return Ok(());
         }
+        let source = InstanceSource {
+            node: p.node,
+            instance: p.instance,
+            holds: Vec::new(),
+        };
         let weights = Content::rest_weights(p, &prims);
         let animated_weights = self.weighs(p.node) && prims.target_count() > 0;
         let what = format!("node {} ('{}')", p.node, p.name);
@@ -305,6 +334,7 @@ impl<'c, 'a> Collector<'c, 'a> {
                     rotation: Quat::IDENTITY,
                     translation: Vec3::ZERO,
                     anchor: Anchor::Skeleton { root },
+                    source,
                 });
             }
             return Ok(());
@@ -335,6 +365,7 @@ impl<'c, 'a> Collector<'c, 'a> {
                     node: p.node,
                     local: p.instance_local * bake.inverse(),
                 },
+                source,
             });
         }
         Ok(())
@@ -403,6 +434,13 @@ impl<'c, 'a> Collector<'c, 'a> {
                 )));
             }
             level_meshes.push(mine.iter().map(|p| p.mesh).collect::<Vec<_>>());
+            if l > 0 {
+                for p in &mine {
+                    self.out
+                        .skipped
+                        .push((p.node, format!("level {l} of LOD chain '{}'", chain.name)));
+                }
+            }
             level_placements.push(mine.into_iter().cloned().collect::<Vec<_>>());
         }
         let key = ModelKey::Rigid(level_meshes, scale_key(scale), Vec::new());
@@ -467,6 +505,9 @@ impl<'c, 'a> Collector<'c, 'a> {
             }))
         })?;
         if let Some(model) = model {
+            let mut holds: Vec<usize> = level_placements[0].iter().map(|p| p.node).collect();
+            holds.dedup();
+            holds.retain(|&n| n != root);
             self.out.instances.push(PendingInstance {
                 model,
                 rotation,
@@ -474,6 +515,11 @@ impl<'c, 'a> Collector<'c, 'a> {
                 anchor: Anchor::Node {
                     node: root,
                     local: Mat4::from_scale(scale).inverse(),
+                },
+                source: InstanceSource {
+                    node: root,
+                    instance: None,
+                    holds,
                 },
             });
         }

@@ -114,6 +114,50 @@ pub fn tracks(
     out
 }
 
+/// Each deformed model's LOD0 as the clip's first frame poses it (model space), by model; None for the others.
+pub fn first_poses(
+    clip: &Clip,
+    rig: &Rig,
+    levels0: &[&crate::geometry::mesh::Mesh],
+    specs: &[Option<DeformSpec>],
+    instances: &[PendingInstance],
+    matrix: &dyn Fn(usize) -> Mat4,
+) -> Vec<Option<Vec<[f32; 3]>>> {
+    let deformers = deformers(specs, instances);
+    let mut out = vec![None; levels0.len()];
+    if deformers.is_empty() {
+        return out;
+    }
+    let chains: Vec<crate::geometry::lod::LodChain> = levels0
+        .iter()
+        .zip(specs)
+        .map(|(m, s)| crate::geometry::lod::LodChain {
+            lods: match s {
+                Some(_) => vec![crate::geometry::lod::Lod {
+                    mesh: (*m).clone(),
+                    target_fraction: 1.0,
+                    error_abs: 0.0,
+                }],
+                None => Vec::new(),
+            },
+        })
+        .collect();
+    let refs: Vec<&crate::geometry::lod::LodChain> = chains.iter().collect();
+    let probe = Animated::new(
+        clip.clone(),
+        rig.clone(),
+        1,
+        vec![None; instances.len()],
+        deformers,
+    );
+    let mut posed = crate::scene::animated::Posed::default();
+    probe.pose(&refs, 0, matrix, &mut posed);
+    for p in posed.lods {
+        out[p.model as usize] = Some(p.positions);
+    }
+    out
+}
+
 /// The deformers of the deformed models (`specs`, per model; each has one instance).
 pub fn deformers(specs: &[Option<DeformSpec>], instances: &[PendingInstance]) -> Vec<Deformer> {
     specs

@@ -42,6 +42,22 @@ pub struct UserParts {
     /// What was not drawn, or drawn other than the file says, and why.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// Per instance, the glTF node it is (what `lodbench export --out FILE.obj` names its groups by).
+    #[serde(skip)]
+    pub sources: Vec<InstanceSource>,
+    /// The nodes with a mesh that are no instance, and why (a coarser level of a chain, no triangles).
+    #[serde(skip)]
+    pub skipped: Vec<(usize, String)>,
+}
+
+/// The glTF node an instance is.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct InstanceSource {
+    pub node: usize,
+    /// Its EXT_mesh_gpu_instancing instance.
+    pub instance: Option<usize>,
+    /// The other nodes whose meshes its model holds, in order (an authored chain's LOD0 hierarchy).
+    pub holds: Vec<usize>,
 }
 
 #[derive(Debug, Clone, Serialize)]

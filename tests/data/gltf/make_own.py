@@ -1,0 +1,211 @@
+#!/usr/bin/env python3
+"""Writes the glTF fixtures of tests/data/gltf/ made here (standard library only; CC0 like the rest of this
+folder's own files). Run from anywhere: python3 tests/data/gltf/make_own.py.
+
+- faceted-sphere.gltf: a UV sphere (24 segments, 12 rings, radius 1) drawn flat-shaded with a texture layout:
+  every triangle has its own three vertices (its face normal on each; TEXCOORD_0 from longitude and latitude), so
+  every vertex is split by a hard edge and the meridian at u = 0 / 1 is a texture seam. 528 triangles, 1584
+  vertices: the layout that gives a position-only simplifier nothing to collapse (Fox, SciFiHelmet).
+- lod-hierarchy.gltf: MSFT_lod as Microsoft's glTF-Toolkit writes it, on a scene root whose levels are node
+  hierarchies: node 0 `Lamp_LOD0` (no mesh; children 1 and 2, each a tetrahedron, 1 and 2 units along +x),
+  MSFT_lod ids [3]; node 3 `Lamp_LOD1`, outside the scene, with child 4 (one tetrahedron of 4 triangles at 1.5
+  along +x, scaled by 1.5); `extras.MSFT_screencoverage` [0.3, 0.0]. LOD0 is 8 triangles (4 + 4), LOD1 is 4.
+- still-and-moving.gltf: the faceted sphere (static, at x = -2) beside a tetrahedron (at x = +2) whose one morph
+  target lifts its apex by 0.5, at weight 1 at rest; an animation drives the weight 1 -> 0 -> 1 over 2 s (LINEAR),
+  so every pose lies inside the rest pose's bounding sphere (the same clip planes with and without the
+  animation). The tetrahedron cannot be simplified (a chain of LOD0 alone, never in transition) and is deformed
+  every frame; the sphere crosses its switches and never moves: what lodpop sees of the sphere must not depend
+  on the animation.
+- integral-floats.gltf: the unit tetrahedron of ../tetra.gltf with every integer written as an integral float
+  (`"byteStride": 12.0`, `"componentType": 5126.0`, `"mesh": 0.0`, ...), which the glTF Validator accepts.
+"""
+
+import base64
+import json
+import math
+import struct
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+GENERATOR = "lodbench tests/data/gltf/make_own.py"
+
+
+def data_uri(data: bytes) -> str:
+    return "data:application/octet-stream;base64," + base64.b64encode(data).decode("ascii")
+
+
+def write(name: str, doc: dict) -> None:
+    (HERE / name).write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
+
+
+def faceted_sphere(segments: int = 24, rings: int = 12) -> dict:
+    def point(i, j):
+        theta = math.pi * j / rings
+        phi = 2 * math.pi * i / segments
+        return (math.sin(theta) * math.cos(phi), math.cos(theta), math.sin(theta) * math.sin(phi))
+
+    positions, normals, uvs = [], [], []
+    for j in range(rings):
+        for i in range(segments):
+            quad = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
+            tris = [(quad[0], quad[2], quad[1]), (quad[0], quad[3], quad[2])]
+            if j == 0:
+                tris = tris[1:]
+            elif j == rings - 1:
+                tris = tris[:1]
+            for tri in tris:
+                p = [point(*c) for c in tri]
+                e1 = [p[1][k] - p[0][k] for k in range(3)]
+                e2 = [p[2][k] - p[0][k] for k in range(3)]
+                n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+                length = math.sqrt(sum(c * c for c in n))
+                n = [c / length for c in n]
+                for (i2, j2), q in zip(tri, p):
+                    positions.append(q)
+                    normals.append(n)
+                    uvs.append((i2 / segments, j2 / rings))
+    count = len(positions)
+    data = b"".join(struct.pack("<3f", *p) for p in positions)
+    data += b"".join(struct.pack("<3f", *n) for n in normals)
+    data += b"".join(struct.pack("<2f", *t) for t in uvs)
+    lo = [min(p[k] for p in positions) for k in range(3)]
+    hi = [max(p[k] for p in positions) for k in range(3)]
+    return {
+        "asset": {"version": "2.0", "generator": GENERATOR},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"name": "FacetedSphere", "mesh": 0}],
+        "meshes": [{"name": "FacetedSphere", "primitives": [
+            {"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "mode": 4}]}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": count, "type": "VEC3", "min": lo, "max": hi},
+            {"bufferView": 1, "componentType": 5126, "count": count, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5126, "count": count, "type": "VEC2"},
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 12 * count},
+            {"buffer": 0, "byteOffset": 12 * count, "byteLength": 12 * count},
+            {"buffer": 0, "byteOffset": 24 * count, "byteLength": 8 * count},
+        ],
+        "buffers": [{"byteLength": len(data), "uri": data_uri(data)}],
+    }
+
+
+TETRA = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
+TETRA_TRIANGLES = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+
+
+def tetra_buffer() -> bytes:
+    data = b"".join(struct.pack("<3f", *p) for p in TETRA)
+    return data + b"".join(struct.pack("<3H", *t) for t in TETRA_TRIANGLES)
+
+
+def tetra_accessors() -> tuple[list, list]:
+    accessors = [
+        {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+        {"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR"},
+    ]
+    views = [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 24}]
+    return accessors, views
+
+
+def lod_hierarchy() -> dict:
+    data = tetra_buffer()
+    accessors, views = tetra_accessors()
+    return {
+        "asset": {"version": "2.0", "generator": GENERATOR},
+        "extensionsUsed": ["MSFT_lod"],
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [
+            {"name": "Lamp_LOD0", "children": [1, 2], "extensions": {"MSFT_lod": {"ids": [3]}},
+             "extras": {"MSFT_screencoverage": [0.3, 0.0]}},
+            {"name": "Lamp_LOD0_partA", "mesh": 0, "translation": [1.0, 0.0, 0.0]},
+            {"name": "Lamp_LOD0_partB", "mesh": 0, "translation": [2.0, 0.0, 0.0]},
+            {"name": "Lamp_LOD1", "children": [4]},
+            {"name": "Lamp_LOD1_whole", "mesh": 0, "translation": [1.5, 0.0, 0.0], "scale": [1.5, 1.5, 1.5]},
+        ],
+        "meshes": [{"name": "tetra", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": len(data), "uri": data_uri(data)}],
+    }
+
+
+def integral_floats() -> dict:
+    data = tetra_buffer()
+    return {
+        "asset": {"version": "2.0", "generator": GENERATOR},
+        "scene": 0.0,
+        "scenes": [{"nodes": [0.0]}],
+        "nodes": [{"name": "tetra", "mesh": 0.0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0.0}, "indices": 1.0, "mode": 4.0}]}],
+        "accessors": [
+            {"bufferView": 0.0, "byteOffset": 0.0, "componentType": 5126.0, "count": 4.0, "type": "VEC3",
+             "min": [0, 0, 0], "max": [1, 1, 1]},
+            {"bufferView": 1.0, "componentType": 5123.0, "count": 12.0, "type": "SCALAR"},
+        ],
+        "bufferViews": [
+            {"buffer": 0.0, "byteOffset": 0.0, "byteLength": 48.0, "byteStride": 12.0},
+            {"buffer": 0.0, "byteOffset": 48.0, "byteLength": 24.0},
+        ],
+        "buffers": [{"byteLength": float(len(data)), "uri": data_uri(data)}],
+    }
+
+
+def still_and_moving() -> dict:
+    sphere = faceted_sphere()
+    data = base64.b64decode(sphere["buffers"][0]["uri"].split(",", 1)[1])
+    count = sphere["accessors"][0]["count"]
+
+    def view(byte_offset: int, byte_length: int) -> dict:
+        return {"buffer": 0, "byteOffset": byte_offset, "byteLength": byte_length}
+
+    views = [view(v["byteOffset"], v["byteLength"]) for v in sphere["bufferViews"]]
+    accessors = list(sphere["accessors"])
+    base = len(data)
+    tetra = tetra_buffer()
+    lift = b"".join(struct.pack("<3f", *p) for p in [(0, 0, 0), (0, 0, 0), (0, 0.5, 0), (0, 0, 0)])
+    times = struct.pack("<3f", 0.0, 1.0, 2.0)
+    weights = struct.pack("<3f", 1.0, 0.0, 1.0)
+    data += tetra + lift + times + weights
+    views += [view(base, 48), view(base + 48, 24), view(base + 72, 48), view(base + 120, 12), view(base + 132, 12)]
+    n = len(accessors)
+    accessors += [
+        {"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+        {"bufferView": 4, "componentType": 5123, "count": 12, "type": "SCALAR"},
+        {"bufferView": 5, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0.5, 0]},
+        {"bufferView": 6, "componentType": 5126, "count": 3, "type": "SCALAR", "min": [0.0], "max": [2.0]},
+        {"bufferView": 7, "componentType": 5126, "count": 3, "type": "SCALAR"},
+    ]
+    assert count == sphere["accessors"][0]["count"]
+    return {
+        "asset": {"version": "2.0", "generator": GENERATOR},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [
+            {"name": "StillSphere", "mesh": 0, "translation": [-2.0, 0.0, 0.0]},
+            {"name": "MovingTetra", "mesh": 1, "translation": [2.0, 0.0, 0.0]},
+        ],
+        "meshes": [
+            sphere["meshes"][0],
+            {"name": "MovingTetra", "weights": [1.0], "primitives": [
+                {"attributes": {"POSITION": n}, "indices": n + 1, "targets": [{"POSITION": n + 2}]}]},
+        ],
+        "animations": [{"name": "lift", "samplers": [{"input": n + 3, "output": n + 4, "interpolation": "LINEAR"}],
+                        "channels": [{"sampler": 0, "target": {"node": 1, "path": "weights"}}]}],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": len(data), "uri": data_uri(data)}],
+    }
+
+
+def main() -> None:
+    write("faceted-sphere.gltf", faceted_sphere())
+    write("lod-hierarchy.gltf", lod_hierarchy())
+    write("integral-floats.gltf", integral_floats())
+    write("still-and-moving.gltf", still_and_moving())
+
+
+if __name__ == "__main__":
+    main()
