@@ -281,9 +281,16 @@ impl Experiment {
     /// word taken as a string), applied before the sweep, so they hold in every run; a key the sweep varies
     /// cannot be set.
     pub fn load_with(path: &Path, overrides: &[String]) -> Result<Experiment> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Self::parse(path, text, overrides)
+    }
+
+    /// [`Experiment::load_with`] of the text of the file at `path` (named in errors, and the experiment's
+    /// `file`).
+    pub fn parse(path: &Path, text: String, overrides: &[String]) -> Result<Experiment> {
         let source = Source {
             name: path.display().to_string(),
-            text: std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?,
+            text,
         };
         let mut file: ExperimentFile =
             toml::from_str(&source.text).map_err(|e| source.bad(source.at(&e)))?;

@@ -416,6 +416,10 @@ pub struct DescribeArgs {
     /// Machine-readable output.
     #[arg(long)]
     pub json: bool,
+    /// Also measure each LOD against LOD0: the largest and the mean distance from LOD0's vertices to the LOD's
+    /// surface (object-space units), a measure independent of the simplifier's own error.
+    #[arg(long)]
+    pub deviation: bool,
 }
 
 #[derive(Debug, Clone, Args)]

@@ -9,7 +9,10 @@ use crate::scene::{SceneConfig, SceneDef, SceneDescription, SceneKind};
 pub fn execute(args: &DescribeArgs) -> Result<()> {
     let cfg = SceneConfig::from_args(&args.scene_args)?;
     let def = SceneDef::new(SceneKind::from_name(&args.scene)?, &cfg)?;
-    let d = def.describe(&cfg);
+    let d = match args.deviation {
+        true => def.describe_with_deviation(&cfg),
+        false => def.describe(&cfg),
+    };
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&d)?);
         return Ok(());
@@ -130,17 +133,27 @@ fn print_models(d: &SceneDescription) {
             m.radius,
             m.switch_source
         );
+        let deviation = m.lods.iter().any(|l| l.deviation_max.is_some());
         outln!(
-            "  {:>4} {:>10} {:>9} {:>14} {:>16}",
+            "  {:>4} {:>10} {:>9} {:>14} {:>16}{}",
             "lod",
             "triangles",
             "vertices",
             "error_abs",
-            "switch_distance"
+            "switch_distance",
+            if deviation {
+                format!(" {:>14} {:>14}", "deviation_max", "deviation_mean")
+            } else {
+                String::new()
+            }
         );
         for l in &m.lods {
+            let measured = match (l.deviation_max, l.deviation_mean) {
+                (Some(a), Some(b)) => format!(" {a:>14.6} {b:>14.6}"),
+                _ => String::new(),
+            };
             outln!(
-                "  {:>4} {:>10} {:>9} {:>14.6} {:>16}{}",
+                "  {:>4} {:>10} {:>9} {:>14.6} {:>16}{measured}{}",
                 l.info.lod,
                 l.info.triangles,
                 l.info.vertices,

@@ -315,6 +315,24 @@ pub(crate) fn compact(name: &str, src: &Mesh, indices: &[u32]) -> Result<Mesh> {
         .with_data(name, src.data.gather(&order))
 }
 
+/// How far `lod` lies from `lod0`'s vertices: the largest and the mean distance from each vertex of `lod0` to the
+/// nearest point of `lod`'s surface (object-space units). A measure of what a level gives up that does not come
+/// from the simplifier that made it, so that chains made by different tools compare (`lodbench describe
+/// --deviation`). Every vertex of a simplified level is a vertex of LOD0, so the other direction's vertex
+/// distances are 0.
+pub fn surface_deviation(lod0: &Mesh, lod: &Mesh) -> (f32, f32) {
+    let t = crate::geometry::morph::closest_surface(lod0, lod);
+    let d: Vec<f32> = lod0
+        .positions
+        .iter()
+        .zip(&t.positions)
+        .map(|(a, b)| glam::Vec3::from(*a).distance(glam::Vec3::from(*b)))
+        .collect();
+    let max = d.iter().copied().fold(0.0f32, f32::max);
+    let mean = d.iter().map(|&x| f64::from(x)).sum::<f64>() / d.len().max(1) as f64;
+    (max, mean as f32)
+}
+
 /// Distance at which an object-space error `error_abs` (at instance scale `scale`) projects to `pixel_error`
 /// pixels on a viewport `height_px` pixels high with vertical field of view `fov_y` (radians):
 /// `pixels = error * height / (2 d tan(fov/2))`, solved for d.

@@ -260,7 +260,13 @@ impl Mesh {
         let name = path.display().to_string();
         let bytes = read_mesh_file(path, &name)?;
         let dir = path.parent().unwrap_or(Path::new(""));
-        parse_gltf(&bytes, dir).map_err(|problem| mesh_error(&name, problem))
+        Mesh::parse_gltf(&name, &bytes, dir)
+    }
+
+    /// Parses a glTF (JSON or GLB) held in memory as [`Mesh::load_gltf`] does; external buffers are looked up in
+    /// `dir`, `name` is used in error messages.
+    pub fn parse_gltf(name: &str, bytes: &[u8], dir: &Path) -> Result<Mesh> {
+        parse_gltf(bytes, dir).map_err(|problem| mesh_error(name, problem))
     }
 
     /// Parses OBJ text held in memory; `name` is used in error messages.

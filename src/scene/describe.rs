@@ -89,6 +89,12 @@ pub struct LodDescription {
     /// "not reached by the sweep" for a bunny-scene switch nearer than the path's start ([`BunnyPath`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<&'static str>,
+    /// `lodbench describe --deviation`: the largest and the mean distance from LOD0's vertices to this LOD's
+    /// surface ([`crate::geometry::lod::surface_deviation`]), object-space units.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub deviation_max: Option<f32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub deviation_mean: Option<f32>,
 }
 
 /// The terrain's hierarchy, per level (None without the height field's grid, or where it does not build).
@@ -188,6 +194,19 @@ impl SceneDef {
         }
     }
 
+    /// [`SceneDef::describe`] with every LOD's measured deviation from LOD0 ([`LodDescription::deviation_max`]).
+    pub fn describe_with_deviation(&self, cfg: &SceneConfig) -> SceneDescription {
+        let mut d = self.describe(cfg);
+        for (model, desc) in self.models.iter().zip(&mut d.models) {
+            let lod0 = &model.chain.lods[0].mesh;
+            for (lod, l) in model.chain.lods.iter().zip(&mut desc.lods) {
+                let (max, mean) = crate::geometry::lod::surface_deviation(lod0, &lod.mesh);
+                (l.deviation_max, l.deviation_mean) = (Some(max), Some(mean));
+            }
+        }
+        d
+    }
+
     fn describe_model(&self, m: &Model) -> ModelDescription {
         let path = self.path();
         ModelDescription {
@@ -204,6 +223,8 @@ impl SceneDef {
                         (1.., Some(p)) if info.lod <= p.unreached => Some(NOT_REACHED),
                         _ => None,
                     },
+                    deviation_max: None,
+                    deviation_mean: None,
                     info,
                 })
                 .collect(),

@@ -46,6 +46,9 @@ mod ci_profile;
 mod regress;
 mod render;
 
+// The fuzz targets' corpora replayed (tests/fuzz/).
+mod fuzz_corpus;
+
 // The source tree: the import graph of src/ and the WGSL of shaders/.
 mod architecture;
 mod shaders;

@@ -5,7 +5,7 @@ folder's own files). Run from anywhere: python3 tests/data/gltf/make_own.py.
 - faceted-sphere.gltf: a UV sphere (24 segments, 12 rings, radius 1) drawn flat-shaded with a texture layout:
   every triangle has its own three vertices (its face normal on each; TEXCOORD_0 from longitude and latitude), so
   every vertex is split by a hard edge and the meridian at u = 0 / 1 is a texture seam. 528 triangles, 1584
-  vertices: the layout that gives a position-only simplifier nothing to collapse (Fox, SciFiHelmet).
+  vertices, indexed in order: the layout that gives a position-only simplifier nothing to collapse (Fox, SciFiHelmet).
 - lod-hierarchy.gltf: MSFT_lod as Microsoft's glTF-Toolkit writes it, on a scene root whose levels are node
   hierarchies: node 0 `Lamp_LOD0` (no mesh; children 1 and 2, each a tetrahedron, 1 and 2 units along +x),
   MSFT_lod ids [3]; node 3 `Lamp_LOD1`, outside the scene, with child 4 (one tetrahedron of 4 triangles at 1.5
@@ -68,6 +68,7 @@ def faceted_sphere(segments: int = 24, rings: int = 12) -> dict:
     data = b"".join(struct.pack("<3f", *p) for p in positions)
     data += b"".join(struct.pack("<3f", *n) for n in normals)
     data += b"".join(struct.pack("<2f", *t) for t in uvs)
+    data += struct.pack(f"<{count}H", *range(count))
     lo = [min(p[k] for p in positions) for k in range(3)]
     hi = [max(p[k] for p in positions) for k in range(3)]
     return {
@@ -76,16 +77,18 @@ def faceted_sphere(segments: int = 24, rings: int = 12) -> dict:
         "scenes": [{"nodes": [0]}],
         "nodes": [{"name": "FacetedSphere", "mesh": 0}],
         "meshes": [{"name": "FacetedSphere", "primitives": [
-            {"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "mode": 4}]}],
+            {"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "mode": 4}]}],
         "accessors": [
             {"bufferView": 0, "componentType": 5126, "count": count, "type": "VEC3", "min": lo, "max": hi},
             {"bufferView": 1, "componentType": 5126, "count": count, "type": "VEC3"},
             {"bufferView": 2, "componentType": 5126, "count": count, "type": "VEC2"},
+            {"bufferView": 3, "componentType": 5123, "count": count, "type": "SCALAR"},
         ],
         "bufferViews": [
             {"buffer": 0, "byteOffset": 0, "byteLength": 12 * count},
             {"buffer": 0, "byteOffset": 12 * count, "byteLength": 12 * count},
             {"buffer": 0, "byteOffset": 24 * count, "byteLength": 8 * count},
+            {"buffer": 0, "byteOffset": 32 * count, "byteLength": 2 * count},
         ],
         "buffers": [{"byteLength": len(data), "uri": data_uri(data)}],
     }
@@ -169,14 +172,16 @@ def still_and_moving() -> dict:
     times = struct.pack("<3f", 0.0, 1.0, 2.0)
     weights = struct.pack("<3f", 1.0, 0.0, 1.0)
     data += tetra + lift + times + weights
+    v = len(views)
     views += [view(base, 48), view(base + 48, 24), view(base + 72, 48), view(base + 120, 12), view(base + 132, 12)]
     n = len(accessors)
     accessors += [
-        {"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
-        {"bufferView": 4, "componentType": 5123, "count": 12, "type": "SCALAR"},
-        {"bufferView": 5, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0.5, 0]},
-        {"bufferView": 6, "componentType": 5126, "count": 3, "type": "SCALAR", "min": [0.0], "max": [2.0]},
-        {"bufferView": 7, "componentType": 5126, "count": 3, "type": "SCALAR"},
+        {"bufferView": v, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+        {"bufferView": v + 1, "componentType": 5123, "count": 12, "type": "SCALAR"},
+        {"bufferView": v + 2, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0],
+         "max": [0, 0.5, 0]},
+        {"bufferView": v + 3, "componentType": 5126, "count": 3, "type": "SCALAR", "min": [0.0], "max": [2.0]},
+        {"bufferView": v + 4, "componentType": 5126, "count": 3, "type": "SCALAR"},
     ]
     assert count == sphere["accessors"][0]["count"]
     return {
