@@ -39,7 +39,7 @@ use glam::{Mat4, Vec3};
 use std::path::Path;
 use std::sync::Arc;
 
-/// User scene `kind` (its path): the models and instances of the file.
+/// User scene `kind` (its path): the models and instances of the file, in named steps.
 pub fn def(
     kind: SceneKind,
     cfg: &SceneConfig,
@@ -65,85 +65,34 @@ pub fn def(
 
     // The models at rest, and how the clip moves their instances.
     let collected = models::Collector::new(file, &mut content, &rig).collect()?;
-    let tracks = match &clip {
-        Some(c) => motion::tracks(&content, &rig, c, pv.frames, &collected.instances),
-        None => vec![None; collected.instances.len()],
-    };
-    let rest: Vec<Mat4> = collected
-        .instances
-        .iter()
-        .map(|i| Mat4::from_rotation_translation(i.rotation, i.translation))
-        .collect();
-    let matrix_at = |i: usize, f: u32| -> Mat4 {
-        tracks[i]
-            .as_ref()
-            .map_or(rest[i], |t| t[(f as usize).min(t.len().saturating_sub(1))])
-    };
-
-    // The default flight's start: the whole scene on frame 0, deformed models as the clip poses them there.
+    let placed = Placed::new(&content, &rig, clip.as_ref(), pv.frames, &collected);
     let deform_specs: Vec<Option<models::DeformSpec>> =
         collected.models.iter().map(|p| p.deform.clone()).collect();
-    let first_poses = match &clip {
-        Some(c) => motion::first_poses(
-            c,
-            &rig,
-            &collected
-                .models
-                .iter()
-                .map(|m| &m.levels[0])
-                .collect::<Vec<_>>(),
-            &deform_specs,
-            &collected.instances,
-            &|k| matrix_at(k, 0),
-        ),
-        None => vec![None; collected.models.len()],
-    };
-    let spheres: Vec<(Vec3, f32)> = collected
-        .instances
-        .iter()
-        .enumerate()
-        .map(|(k, i)| {
-            let mesh = &collected.models[i.model].levels[0];
-            let (c, r) = match &first_poses[i.model] {
-                Some(p) => bounding_sphere_of(p),
-                None => mesh.bounding_sphere(),
-            };
-            let m = matrix_at(k, 0);
-            let s = m.to_scale_rotation_translation().0.abs().max_element();
-            (m.transform_point3(c), r * s)
-        })
-        .collect();
+
+    // The default flight's start: the whole scene on frame 0.
+    let spheres = first_frame_spheres(clip.as_ref(), &rig, &collected, &deform_specs, &placed);
     let sphere = flight::bounding_sphere(&spheres);
     let (eye0, start) = flight::start(sphere, pv, fov_y);
 
     // The LOD chains, a generated chain's levels at multiples of the distance its model is first seen from.
-    let pixel_error = cfg.pixel_error(kind, pv.height);
     let view = chains::View {
         cfg,
         pv,
         fov_y,
-        pixel_error,
+        pixel_error: cfg.pixel_error(kind, pv.height),
     };
-    let own_camera = camera.is_some() || cfg.camera_path.is_some();
-    let mut models: Vec<Model> = Vec::with_capacity(collected.models.len());
-    let mut chain_descriptions = Vec::new();
-    let pending = collected.models;
-    let mut collected_notes = collected.notes;
-    for (m, p) in pending.into_iter().enumerate() {
-        let radius = p.levels[0].bounding_sphere().1;
-        let fit = fit_distance(radius, pv.width, pv.height, fov_y);
-        let nearest = spheres
-            .iter()
-            .zip(&collected.instances)
-            .filter(|(_, i)| i.model == m)
-            .map(|(s, _)| s.0.distance(eye0))
-            .fold(f32::INFINITY, f32::min);
-        let seen_from = if own_camera { fit } else { fit.max(nearest) };
-        let (model, description, note) = chains::build(file, p, &view, seen_from)?;
-        models.push(model);
-        collected_notes.extend(note);
-        chain_descriptions.extend(description);
-    }
+    let first_seen = FirstSeen {
+        spheres: &spheres,
+        eye: (camera.is_none() && cfg.camera_path.is_none()).then_some(eye0),
+    };
+    let (mut models, chain_descriptions, mut notes) = build_models(
+        file,
+        collected.models,
+        &collected.instances,
+        &view,
+        &first_seen,
+    )?;
+    notes.splice(0..0, collected.notes);
     let instances: Vec<Instance> = collected
         .instances
         .iter()
@@ -162,45 +111,25 @@ pub fn def(
                 c,
                 rig,
                 pv.frames,
-                tracks.clone(),
+                placed.tracks.clone(),
                 motion::deformers(&deform_specs, &collected.instances),
             )
         })
         .filter(|a| !a.is_still());
     if let Some(a) = &animation {
-        motion::widen_to_poses(a, &mut models, &matrix_at);
+        motion::widen_to_poses(a, &mut models, &|i, f| placed.at(i, f));
+        notes.push(motion::note(file, a, instances.len()));
     }
-    let animation = animation.map(Arc::new);
 
     // The flight's end, the clip planes, and what the camera does.
-    let last = pv.frames.saturating_sub(1);
-    let ends: Vec<(Vec3, Option<f32>)> = instances
-        .iter()
-        .enumerate()
-        .map(|(k, i)| {
-            let m = &models[i.model as usize];
-            (
-                matrix_at(k, last).transform_point3(m.center),
-                m.switches.last().copied(),
-            )
-        })
-        .collect();
-    let end = flight::end(cfg, sphere.0, start, &ends);
+    let end = flight::end(
+        cfg,
+        sphere.0,
+        start,
+        &last_places(&models, &instances, &placed, pv.frames),
+    );
     let (from, to) = (eye0, sphere.0 + Vec3::Z * end);
-    let eyes: Vec<Vec3> = match &camera {
-        Some((_, c)) => c.eyes().collect(),
-        None => vec![from, to],
-    };
-    let reach = (0..pv.frames.max(1))
-        .step_by(((pv.frames / 64).max(1)) as usize)
-        .chain([last])
-        .flat_map(|f| instances.iter().enumerate().map(move |(k, i)| (k, i, f)))
-        .map(|(k, i, f)| {
-            let m = &models[i.model as usize];
-            let p = matrix_at(k, f).transform_point3(m.center);
-            eyes.iter().map(|e| p.distance(*e)).fold(0.0f32, f32::max) + m.radius
-        })
-        .fold(0.0f32, f32::max);
+    let (near, far) = clip_planes(&models, &instances, &placed, pv.frames, &camera, [from, to]);
     let camera_source = match &camera {
         Some((a, c)) => format!(
             "the file's camera animation (node {}, {} keys{}), resampled to the frames",
@@ -217,25 +146,6 @@ pub fn def(
             sphere.1
         ),
     };
-    let near = camera.as_ref().and_then(|c| c.0.znear).unwrap_or(
-        models
-            .iter()
-            .map(|m| m.radius)
-            .fold(f32::INFINITY, f32::min)
-            * 0.02,
-    );
-    let mut notes = collected_notes;
-    if let Some(a) = &animation {
-        notes.push(format!(
-            "{file}: animation {} '{}' plays ({:.3} s, looped at 60 frames a second): {} instance(s) move, {} \
-             model(s) deformed",
-            a.clip.index,
-            a.clip.name,
-            a.clip.end_s - a.clip.start_s,
-            (0..instances.len()).filter(|&i| a.instance_matrix(i, 0).is_some()).count(),
-            a.deformers.len()
-        ));
-    }
     let parts = UserParts {
         instance_count: instances.len(),
         instances,
@@ -243,17 +153,14 @@ pub fn def(
         to: to.to_array(),
         forward: [0.0, 0.0, -1.0],
         near,
-        far: camera
-            .as_ref()
-            .and_then(|c| c.0.zfar)
-            .unwrap_or(reach * 1.5),
+        far,
         scene_sphere: (sphere.0.to_array(), sphere.1),
         start,
         chains: chain_descriptions,
         fov_y: camera.as_ref().and_then(|c| c.0.yfov),
         camera: camera.map(|c| c.1),
         camera_source,
-        animation,
+        animation: animation.map(Arc::new),
         animations: content.animation_names(),
         notes,
         sources: collected
@@ -270,6 +177,175 @@ pub fn def(
         notes: Vec::new(),
     };
     Ok((set, parts))
+}
+
+/// Every instance's model-to-world matrix on every frame: its track where the clip moves it, else its rest
+/// placement.
+struct Placed {
+    tracks: Vec<Option<Vec<Mat4>>>,
+    rest: Vec<Mat4>,
+}
+
+impl Placed {
+    fn new(
+        content: &gltf::Content<'_>,
+        rig: &gltf::Rig,
+        clip: Option<&crate::scene::animated::Clip>,
+        frames: u32,
+        collected: &models::Collected,
+    ) -> Placed {
+        Placed {
+            tracks: match clip {
+                Some(c) => motion::tracks(content, rig, c, frames, &collected.instances),
+                None => vec![None; collected.instances.len()],
+            },
+            rest: collected
+                .instances
+                .iter()
+                .map(|i| Mat4::from_rotation_translation(i.rotation, i.translation))
+                .collect(),
+        }
+    }
+
+    fn at(&self, i: usize, f: u32) -> Mat4 {
+        self.tracks[i].as_ref().map_or(self.rest[i], |t| {
+            t[(f as usize).min(t.len().saturating_sub(1))]
+        })
+    }
+}
+
+/// Each instance's bounding sphere on frame 0 (world space), deformed models as the clip poses them there.
+fn first_frame_spheres(
+    clip: Option<&crate::scene::animated::Clip>,
+    rig: &gltf::Rig,
+    collected: &models::Collected,
+    deform_specs: &[Option<models::DeformSpec>],
+    placed: &Placed,
+) -> Vec<(Vec3, f32)> {
+    let levels0: Vec<&crate::geometry::mesh::Mesh> =
+        collected.models.iter().map(|m| &m.levels[0]).collect();
+    let poses = match clip {
+        Some(c) => {
+            motion::first_poses(c, rig, &levels0, deform_specs, &collected.instances, &|k| {
+                placed.at(k, 0)
+            })
+        }
+        None => vec![None; levels0.len()],
+    };
+    collected
+        .instances
+        .iter()
+        .enumerate()
+        .map(|(k, i)| {
+            let (c, r) = match &poses[i.model] {
+                Some(p) => bounding_sphere_of(p),
+                None => levels0[i.model].bounding_sphere(),
+            };
+            let m = placed.at(k, 0);
+            let s = m.to_scale_rotation_translation().0.abs().max_element();
+            (m.transform_point3(c), r * s)
+        })
+        .collect()
+}
+
+/// Where each model is first seen from: the default flight's first eye (None with the file's camera or
+/// `--camera-path`) and every instance's sphere on frame 0.
+struct FirstSeen<'a> {
+    spheres: &'a [(Vec3, f32)],
+    eye: Option<Vec3>,
+}
+
+/// Every model with its chain and switch distances, the authored chains' descriptions, and the notes the chains
+/// leave. A generated chain's levels are at multiples of the distance its model is first seen from: the nearest
+/// of its instances from the flight's first eye, never nearer than where the model alone fits the view.
+fn build_models(
+    file: &str,
+    pending: Vec<models::PendingModel>,
+    instances: &[models::PendingInstance],
+    view: &chains::View<'_>,
+    seen: &FirstSeen<'_>,
+) -> Result<(Vec<Model>, Vec<ChainDescription>, Vec<String>)> {
+    let (mut models, mut descriptions, mut notes) = (Vec::new(), Vec::new(), Vec::new());
+    for (m, p) in pending.into_iter().enumerate() {
+        let radius = p.levels[0].bounding_sphere().1;
+        let fit = fit_distance(radius, view.pv.width, view.pv.height, view.fov_y);
+        let nearest = match seen.eye {
+            Some(eye) => seen
+                .spheres
+                .iter()
+                .zip(instances)
+                .filter(|(_, i)| i.model == m)
+                .map(|(s, _)| s.0.distance(eye))
+                .fold(f32::INFINITY, f32::min),
+            None => fit,
+        };
+        let (model, description, note) = chains::build(file, p, view, fit.max(nearest))?;
+        models.push(model);
+        descriptions.extend(description);
+        notes.extend(note);
+    }
+    Ok((models, descriptions, notes))
+}
+
+/// Each instance's centre on the last frame and its model's last switch (what the flight's end must pass).
+fn last_places(
+    models: &[Model],
+    instances: &[Instance],
+    placed: &Placed,
+    frames: u32,
+) -> Vec<(Vec3, Option<f32>)> {
+    let last = frames.saturating_sub(1);
+    instances
+        .iter()
+        .enumerate()
+        .map(|(k, i)| {
+            let m = &models[i.model as usize];
+            (
+                placed.at(k, last).transform_point3(m.center),
+                m.switches.last().copied(),
+            )
+        })
+        .collect()
+}
+
+/// The clip planes: the file camera's when it gives them; else near at 0.02 of the smallest model's radius and far
+/// at 1.5 times the farthest any instance gets from the camera's eyes (its keys, or the flight's ends), over the
+/// frames (every 64th and the last).
+fn clip_planes(
+    models: &[Model],
+    instances: &[Instance],
+    placed: &Placed,
+    frames: u32,
+    camera: &Option<(
+        gltf::AnimatedCamera,
+        Arc<crate::scene::camera_path::CameraPath>,
+    )>,
+    flight: [Vec3; 2],
+) -> (f32, f32) {
+    let eyes: Vec<Vec3> = match camera {
+        Some((_, c)) => c.eyes().collect(),
+        None => flight.to_vec(),
+    };
+    let last = frames.saturating_sub(1);
+    let reach = (0..frames.max(1))
+        .step_by((frames / 64).max(1) as usize)
+        .chain([last])
+        .flat_map(|f| instances.iter().enumerate().map(move |(k, i)| (k, i, f)))
+        .map(|(k, i, f)| {
+            let m = &models[i.model as usize];
+            let p = placed.at(k, f).transform_point3(m.center);
+            eyes.iter().map(|e| p.distance(*e)).fold(0.0f32, f32::max) + m.radius
+        })
+        .fold(0.0f32, f32::max);
+    let smallest = models
+        .iter()
+        .map(|m| m.radius)
+        .fold(f32::INFINITY, f32::min);
+    let file = camera.as_ref().map(|c| (c.0.znear, c.0.zfar));
+    (
+        file.and_then(|c| c.0).unwrap_or(smallest * 0.02),
+        file.and_then(|c| c.1).unwrap_or(reach * 1.5),
+    )
 }
 
 /// The centre of the box of `points` and the radius of the sphere around it that holds them all.

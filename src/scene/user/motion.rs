@@ -178,6 +178,19 @@ pub fn deformers(specs: &[Option<DeformSpec>], instances: &[PendingInstance]) ->
         .collect()
 }
 
+/// The note a run prints of the clip that plays.
+pub fn note(file: &str, a: &Animated, instances: usize) -> String {
+    format!(
+        "{file}: animation {} '{}' plays ({:.3} s, looped at 60 frames a second): {} instance(s) move, {} model(s) \
+         deformed",
+        a.clip.index,
+        a.clip.name,
+        a.clip.end_s - a.clip.start_s,
+        (0..instances).filter(|&i| a.instance_matrix(i, 0).is_some()).count(),
+        a.deformers.len()
+    )
+}
+
 /// Widens each deformed model's reach and radius to every frame's pose (coverage tiles and shadow bounds rely
 /// on them).
 pub fn widen_to_poses(
