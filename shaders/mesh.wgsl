@@ -1,7 +1,12 @@
-// Mesh shading shared by every method: Lambert plus ambient with a per-instance colour, written to an sRGB
-// target (the hardware encodes). Instance data carries the object-to-world matrix, the colour (w: the
-// instance's animation angle in radians) and the transition parameters (x = k, y = alpha, z = LOD,
-// w = instance id) that the methods read.
+// Mesh drawing shared by every method, the part of it that does not depend on the scene's surfaces. A mesh
+// pipeline's shader is this file after one of shaders/surface/*.wgsl (src/gpu/pipelines.rs, `mesh_wgsl`):
+// `surface/flat.wgsl` (Lambert plus ambient with a per-instance colour: the built-in scenes, and user scenes with
+// --materials flat) or `surface/pbr.wgsl` (glTF's metallic-roughness materials with their textures). Each
+// defines VertexIn, MorphIn, VsOut (with at least the fields `transform` below writes), `vertex`,
+// `morph_vertex`, `masked` and `shade`; the entry points below call them. Colours are written to an sRGB target
+// (the hardware encodes). Instance data carries the object-to-world matrix, the colour (w: the instance's
+// animation angle in radians) and the transition parameters (x = k, y = alpha, z = LOD, w = instance id) that
+// the methods read.
 //
 // Per-vertex `aux` = (u, v, kind, hub_y) (src/geometry/mesh.rs): kind 1 and 2 are alpha-tested leaf cards (masks
 // over (u, v) below), kind 3 a windmill blade vertex, rotated about the axis parallel to +z through (0, hub_y) by
@@ -33,12 +38,6 @@ struct Camera {
 @group(0) @binding(1) var shadow_map: texture_depth_2d;
 @group(0) @binding(2) var shadow_sampler: sampler_comparison;
 
-struct VertexIn {
-    @location(0) position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(10) aux: vec4<f32>,
-};
-
 struct InstanceIn {
     @location(2) model_0: vec4<f32>,
     @location(3) model_1: vec4<f32>,
@@ -46,20 +45,6 @@ struct InstanceIn {
     @location(5) model_3: vec4<f32>,
     @location(6) color: vec4<f32>,
     @location(7) params: vec4<f32>,
-};
-
-struct VsOut {
-    // Invariant: passes that redraw the same geometry (depth-equal tests) get bit-identical depths.
-    @builtin(position) @invariant clip: vec4<f32>,
-    @location(0) normal: vec3<f32>,
-    @location(1) color: vec4<f32>,
-    @location(2) params: vec4<f32>,
-    @location(3) uv: vec2<f32>,
-    @location(4) @interpolate(flat) kind: f32,
-    // Object-space position before any animation (FSI's visibility-texture lookup).
-    @location(5) object: vec3<f32>,
-    // World-space position (the shadow lookup).
-    @location(6) world: vec3<f32>,
 };
 
 const KIND_LEAF: f32 = 1.0;
@@ -95,7 +80,14 @@ fn transform(position: vec3<f32>, normal: vec3<f32>, aux: vec4<f32>, inst: Insta
 
 @vertex
 fn vs_main(v: VertexIn, inst: InstanceIn) -> VsOut {
-    return transform(v.position, v.normal, v.aux, inst);
+    return vertex(v, inst);
+}
+
+// Geomorphing (Sheliemietiev et al. 2023 sections 10-11): each vertex of the finer LOD moves towards its target on
+// the coarser LOD by the morph weight params.x (`morph_vertex`).
+@vertex
+fn vs_morph(v: VertexIn, inst: InstanceIn, m: MorphIn) -> VsOut {
+    return morph_vertex(v, inst, m);
 }
 
 // The leaf masks of src/geometry/procgen.rs (`leaf_mask`, `leaf_cluster_mask`): keep the two in step.
@@ -114,11 +106,9 @@ fn leaf_cluster_mask(uv: vec2<f32>) -> bool {
     return leaf_mask(uv * 3.0 - c);
 }
 
-// True where an alpha-tested card has no leaf (the fragment is discarded by every method).
-fn masked(in: VsOut) -> bool {
-    if (!ALPHA_TEST) {
-        return false;
-    }
+// True where an alpha-tested leaf card (aux kinds 1 and 2) has no leaf (the fragment is discarded by every
+// method).
+fn aux_masked(in: VsOut) -> bool {
     if (in.kind == KIND_LEAF) {
         return !leaf_mask(in.uv);
     }
@@ -128,23 +118,14 @@ fn masked(in: VsOut) -> bool {
     return false;
 }
 
-// Geomorphing (Sheliemietiev et al. 2023 sections 10-11): each vertex of the finer LOD moves towards its target on the coarser
-// LOD by the morph weight params.x; the normal is interpolated and renormalised.
-struct MorphIn {
-    @location(8) target_position: vec3<f32>,
-    @location(9) target_normal: vec3<f32>,
-};
-
-@vertex
-fn vs_morph(v: VertexIn, inst: InstanceIn, m: MorphIn) -> VsOut {
-    let t = inst.params.x;
-    let n = mix(v.normal, m.target_normal, t);
-    let len = length(n);
-    var normal = v.normal;
-    if (len > 1e-6) {
-        normal = n / len;
+// --shader-work: a chain of dependent multiply-adds, each result in [0, 1), added with weight work.y.
+fn shader_work(world: vec3<f32>) -> vec3<f32> {
+    var w = fract(dot(world, vec3<f32>(0.1, 0.2, 0.3)));
+    let iterations = u32(camera.work.x);
+    for (var i = 0u; i < iterations; i = i + 1u) {
+        w = fract(w * 1.618034 + 0.318310);
     }
-    return transform(mix(v.position, m.target_position, t), normal, v.aux, inst);
+    return vec3<f32>(w * camera.work.y);
 }
 
 // The share of the light reaching `world`: a 3x3 percentage-closer filter of 2x2 bilinear depth comparisons
@@ -168,38 +149,18 @@ fn lit(world: vec3<f32>) -> f32 {
     return sum / 9.0;
 }
 
-fn shade(in: VsOut, front: bool) -> vec3<f32> {
-    var n = normalize(in.normal);
-    // Two-sided lighting: scanned meshes have holes, so back faces can be seen.
-    if (!front) {
-        n = -n;
-    }
-    var lambert = max(dot(n, camera.light.xyz), 0.0);
-    if (camera.shadow.x > 0.5) {
-        lambert = lambert * lit(in.world);
-    }
-    let ambient = camera.light.w;
-    // --shader-work: a chain of dependent multiply-adds, each result in [0, 1), added with weight work.y.
-    var w = fract(dot(in.world, vec3<f32>(0.1, 0.2, 0.3)));
-    let iterations = u32(camera.work.x);
-    for (var i = 0u; i < iterations; i = i + 1u) {
-        w = fract(w * 1.618034 + 0.318310);
-    }
-    return in.color.rgb * (ambient + (1.0 - ambient) * lambert) + vec3<f32>(w * camera.work.y);
-}
-
 @fragment
 fn fs_opaque(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     if (masked(in)) {
         discard;
     }
-    return vec4<f32>(shade(in, front), 1.0);
+    return shade(in, front);
 }
 
 // The shadow pass (src/gpu/shadow.rs): the caster seen from the light.
 @vertex
 fn vs_shadow(v: VertexIn, inst: InstanceIn) -> VsOut {
-    var out = transform(v.position, v.normal, v.aux, inst);
+    var out = vertex(v, inst);
     out.clip = camera.light_view_proj * vec4<f32>(out.world, 1.0);
     return out;
 }
@@ -230,7 +191,8 @@ fn fs_translucent(in: VsOut, @builtin(front_facing) front: bool) -> @location(0)
     if (masked(in)) {
         discard;
     }
-    return vec4<f32>(shade(in, front), in.params.y);
+    let c = shade(in, front);
+    return vec4<f32>(c.rgb, c.a * in.params.y);
 }
 
 // alpha-2pass colour pass: the depth attachment holds this object's own nearest surface (depth-equal test);
@@ -244,7 +206,8 @@ fn fs_translucent_occluded(in: VsOut, @builtin(front_facing) front: bool) -> @lo
     if (in.clip.z > behind || masked(in)) {
         discard;
     }
-    return vec4<f32>(shade(in, front), in.params.y);
+    let c = shade(in, front);
+    return vec4<f32>(c.rgb, c.a * in.params.y);
 }
 
 // alpha-sorted's peel (src/methods/alpha_sorted.rs, shaders/peel.wgsl): the translucent fragment, kept only behind the
@@ -258,7 +221,8 @@ fn fs_translucent_peel(in: VsOut, @builtin(front_facing) front: bool) -> @locati
     if (in.clip.z <= previous || masked(in)) {
         discard;
     }
-    return vec4<f32>(shade(in, front), in.params.y);
+    let c = shade(in, front);
+    return vec4<f32>(c.rgb, c.a * in.params.y);
 }
 
 // Noise blending (Sheliemietiev et al. 2023 section 9, eq. 3): a pixel of a t-instance keeps the incoming LOD where
@@ -291,7 +255,7 @@ fn fs_dither(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4
     if (keep_incoming != incoming || masked(in)) {
         discard;
     }
-    return vec4<f32>(shade(in, front), 1.0);
+    return shade(in, front);
 }
 
 // Frame Sequential Interpolation (Scherzer & Wimmer 2008 sections 3.2-3.5): the scene is drawn into a LOD buffer of colour,
@@ -312,7 +276,7 @@ fn fs_fsi_n(in: VsOut, @builtin(front_facing) front: bool) -> FsiOut {
         discard;
     }
     var out: FsiOut;
-    out.color = vec4<f32>(shade(in, front), 1.0);
+    out.color = shade(in, front);
     out.id = 0u;
     return out;
 }
@@ -357,7 +321,7 @@ fn fs_fsi_t_blend(in: VsOut, @builtin(front_facing) front: bool) -> FsiOut {
 
 fn fsi_t_out(in: VsOut, front: bool) -> FsiOut {
     var out: FsiOut;
-    out.color = vec4<f32>(shade(in, front), 1.0);
+    out.color = shade(in, front);
     // params is interpolated: a constant can come out a hair below the integer. Back faces write the next id
     // (src/methods/fsi.rs, `back_id`), so the combination never averages an object's inside with its front.
     let id = u32(round(in.params.w));

@@ -118,6 +118,7 @@ impl SceneConfig {
                 .map(crate::scene::config::AnimationChoice::parse)
                 .unwrap_or_default(),
             simplify: a.simplify,
+            materials: a.materials,
             shader_work: a.shader_work,
             schedule,
             camera: a.camera,

@@ -234,6 +234,11 @@ pub struct SceneArgs {
     /// collapsible, texture seams protected) or `positions` (positions alone: split vertices keep their seams).
     #[arg(long, value_enum, default_value_t = crate::geometry::lod::Simplify::Attributes)]
     pub simplify: crate::geometry::lod::Simplify,
+    /// glTF scenes (`--scene FILE.glb`): `full` draws the file's materials (metallic-roughness, textures, normal
+    /// maps, alpha modes, vertex colours); `flat` draws each model in one colour, Lambert and ambient, reading no
+    /// texture (the built-in scenes' look: the silhouette's popping alone).
+    #[arg(long, value_enum, default_value_t = crate::geometry::material::MaterialMode::Full)]
+    pub materials: crate::geometry::material::MaterialMode,
     /// glTF scenes (`--scene FILE.glb`): the animation that plays over the frames, by index or name, or `none`
     /// (the scene at rest). Default: the file's first animation, 60 frames a second of clip time, looped.
     #[arg(long)]

@@ -1,5 +1,5 @@
 //! Per-vertex data a mesh carries besides its positions and normals: texture coordinates, tangents and colours
-//! (drawn by nothing yet; kept so that every LOD has them), and what deforms it: skin influences and morph
+//! (what a user scene's materials sample, `shaders/surface_pbr.wgsl`), and what deforms it: skin influences and morph
 //! targets. Every simplified vertex is an original vertex, so each LOD gathers all of it by index
 //! ([`VertexData::gather`]) and indexes the same joints and targets.
 
@@ -40,6 +40,8 @@ pub struct MorphTarget {
 pub struct Deformable {
     pub base_positions: Vec<[f32; 3]>,
     pub base_normals: Vec<[f32; 3]>,
+    /// The undeformed tangents, when the mesh has them (turned with the skin; morph targets do not move them).
+    pub base_tangents: Option<Vec<[f32; 4]>>,
     pub skin: Option<SkinInfluences>,
     pub targets: Vec<MorphTarget>,
 }
@@ -49,6 +51,8 @@ pub struct Deformable {
 pub struct VertexData {
     /// TEXCOORD_0.
     pub uv0: Option<Vec<[f32; 2]>>,
+    /// TEXCOORD_1.
+    pub uv1: Option<Vec<[f32; 2]>>,
     /// TANGENT: xyz, and w the bitangent's sign.
     pub tangents: Option<Vec<[f32; 4]>>,
     /// COLOR_0, linear RGBA.
@@ -66,12 +70,14 @@ impl VertexData {
     pub fn gather(&self, order: &[u32]) -> VertexData {
         VertexData {
             uv0: self.uv0.as_deref().map(|v| gather(v, order)),
+            uv1: self.uv1.as_deref().map(|v| gather(v, order)),
             tangents: self.tangents.as_deref().map(|v| gather(v, order)),
             colors: self.colors.as_deref().map(|v| gather(v, order)),
             deform: self.deform.as_ref().map(|d| {
                 Box::new(Deformable {
                     base_positions: gather(&d.base_positions, order),
                     base_normals: gather(&d.base_normals, order),
+                    base_tangents: d.base_tangents.as_deref().map(|t| gather(t, order)),
                     skin: d.skin.as_ref().map(|s| {
                         let n = s.per_vertex;
                         let mut joints = Vec::with_capacity(order.len() * n);
@@ -117,11 +123,13 @@ impl VertexData {
             Ok(())
         }
         each("texture coordinates", &self.uv0, n)?;
+        each("second texture coordinates", &self.uv1, n)?;
         each("tangents", &self.tangents, n)?;
         each("colours", &self.colors, n)?;
         let Some(d) = &self.deform else { return Ok(()) };
         each("bind-pose positions", &Some(d.base_positions.clone()), n)?;
         each("bind-pose normals", &Some(d.base_normals.clone()), n)?;
+        each("bind-pose tangents", &d.base_tangents, n)?;
         if let Some(s) = &d.skin {
             if s.per_vertex == 0
                 || s.joints.len() != n * s.per_vertex
@@ -176,11 +184,13 @@ mod tests {
     fn data() -> VertexData {
         VertexData {
             uv0: Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
+            uv1: None,
             tangents: None,
             colors: Some(vec![[1.0; 4], [0.5; 4], [0.25; 4]]),
             deform: Some(Box::new(Deformable {
                 base_positions: vec![[0.0; 3], [1.0; 3], [2.0; 3]],
                 base_normals: vec![[0.0, 1.0, 0.0]; 3],
+                base_tangents: None,
                 skin: Some(SkinInfluences {
                     per_vertex: 4,
                     joints: vec![0, 1, 0, 0, 1, 0, 0, 0, 2, 1, 0, 0],

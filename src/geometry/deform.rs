@@ -38,6 +38,19 @@ pub fn deform(
     positions: &mut [[f32; 3]],
     normals: &mut [[f32; 3]],
 ) {
+    deform_with_tangents(d, weights, placing, positions, normals, None);
+}
+
+/// [`deform`], and the tangents turned by the same matrices into `tangents` when `d` has them (their
+/// handedness flipped where a matrix mirrors).
+pub fn deform_with_tangents(
+    d: &Deformable,
+    weights: &[f32],
+    placing: Placing<'_>,
+    positions: &mut [[f32; 3]],
+    normals: &mut [[f32; 3]],
+    mut tangents: Option<&mut [[f32; 4]]>,
+) {
     let active: Vec<(usize, f32)> = weights
         .iter()
         .copied()
@@ -75,6 +88,14 @@ pub fn deform(
         };
         positions[v] = m.transform_point3(p).to_array();
         normals[v] = (nm * n).try_normalize().unwrap_or(n).to_array();
+        if let (Some(out), Some(base)) = (tangents.as_deref_mut(), &d.base_tangents) {
+            let [x, y, z, w] = base[v];
+            let t = Vec3::new(x, y, z);
+            let linear = Mat3::from_mat4(m);
+            let turned = (linear * t).try_normalize().unwrap_or(t);
+            let sign = if linear.determinant() < 0.0 { -w } else { w };
+            out[v] = [turned.x, turned.y, turned.z, sign];
+        }
     }
 }
 
@@ -87,6 +108,7 @@ mod tests {
         Deformable {
             base_positions: vec![[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
             base_normals: vec![[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]],
+            base_tangents: Some(vec![[1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0]]),
             skin: Some(SkinInfluences {
                 per_vertex: 4,
                 joints: vec![0, 1, 0, 0, 1, 0, 0, 0],
@@ -117,9 +139,13 @@ mod tests {
             Mat4::IDENTITY,
             Mat4::from_rotation_z(std::f32::consts::FRAC_PI_2),
         ];
-        deform(&d, &[], Placing::Skin(&rot), &mut p, &mut n);
+        let mut t = vec![[0.0; 4]; 2];
+        deform_with_tangents(&d, &[], Placing::Skin(&rot), &mut p, &mut n, Some(&mut t));
         assert!(Vec3::from(p[1]).abs_diff_eq(Vec3::new(-2.0, 0.0, 0.0), 1e-6));
         assert!(Vec3::from(n[1]).abs_diff_eq(Vec3::Y, 1e-6));
+        // The tangent turns with the joint: +x to +y, its sign kept.
+        assert!(Vec3::from_slice(&t[1][..3]).abs_diff_eq(Vec3::Y, 1e-6));
+        assert_eq!(t[1][3], 1.0);
     }
 
     /// A rigid placing applies one matrix; normals follow the inverse transpose, and a mirror keeps a normal on

@@ -48,7 +48,7 @@ impl AttributeSeams {
                 values.extend_from_slice(&c[v][..3]);
             }
         }
-        let mut locks = vec![meshopt::SimplifyVertex::empty(); mesh.vertex_count()];
+        let mut locks = material_borders(mesh, adapter);
         if let Some(uv) = uv {
             let remap = meshopt::generate_position_remap(adapter);
             let mut seam = vec![false; mesh.vertex_count()];
@@ -59,7 +59,7 @@ impl AttributeSeams {
             }
             for (v, &r) in remap.iter().enumerate() {
                 if seam[r as usize] {
-                    locks[v] = meshopt::SimplifyVertex::Protect;
+                    locks[v] |= meshopt::SimplifyVertex::Protect;
                 }
             }
         }
@@ -69,6 +69,66 @@ impl AttributeSeams {
             locks,
         }
     }
+}
+
+/// Per vertex, `Lock` where its position is shared by vertices of two materials ([`Mesh::parts`]), empty
+/// elsewhere: each material's triangles are simplified on their own ([`simplify_runs`]), and a border between two
+/// materials stays where it is, so that neither side opens a crack in the other.
+fn material_borders(
+    mesh: &Mesh,
+    adapter: &meshopt::VertexDataAdapter<'_>,
+) -> Vec<meshopt::SimplifyVertex> {
+    let mut locks = vec![meshopt::SimplifyVertex::empty(); mesh.vertex_count()];
+    if mesh.parts.len() < 2 {
+        return locks;
+    }
+    let mut material = vec![u32::MAX; mesh.vertex_count()];
+    for p in &mesh.parts {
+        let a = p.first_index as usize;
+        for &i in &mesh.indices[a..a + p.index_count as usize] {
+            material[i as usize] = p.material;
+        }
+    }
+    let remap = meshopt::generate_position_remap(adapter);
+    // Per welded position: the material of its first vertex, and whether another material shares it.
+    let mut first = vec![u32::MAX; mesh.vertex_count()];
+    let mut shared = vec![false; mesh.vertex_count()];
+    for (v, &r) in remap.iter().enumerate() {
+        let (m, r) = (material[v], r as usize);
+        if m == u32::MAX {
+            continue;
+        }
+        if first[r] == u32::MAX {
+            first[r] = m;
+        } else if first[r] != m {
+            shared[r] = true;
+        }
+    }
+    for (v, &r) in remap.iter().enumerate() {
+        if shared[r as usize] {
+            locks[v] = meshopt::SimplifyVertex::Lock;
+        }
+    }
+    locks
+}
+
+/// Each material run's simplified indices (material None: the mesh has no parts).
+type Runs = Vec<(Option<u32>, Vec<u32>)>;
+
+/// Simplifies each material run of `mesh` on its own (`simplify` gives a run's indices and error), so that no
+/// triangle joins vertices of two materials: the runs' results in order, and the largest error.
+fn simplify_runs(mesh: &Mesh, mut simplify: impl FnMut(&[u32]) -> (Vec<u32>, f32)) -> (Runs, f32) {
+    let mut worst = 0.0f32;
+    let runs = mesh
+        .runs()
+        .into_iter()
+        .map(|(material, range)| {
+            let (indices, error) = simplify(&mesh.indices[range]);
+            worst = worst.max(error);
+            (material, indices)
+        })
+        .collect();
+    (runs, worst)
 }
 
 /// Default triangle targets, as fractions of LOD0 (100 / 50 / 25 / 10 %).
@@ -135,18 +195,34 @@ impl LodChain {
             target_fraction: 1.0,
             error_abs: 0.0,
         }];
+        let borders = material_borders(mesh, &adapter);
         for &fraction in &targets[1..] {
-            let target_indices = target_index_count(mesh.indices.len(), fraction);
-            let mut error = 0.0f32;
-            let indices = meshopt::simplify(
-                &mesh.indices,
-                &adapter,
-                target_indices,
-                f32::MAX,
-                meshopt::SimplifyOptions::ErrorAbsolute,
-                Some(&mut error),
-            );
-            if indices.is_empty() {
+            let (runs, error) = simplify_runs(mesh, |run| {
+                let target_indices = target_index_count(run.len(), fraction);
+                let mut error = 0.0f32;
+                let indices = if mesh.parts.len() < 2 {
+                    meshopt::simplify(
+                        run,
+                        &adapter,
+                        target_indices,
+                        f32::MAX,
+                        meshopt::SimplifyOptions::ErrorAbsolute,
+                        Some(&mut error),
+                    )
+                } else {
+                    meshopt::simplify_with_locks(
+                        run,
+                        &adapter,
+                        &borders,
+                        target_indices,
+                        f32::MAX,
+                        meshopt::SimplifyOptions::ErrorAbsolute,
+                        Some(&mut error),
+                    )
+                };
+                (indices, error)
+            });
+            if runs.iter().all(|(_, r)| r.is_empty()) {
                 return Err(Error::Mesh {
                     path: name.to_string(),
                     problem: format!(
@@ -156,7 +232,7 @@ impl LodChain {
                 });
             }
             lods.push(Lod {
-                mesh: compact(name, mesh, &indices)?,
+                mesh: compact_runs(name, mesh, &runs)?,
                 target_fraction: fraction,
                 error_abs: error,
             });
@@ -192,6 +268,7 @@ impl LodChain {
             Simplify::Attributes => Some(AttributeSeams::of(mesh, &adapter)),
             Simplify::Positions => None,
         };
+        let borders = material_borders(mesh, &adapter);
         let t0 = mesh.triangle_count();
         let mut lods = vec![Lod {
             mesh: mesh.clone(),
@@ -199,36 +276,50 @@ impl LodChain {
             error_abs: 0.0,
         }];
         for &bound in errors_abs {
-            let mut error = 0.0f32;
-            let indices = match &seams {
-                None => meshopt::simplify(
-                    &mesh.indices,
-                    &adapter,
-                    3,
-                    bound,
-                    meshopt::SimplifyOptions::ErrorAbsolute,
-                    Some(&mut error),
-                ),
-                Some(s) => meshopt::simplify_with_attributes_and_locks(
-                    &mesh.indices,
-                    &adapter,
-                    &s.values,
-                    &s.weights,
-                    s.weights.len() * 4,
-                    &s.locks,
-                    3,
-                    bound,
-                    meshopt::SimplifyOptions::ErrorAbsolute | meshopt::SimplifyOptions::Permissive,
-                    Some(&mut error),
-                ),
-            };
+            let (runs, error) = simplify_runs(mesh, |run| {
+                let mut error = 0.0f32;
+                let indices = match &seams {
+                    None if mesh.parts.len() < 2 => meshopt::simplify(
+                        run,
+                        &adapter,
+                        3,
+                        bound,
+                        meshopt::SimplifyOptions::ErrorAbsolute,
+                        Some(&mut error),
+                    ),
+                    None => meshopt::simplify_with_locks(
+                        run,
+                        &adapter,
+                        &borders,
+                        3,
+                        bound,
+                        meshopt::SimplifyOptions::ErrorAbsolute,
+                        Some(&mut error),
+                    ),
+                    Some(s) => meshopt::simplify_with_attributes_and_locks(
+                        run,
+                        &adapter,
+                        &s.values,
+                        &s.weights,
+                        s.weights.len() * 4,
+                        &s.locks,
+                        3,
+                        bound,
+                        meshopt::SimplifyOptions::ErrorAbsolute
+                            | meshopt::SimplifyOptions::Permissive,
+                        Some(&mut error),
+                    ),
+                };
+                (indices, error)
+            });
+            let kept: usize = runs.iter().map(|(_, r)| r.len()).sum();
             let previous = lods.last().map_or(t0, |l| l.mesh.triangle_count());
-            if indices.is_empty() || indices.len() / 3 * 100 > previous * 95 {
+            if runs.iter().all(|(_, r)| r.is_empty()) || kept / 3 * 100 > previous * 95 {
                 continue;
             }
             lods.push(Lod {
-                mesh: compact(name, mesh, &indices)?,
-                target_fraction: (indices.len() / 3) as f32 / t0 as f32,
+                mesh: compact_runs(name, mesh, &runs)?,
+                target_fraction: (kept / 3) as f32 / t0 as f32,
                 error_abs: error,
             });
         }
@@ -292,6 +383,25 @@ impl LodChain {
             })
             .collect()
     }
+}
+
+/// [`compact`] of the runs' indices one after the other, the runs (material, indices) becoming the mesh's
+/// parts (a run of material None: the mesh has no parts).
+pub(crate) fn compact_runs(
+    name: &str,
+    src: &Mesh,
+    runs: &[(Option<u32>, Vec<u32>)],
+) -> Result<Mesh> {
+    let all: Vec<u32> = runs.iter().flat_map(|(_, r)| r.iter().copied()).collect();
+    let mesh = compact(name, src, &all)?;
+    if src.parts.is_empty() {
+        return Ok(mesh);
+    }
+    let counts: Vec<(u32, u32)> = runs
+        .iter()
+        .map(|(m, r)| (m.unwrap_or(0), r.len() as u32))
+        .collect();
+    mesh.with_parts(name, &counts)
 }
 
 /// Keeps only the vertices `indices` reference (in first-use order), with LOD0's normals, shading extras and

@@ -26,6 +26,18 @@ pub struct Mesh {
     /// Texture coordinates, tangents, colours, skin and morph targets, where the source has them
     /// ([`Mesh::with_data`]); simplification keeps them ([`VertexData::gather`]).
     pub data: VertexData,
+    /// The triangles by material, in runs covering `indices` in order ([`Mesh::with_parts`]); empty: the whole
+    /// mesh in the scene's one flat look (every built-in scene).
+    pub parts: Vec<Part>,
+}
+
+/// A run of a mesh's triangles drawn with one material: `index_count` indices from `first_index`, material
+/// `material` of the scene's [`crate::geometry::material::Materials`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Part {
+    pub material: u32,
+    pub first_index: u32,
+    pub index_count: u32,
 }
 
 /// `aux` kinds (the shader reads them as floats).
@@ -110,7 +122,56 @@ impl Mesh {
             indices,
             aux,
             data: VertexData::default(),
+            parts: Vec::new(),
         })
+    }
+
+    /// Sets the material runs: (material, index count) in order, covering every index, each a whole number of
+    /// triangles (runs of no index are dropped).
+    pub fn with_parts(mut self, name: &str, runs: &[(u32, u32)]) -> Result<Mesh> {
+        let mut parts = Vec::with_capacity(runs.len());
+        let mut at = 0u64;
+        for &(material, count) in runs {
+            if count % 3 != 0 {
+                return Err(mesh_error(
+                    name,
+                    format!("a material run of {count} indices is not whole triangles"),
+                ));
+            }
+            if count > 0 {
+                parts.push(Part {
+                    material,
+                    first_index: at as u32,
+                    index_count: count,
+                });
+            }
+            at += u64::from(count);
+        }
+        if at != self.indices.len() as u64 {
+            return Err(mesh_error(
+                name,
+                format!(
+                    "material runs cover {at} of its {} indices",
+                    self.indices.len()
+                ),
+            ));
+        }
+        self.parts = parts;
+        Ok(self)
+    }
+
+    /// The material runs as (material, index range); one run of material None when the mesh has none.
+    pub fn runs(&self) -> Vec<(Option<u32>, std::ops::Range<usize>)> {
+        if self.parts.is_empty() {
+            return vec![(None, 0..self.indices.len())];
+        }
+        self.parts
+            .iter()
+            .map(|p| {
+                let a = p.first_index as usize;
+                (Some(p.material), a..a + p.index_count as usize)
+            })
+            .collect()
     }
 
     /// Sets the per-vertex `aux` data (one entry per vertex, finite).

@@ -91,6 +91,70 @@ pub fn morph_targets(fine: &Mesh, coarse: &Mesh, how: Correspondence) -> Arc<Mor
     t
 }
 
+/// [`morph_targets`] within each material: a fine vertex of a material's triangles targets the coarse LOD's
+/// triangles of the same material (a target on another material's surface would take its texture coordinates
+/// from another texture's layout), or the whole coarse mesh where the coarse LOD lost that material. The same as
+/// [`morph_targets`] for a mesh of one material or none.
+pub fn morph_targets_by_material(
+    fine: &Mesh,
+    coarse: &Mesh,
+    how: Correspondence,
+) -> Arc<MorphTargets> {
+    if fine.parts.len() < 2 {
+        return morph_targets(fine, coarse, how);
+    }
+    let mut out = MorphTargets {
+        positions: fine.positions.clone(),
+        normals: fine.normals.clone(),
+        sources: vec![[(0, 0.0); 3]; fine.positions.len()],
+    };
+    for part in &fine.parts {
+        let (sub_fine, fine_order) = sub_mesh(fine, part.material);
+        let (sub_coarse, coarse_order) =
+            match coarse.parts.iter().any(|p| p.material == part.material) {
+                true => sub_mesh(coarse, part.material),
+                false => (coarse.clone(), (0..coarse.vertex_count() as u32).collect()),
+            };
+        let t = morph_targets(&sub_fine, &sub_coarse, how);
+        for (k, &v) in fine_order.iter().enumerate() {
+            let v = v as usize;
+            out.positions[v] = t.positions[k];
+            out.normals[v] = t.normals[k];
+            out.sources[v] = t.sources[k].map(|(i, w)| (coarse_order[i as usize], w));
+        }
+    }
+    Arc::new(out)
+}
+
+/// The triangles of `mesh`'s parts of `material` as a mesh of their own, and each of its vertices' index in
+/// `mesh`.
+fn sub_mesh(mesh: &Mesh, material: u32) -> (Mesh, Vec<u32>) {
+    let mut remap = vec![u32::MAX; mesh.vertex_count()];
+    let mut order = Vec::new();
+    let mut indices = Vec::new();
+    for p in mesh.parts.iter().filter(|p| p.material == material) {
+        let a = p.first_index as usize;
+        for &i in &mesh.indices[a..a + p.index_count as usize] {
+            let slot = &mut remap[i as usize];
+            if *slot == u32::MAX {
+                *slot = order.len() as u32;
+                order.push(i);
+            }
+            indices.push(*slot);
+        }
+    }
+    let pick = |v: &[[f32; 3]]| order.iter().map(|&i| v[i as usize]).collect::<Vec<_>>();
+    let sub = Mesh {
+        positions: pick(&mesh.positions),
+        normals: pick(&mesh.normals),
+        indices,
+        aux: order.iter().map(|&i| mesh.aux[i as usize]).collect(),
+        data: Default::default(),
+        parts: Vec::new(),
+    };
+    (sub, order)
+}
+
 fn mesh_hash(m: &Mesh) -> u64 {
     let mut h = std::collections::hash_map::DefaultHasher::new();
     bytemuck::cast_slice::<_, u8>(&m.positions).hash(&mut h);

@@ -70,6 +70,14 @@ pub struct DrawList {
 }
 
 impl DrawList {
+    /// A list of these draws alone (their instances already uploaded).
+    pub fn of_draws(draws: Vec<Draw>) -> DrawList {
+        DrawList {
+            draws,
+            ..Default::default()
+        }
+    }
+
     pub fn clear(&mut self) {
         self.items.clear();
         self.instances.clear();

@@ -10,6 +10,7 @@ pub mod pipelines;
 pub mod readback;
 pub mod scene_gpu;
 pub mod shadow_pass;
+pub mod surface;
 pub mod taa_resolve;
 pub mod targets;
 pub mod timing;
@@ -17,7 +18,10 @@ pub mod timing;
 pub use context::{AdapterSummary, GpuContext, TimingSource};
 pub use draw_list::{Draw, DrawList, DrawStats, InstanceRaw, PipelineIndex, Selection};
 pub use instances::{changed_runs, InstanceBuffer, UploadCounters};
-pub use pipelines::{vertex_layouts, MeshPipeline, Vertex, MESH_WGSL};
+pub use pipelines::{
+    mesh_wgsl, MaterialClass, MeshPipeline, MeshPipelines, Surface, SurfaceTarget, SurfaceVertex,
+    Vertex,
+};
 pub use readback::{read_texture, TextureReadback};
-pub use scene_gpu::{LodRange, SceneGpu, AMBIENT, LIGHT_DIR};
+pub use scene_gpu::{surface_vertex, LodRange, PartRange, SceneGpu, AMBIENT, LIGHT_DIR};
 pub use targets::{texture_2d, RenderTarget, ATTACHMENT_READ};

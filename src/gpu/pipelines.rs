@@ -1,5 +1,6 @@
-//! The mesh pipeline factory: one pipeline over the shared vertex layout and shaders/mesh.wgsl per depth,
-//! blend and entry-point setting a method asks for.
+//! The mesh pipeline factory: pipelines over the shared vertex layout and the scene's mesh shader
+//! (shaders/mesh.wgsl after one of shaders/surface/*.wgsl) per depth, blend and entry-point setting a method
+//! asks for, one variant per material class the scene draws (culling, blending).
 
 use crate::formats::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::gpu::draw_list::InstanceRaw;
@@ -15,9 +16,130 @@ pub struct Vertex {
     pub aux: [f32; 4],
 }
 
-pub const MESH_WGSL: &str = include_str!("../../shaders/mesh.wgsl");
+/// A vertex's material attributes (the PBR surface's second vertex buffer, slot 3).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct SurfaceVertex {
+    /// TEXCOORD_0 in xy, TEXCOORD_1 in zw.
+    pub tex: [f32; 4],
+    pub tangent: [f32; 4],
+    /// COLOR_0, linear RGBA.
+    pub color: [f32; 4],
+}
 
-pub fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 2] {
+/// geomorph's target of a vertex's material attributes on the coarser LOD (slot 4 with the PBR surface).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct SurfaceTarget {
+    pub tex: [f32; 4],
+    pub tangent: [f32; 4],
+}
+
+/// The part of the mesh shader that is the scene's surface (shaders/surface/).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Surface {
+    /// `surface/flat.wgsl`: Lambert and ambient in the instance's colour (the built-in scenes).
+    Flat,
+    /// `surface/pbr.wgsl`: glTF materials, with the surface vertex buffer and a material bind group (group 2).
+    Pbr,
+}
+
+pub const MESH_WGSL: &str = include_str!("../../shaders/mesh.wgsl");
+pub const SURFACE_FLAT_WGSL: &str = include_str!("../../shaders/surface/flat.wgsl");
+pub const SURFACE_PBR_WGSL: &str = include_str!("../../shaders/surface/pbr.wgsl");
+
+/// The mesh shader of `surface`: the surface's file, then shaders/mesh.wgsl (the entry points).
+pub fn mesh_wgsl(surface: Surface) -> String {
+    let s = match surface {
+        Surface::Flat => SURFACE_FLAT_WGSL,
+        Surface::Pbr => SURFACE_PBR_WGSL,
+    };
+    format!("{s}\n{MESH_WGSL}")
+}
+
+/// The bind group index of a material (the PBR surface); a method's own groups are 1.
+pub const MATERIAL_GROUP: u32 = 2;
+
+/// How a part's pipeline differs from its method's: its faces culled (a single-sided material), blended (a
+/// BLEND material). The flat surface has class 0 alone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct MaterialClass(pub u8);
+
+impl MaterialClass {
+    pub const PLAIN: MaterialClass = MaterialClass(0);
+    const CULL: u8 = 1;
+    const BLEND: u8 = 2;
+
+    pub fn new(single_sided: bool, blend: bool) -> MaterialClass {
+        MaterialClass(
+            if single_sided { Self::CULL } else { 0 } | if blend { Self::BLEND } else { 0 },
+        )
+    }
+
+    pub fn culls(self) -> bool {
+        self.0 & Self::CULL != 0
+    }
+
+    pub fn blends(self) -> bool {
+        self.0 & Self::BLEND != 0
+    }
+
+    fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// Blending of a BLEND material's fragment over what is behind it, the target's alpha kept.
+const BLEND_OVER: wgpu::BlendState = wgpu::BlendState {
+    color: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::SrcAlpha,
+        dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+        operation: wgpu::BlendOperation::Add,
+    },
+    alpha: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::Zero,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    },
+};
+
+/// One method pipeline in each material class the scene draws; a class the pipeline does not draw (BLEND parts
+/// in a depth-only pass) has none, and its parts are skipped.
+pub struct MeshPipelines {
+    variants: [Option<wgpu::RenderPipeline>; 4],
+    /// The first class's variant (every set has one).
+    first: wgpu::RenderPipeline,
+}
+
+impl MeshPipelines {
+    /// The pipeline of `class`, when the method draws it.
+    pub fn get(&self, class: MaterialClass) -> Option<&wgpu::RenderPipeline> {
+        self.variants.get(class.index()).and_then(Option::as_ref)
+    }
+
+    /// The pipeline of the first class the scene has: the plain class of the flat surface, which the unified
+    /// scenes' methods draw with.
+    pub fn base(&self) -> &wgpu::RenderPipeline {
+        &self.first
+    }
+}
+
+/// What the scene gives every mesh pipeline: its shader, camera layout, surface and material classes.
+pub struct PipelineContext<'a> {
+    pub device: &'a wgpu::Device,
+    pub shader: &'a wgpu::ShaderModule,
+    pub camera_layout: &'a wgpu::BindGroupLayout,
+    pub alpha_test: bool,
+    pub surface: Surface,
+    /// The material bind group layout (the PBR surface).
+    pub material_layout: Option<&'a wgpu::BindGroupLayout>,
+    /// The classes the scene's parts have (the plain class alone for the flat surface).
+    pub classes: &'a [MaterialClass],
+    /// Faces culled where neither the descriptor nor the class says (back faces in the unified scenes).
+    pub cull: Option<wgpu::Face>,
+}
+
+fn vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 2] {
     const VERTEX: [wgpu::VertexAttribute; 3] =
         wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 10 => Float32x4];
     const INSTANCE: [wgpu::VertexAttribute; 6] = wgpu::vertex_attr_array![
@@ -49,13 +171,13 @@ pub struct MeshPipeline<'a> {
     /// A second colour target of this format (FSI's instance-id target).
     pub id_target: Option<wgpu::TextureFormat>,
     /// Faces culled (None for every shared pipeline: scanned meshes have holes through which their inside is
-    /// seen). `SceneGpu::mesh_pipeline` puts the scene's own culling in place of None (back faces in the
-    /// unified scenes).
+    /// seen). The scene's own culling takes the place of None (back faces in the unified scenes), and a
+    /// single-sided material's class culls back faces.
     pub cull: Option<wgpu::Face>,
     pub depth_compare: wgpu::CompareFunction,
     pub depth_write: bool,
     pub blend: Option<wgpu::BlendState>,
-    /// Bind group layouts after the camera's (group 0).
+    /// Bind group layouts after the camera's (group 0): the method's own (group 1).
     pub extra_layouts: &'a [&'a wgpu::BindGroupLayout],
 }
 
@@ -75,44 +197,54 @@ impl MeshPipeline<'_> {
     }
 }
 
-pub(crate) fn mesh_pipeline(
-    device: &wgpu::Device,
-    shader: &wgpu::ShaderModule,
-    camera_layout: &wgpu::BindGroupLayout,
-    alpha_test: bool,
-    d: &MeshPipeline<'_>,
-) -> wgpu::RenderPipeline {
-    mesh_pipeline_from(device, shader, camera_layout, alpha_test, d, false)
+/// `d` in every class of `ctx`.
+pub(crate) fn mesh_pipelines(ctx: &PipelineContext<'_>, d: &MeshPipeline<'_>) -> MeshPipelines {
+    build(ctx, d, false)
 }
 
-/// The shadow pass's pipeline (src/gpu/shadow.rs): `vs_shadow`, depth only; `fragment` (the dithered
+/// The shadow pass's pipelines (src/gpu/shadow_pass.rs): `vs_shadow`, depth only; `fragment` (the dithered
 /// caster's) discards without writing colour; None = plain depth (the mask's entry with alpha-tested
-/// geometry).
-pub(crate) fn shadow_pipeline(
-    device: &wgpu::Device,
-    shader: &wgpu::ShaderModule,
-    camera_layout: &wgpu::BindGroupLayout,
-    alpha_test: bool,
+/// geometry). Both faces cast; BLEND parts cast nothing.
+pub(crate) fn shadow_pipelines(
+    ctx: &PipelineContext<'_>,
     label: &str,
     fragment: Option<&str>,
-) -> wgpu::RenderPipeline {
+) -> MeshPipelines {
     let d = MeshPipeline {
         fragment,
         ..MeshPipeline::opaque(label)
     };
-    mesh_pipeline_from(device, shader, camera_layout, alpha_test, &d, true)
+    build(ctx, &d, true)
+}
+
+fn build(ctx: &PipelineContext<'_>, d: &MeshPipeline<'_>, shadow: bool) -> MeshPipelines {
+    let mut variants: [Option<wgpu::RenderPipeline>; 4] = Default::default();
+    for &class in ctx.classes {
+        if class.blends() && (shadow || d.fragment.is_none()) {
+            continue;
+        }
+        variants[class.index()] = Some(mesh_pipeline_from(ctx, d, shadow, class));
+    }
+    let first = match variants.iter().flatten().next() {
+        Some(p) => p.clone(),
+        None => mesh_pipeline_from(ctx, d, shadow, MaterialClass::PLAIN),
+    };
+    MeshPipelines { variants, first }
 }
 
 fn mesh_pipeline_from(
-    device: &wgpu::Device,
-    shader: &wgpu::ShaderModule,
-    camera_layout: &wgpu::BindGroupLayout,
-    alpha_test: bool,
+    ctx: &PipelineContext<'_>,
     d: &MeshPipeline<'_>,
     shadow: bool,
+    class: MaterialClass,
 ) -> wgpu::RenderPipeline {
-    let mut layouts: Vec<Option<&wgpu::BindGroupLayout>> = vec![Some(camera_layout)];
+    let device = ctx.device;
+    let mut layouts: Vec<Option<&wgpu::BindGroupLayout>> = vec![Some(ctx.camera_layout)];
     layouts.extend(d.extra_layouts.iter().map(|l| Some(*l)));
+    if let Some(m) = ctx.material_layout {
+        layouts.resize(MATERIAL_GROUP as usize, None);
+        layouts.push(Some(m));
+    }
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(d.label),
         bind_group_layouts: &layouts,
@@ -120,30 +252,55 @@ fn mesh_pipeline_from(
     });
     const MORPH: [wgpu::VertexAttribute; 2] =
         wgpu::vertex_attr_array![8 => Float32x3, 9 => Float32x3];
+    const SURFACE: [wgpu::VertexAttribute; 3] =
+        wgpu::vertex_attr_array![11 => Float32x4, 12 => Float32x4, 13 => Float32x4];
+    const SURFACE_MORPH: [wgpu::VertexAttribute; 2] =
+        wgpu::vertex_attr_array![14 => Float32x4, 15 => Float32x4];
     let [vertex, instance] = vertex_layouts();
     let morph = wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<Vertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &MORPH,
     };
-    let buffers = if d.morph {
-        vec![Some(vertex), Some(instance), Some(morph)]
-    } else {
-        vec![Some(vertex), Some(instance)]
+    let mut buffers = vec![Some(vertex), Some(instance), d.morph.then_some(morph)];
+    if ctx.surface == Surface::Pbr {
+        buffers.push(Some(wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<SurfaceVertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &SURFACE,
+        }));
+        buffers.push(d.morph.then_some(wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<SurfaceTarget>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &SURFACE_MORPH,
+        }));
+    }
+    while buffers.last().is_some_and(Option::is_none) {
+        buffers.pop();
+    }
+    let blend = match (class.blends(), d.blend) {
+        (true, Some(b)) => Some(b),
+        (true, None) => Some(BLEND_OVER),
+        (false, b) => b,
     };
     let mut targets = vec![Some(wgpu::ColorTargetState {
         format: COLOR_FORMAT,
-        blend: d.blend,
+        blend,
         write_mask: wgpu::ColorWrites::ALL,
     })];
     if let Some(format) = d.id_target {
         targets.push(Some(wgpu::ColorTargetState {
             format,
             blend: None,
-            write_mask: wgpu::ColorWrites::ALL,
+            // A blended surface leaves the id of what is behind it.
+            write_mask: if class.blends() {
+                wgpu::ColorWrites::empty()
+            } else {
+                wgpu::ColorWrites::ALL
+            },
         }));
     }
-    let constants: &[(&str, f64)] = if alpha_test {
+    let constants: &[(&str, f64)] = if ctx.alpha_test {
         &[("ALPHA_TEST", 1.0)]
     } else {
         &[]
@@ -154,17 +311,24 @@ fn mesh_pipeline_from(
     };
     // Depth-only passes need a fragment stage only to apply the alpha-test mask.
     let (fragment, targets): (Option<&str>, &[Option<wgpu::ColorTargetState>]) =
-        match (d.fragment, alpha_test) {
+        match (d.fragment, ctx.alpha_test) {
             (Some(f), _) if shadow => (Some(f), &[]),
             (Some(f), _) => (Some(f), &targets),
             (None, true) => (Some("fs_depth_masked"), &[]),
             (None, false) => (None, &[]),
         };
+    let cull = if shadow {
+        d.cull
+    } else if class.culls() {
+        Some(wgpu::Face::Back)
+    } else {
+        d.cull.or(ctx.cull)
+    };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(d.label),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
-            module: shader,
+            module: ctx.shader,
             entry_point: Some(match (shadow, d.morph) {
                 (true, _) => "vs_shadow",
                 (false, true) => "vs_morph",
@@ -175,19 +339,19 @@ fn mesh_pipeline_from(
         },
         primitive: wgpu::PrimitiveState {
             topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: d.cull,
+            cull_mode: cull,
             ..Default::default()
         },
         depth_stencil: Some(wgpu::DepthStencilState {
             format: DEPTH_FORMAT,
-            depth_write_enabled: Some(d.depth_write),
+            depth_write_enabled: Some(d.depth_write && !class.blends()),
             depth_compare: Some(d.depth_compare),
             stencil: Default::default(),
             bias: Default::default(),
         }),
         multisample: wgpu::MultisampleState::default(),
         fragment: fragment.map(|entry| wgpu::FragmentState {
-            module: shader,
+            module: ctx.shader,
             entry_point: Some(entry),
             compilation_options,
             targets,

@@ -1,11 +1,16 @@
 //! The scene on the GPU: the models' LOD meshes in one vertex and one index buffer, the camera uniform, the
-//! shared opaque pipeline, render passes and instanced draws.
+//! scene's surface (flat, or its materials: textures, samplers and a bind group each), the shared opaque
+//! pipeline, render passes and instanced draws, part by part where a mesh has materials.
 
 use crate::error::{Error, Result};
 use crate::gpu::context::GpuContext;
 use crate::gpu::draw_list::{DrawList, DrawStats, PipelineIndex};
 use crate::gpu::instances::{InstanceBuffer, UploadCounters};
-use crate::gpu::pipelines::{mesh_pipeline, MeshPipeline, Vertex, MESH_WGSL};
+use crate::gpu::pipelines::{
+    mesh_pipelines, mesh_wgsl, MaterialClass, MeshPipeline, MeshPipelines, PipelineContext,
+    Surface, SurfaceVertex, Vertex, MATERIAL_GROUP,
+};
+use crate::gpu::surface::MaterialsGpu;
 use crate::gpu::targets::{texture_2d, RenderTarget, ATTACHMENT_READ};
 use crate::scene::animated::Posed;
 use crate::scene::{Camera, Motion, Scene, BACKGROUND};
@@ -62,6 +67,17 @@ pub struct LodRange {
     pub base_vertex: i32,
     pub first_index: u32,
     pub index_count: u32,
+    /// Its material parts: `SceneGpu::parts[parts.0..parts.0 + parts.1]` (none with the flat surface).
+    pub parts: (u32, u32),
+}
+
+/// A run of one LOD's indices drawn with one material.
+#[derive(Debug, Clone, Copy)]
+pub struct PartRange {
+    pub first_index: u32,
+    pub index_count: u32,
+    pub material: u32,
+    pub class: MaterialClass,
 }
 
 impl LodRange {
@@ -95,7 +111,15 @@ pub struct SceneGpu {
     pub shadow_maps: Vec<wgpu::Texture>,
     pub shadow_size: u32,
     pub shader: wgpu::ShaderModule,
-    pub opaque_pipeline: wgpu::RenderPipeline,
+    /// What the mesh shader's surface is: flat, or the scene's materials.
+    pub surface: Surface,
+    /// The material parts of every LOD ([`LodRange::parts`]).
+    pub parts: Vec<PartRange>,
+    /// The classes of the parts (the plain class alone with the flat surface), each mesh pipeline's variants.
+    pub classes: Vec<MaterialClass>,
+    /// The materials' textures, samplers and bind groups, and the surface vertex buffer (PBR surface).
+    pub materials: Option<MaterialsGpu>,
+    pub opaque_pipeline: MeshPipelines,
     /// The scene has alpha-tested geometry: every mesh pipeline is built with `ALPHA_TEST` on.
     pub alpha_test: bool,
     /// Faces every mesh pipeline culls where its own descriptor says None: back faces in the unified scenes
@@ -108,6 +132,8 @@ pub struct SceneGpu {
     posed: std::cell::RefCell<Posed>,
     /// Scratch for their vertices, reused every frame.
     pose_vertices: std::cell::RefCell<Vec<Vertex>>,
+    /// Scratch for their surface vertices (their tangents turn with the pose), reused every frame.
+    pose_surface: std::cell::RefCell<Vec<SurfaceVertex>>,
 }
 
 /// The models a scene deforms per frame.
@@ -133,19 +159,38 @@ fn deformed_vertex(position: [f32; 3], normal: [f32; 3], rest: [f32; 3]) -> Vert
     }
 }
 
+/// The surface vertex of vertex `v` of `mesh`: its texture coordinates, tangent and colour, defaults where the
+/// mesh has none ((0, 0), +x, white).
+pub fn surface_vertex(mesh: &crate::geometry::mesh::Mesh, v: usize) -> SurfaceVertex {
+    let d = &mesh.data;
+    let uv0 = d.uv0.as_ref().map_or([0.0; 2], |t| t[v]);
+    let uv1 = d.uv1.as_ref().map_or([0.0; 2], |t| t[v]);
+    SurfaceVertex {
+        tex: [uv0[0], uv0[1], uv1[0], uv1[1]],
+        tangent: d.tangents.as_ref().map_or([1.0, 0.0, 0.0, 1.0], |t| t[v]),
+        color: d.colors.as_ref().map_or([1.0; 4], |c| c[v]),
+    }
+}
+
 impl SceneGpu {
-    /// Builds a pipeline over the shared vertex layout and shader (methods call this in their constructors).
-    pub fn mesh_pipeline(&self, d: &MeshPipeline<'_>) -> wgpu::RenderPipeline {
-        mesh_pipeline(
-            &self.device,
-            &self.shader,
-            &self.camera_layout,
-            self.alpha_test,
-            &MeshPipeline {
-                cull: d.cull.or(self.cull),
-                ..*d
-            },
-        )
+    /// What every mesh pipeline of the scene is built over.
+    pub fn pipeline_context(&self) -> PipelineContext<'_> {
+        PipelineContext {
+            device: &self.device,
+            shader: &self.shader,
+            camera_layout: &self.camera_layout,
+            alpha_test: self.alpha_test,
+            surface: self.surface,
+            material_layout: self.materials.as_ref().map(|m| &m.layout),
+            classes: &self.classes,
+            cull: self.cull,
+        }
+    }
+
+    /// Builds a pipeline over the shared vertex layout and shader, in each material class of the scene (methods
+    /// call this in their constructors).
+    pub fn mesh_pipeline(&self, d: &MeshPipeline<'_>) -> MeshPipelines {
+        mesh_pipelines(&self.pipeline_context(), d)
     }
 
     /// An instance buffer for `capacity` instances.
@@ -176,16 +221,36 @@ impl SceneGpu {
         let mut vertices: Vec<Vertex> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
         let mut lods = Vec::new();
+        let mut parts: Vec<PartRange> = Vec::new();
+        let pbr = !scene.materials.is_empty();
+        let mut surface_vertices: Vec<SurfaceVertex> = Vec::new();
         let deformed = deformed_models(scene);
         for (mi, model) in scene.models.iter().enumerate() {
             let mut ranges = Vec::new();
             for lod in &model.chain.lods {
                 let m = &lod.mesh;
+                let first_part = parts.len() as u32;
+                if pbr {
+                    for p in &m.parts {
+                        let material = &scene.materials.materials[p.material as usize];
+                        parts.push(PartRange {
+                            first_index: indices.len() as u32 + p.first_index,
+                            index_count: p.index_count,
+                            material: p.material,
+                            class: MaterialClass::new(
+                                !material.double_sided,
+                                material.alpha == crate::geometry::material::AlphaMode::Blend,
+                            ),
+                        });
+                    }
+                    surface_vertices.extend((0..m.vertex_count()).map(|v| surface_vertex(m, v)));
+                }
                 ranges.push(LodRange {
                     base_vertex: i32::try_from(vertices.len())
                         .map_err(|_| Error::Gpu("scene has too many vertices".into()))?,
                     first_index: indices.len() as u32,
                     index_count: m.indices.len() as u32,
+                    parts: (first_part, parts.len() as u32 - first_part),
                 });
                 if deformed.contains(&(mi as u32)) {
                     vertices.extend(
@@ -216,6 +281,7 @@ impl SceneGpu {
                         .map_err(|_| Error::Gpu("scene has too many vertices".into()))?,
                     first_index: indices.len() as u32,
                     index_count: m.indices.len() as u32,
+                    parts: (0, 0),
                 });
                 vertices.extend(m.positions.iter().zip(&m.normals).map(|(p, n)| Vertex {
                     position: *p,
@@ -331,28 +397,52 @@ impl SceneGpu {
                 })
             })
             .collect();
+        let surface = if pbr { Surface::Pbr } else { Surface::Flat };
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("mesh.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(MESH_WGSL.into()),
+            label: Some(match surface {
+                Surface::Flat => "surface/flat.wgsl + mesh.wgsl",
+                Surface::Pbr => "surface/pbr.wgsl + mesh.wgsl",
+            }),
+            source: wgpu::ShaderSource::Wgsl(mesh_wgsl(surface).into()),
         });
-        let alpha_test = scene.models.iter().any(|m| {
-            m.chain.lods.iter().any(|l| {
-                l.mesh.aux.iter().any(|a| {
-                    a[2] == crate::geometry::mesh::AUX_LEAF
-                        || a[2] == crate::geometry::mesh::AUX_LEAF_CLUSTER
+        let alpha_test = scene.materials.any_mask()
+            || scene.models.iter().any(|m| {
+                m.chain.lods.iter().any(|l| {
+                    l.mesh.aux.iter().any(|a| {
+                        a[2] == crate::geometry::mesh::AUX_LEAF
+                            || a[2] == crate::geometry::mesh::AUX_LEAF_CLUSTER
+                    })
                 })
-            })
-        });
+            });
         let cull = scene.unified.is_some().then_some(wgpu::Face::Back);
-        let opaque_pipeline = mesh_pipeline(
-            device,
-            &shader,
-            &camera_layout,
-            alpha_test,
-            &MeshPipeline {
+        let mut classes: Vec<MaterialClass> = parts.iter().map(|p| p.class).collect();
+        classes.sort();
+        classes.dedup();
+        if classes.is_empty() {
+            classes.push(MaterialClass::PLAIN);
+        }
+        let materials = pbr
+            .then(|| {
+                MaterialsGpu::new(
+                    ctx,
+                    &scene.materials,
+                    &surface_vertices,
+                    !deformed.is_empty(),
+                )
+            })
+            .transpose()?;
+        let opaque_pipeline = mesh_pipelines(
+            &PipelineContext {
+                device,
+                shader: &shader,
+                camera_layout: &camera_layout,
+                alpha_test,
+                surface,
+                material_layout: materials.as_ref().map(|m| &m.layout),
+                classes: &classes,
                 cull,
-                ..MeshPipeline::opaque("opaque pipeline")
             },
+            &MeshPipeline::opaque("opaque pipeline"),
         );
         ctx.check_errors()?;
         let gpu = SceneGpu {
@@ -371,12 +461,17 @@ impl SceneGpu {
             shadow_maps,
             shadow_size,
             shader,
+            surface,
+            parts,
+            classes,
+            materials,
             opaque_pipeline,
             alpha_test,
             cull,
             uploads: UploadCounters::default(),
             posed: Default::default(),
             pose_vertices: Default::default(),
+            pose_surface: Default::default(),
         };
         gpu.write_work(scene.shader_work, scene.shader_work_weight);
         Ok(gpu)
@@ -445,6 +540,19 @@ impl SceneGpu {
             let at = self.lods[m][l].base_vertex as u64 * std::mem::size_of::<Vertex>() as u64;
             self.queue
                 .write_buffer(&self.vertex_buffer, at, bytemuck::cast_slice(&scratch));
+            if let (Some(mg), false) = (&self.materials, p.tangents.is_empty()) {
+                let mesh = &scene.models[m].chain.lods[l].mesh;
+                let mut surface = self.pose_surface.borrow_mut();
+                surface.clear();
+                surface.extend((0..mesh.vertex_count()).map(|v| SurfaceVertex {
+                    tangent: p.tangents[v],
+                    ..surface_vertex(mesh, v)
+                }));
+                let at = self.lods[m][l].base_vertex as u64
+                    * std::mem::size_of::<SurfaceVertex>() as u64;
+                self.queue
+                    .write_buffer(&mg.vertices, at, bytemuck::cast_slice(&surface));
+            }
         }
     }
 
@@ -641,24 +749,17 @@ impl SceneGpu {
         count: u32,
         model: u32,
         lod: u32,
-        pipeline: &wgpu::RenderPipeline,
+        pipeline: &MeshPipelines,
     ) -> DrawStats {
-        pass.set_bind_group(0, self.camera_group(), &[]);
-        pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
-        pass.set_vertex_buffer(1, buffer.buffer.slice(..));
-        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-        pass.set_pipeline(pipeline);
-        let r = self.lods[model as usize][lod as usize];
-        pass.draw_indexed(
-            r.first_index..r.first_index + r.index_count,
-            r.base_vertex,
-            first..first + count,
-        );
-        DrawStats {
-            triangles: r.triangles() * count as u64,
-            draw_calls: 1,
-            ..Default::default()
-        }
+        let draw = crate::gpu::draw_list::Draw {
+            pipeline: 0,
+            model,
+            lod,
+            first_instance: 0,
+            instance_count: count,
+        };
+        let list = crate::gpu::draw_list::DrawList::of_draws(vec![draw]);
+        self.draw(pass, buffer, first, &list, &[pipeline])
     }
 
     /// Records the draws of `list` (uploaded to `buffer` at instance `first`, see [`SceneGpu::upload_at`])
@@ -670,7 +771,7 @@ impl SceneGpu {
         buffer: &InstanceBuffer,
         first: u32,
         list: &DrawList,
-        pipelines: &[&wgpu::RenderPipeline],
+        pipelines: &[&MeshPipelines],
     ) -> DrawStats {
         let mut stats = DrawStats::default();
         if list.draws.is_empty() {
@@ -680,20 +781,61 @@ impl SceneGpu {
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, buffer.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-        let mut bound: Option<PipelineIndex> = None;
-        for d in &list.draws {
-            if bound != Some(d.pipeline) {
-                pass.set_pipeline(pipelines[d.pipeline as usize]);
-                bound = Some(d.pipeline);
+        let Some(materials) = &self.materials else {
+            let mut bound: Option<PipelineIndex> = None;
+            for d in &list.draws {
+                if bound != Some(d.pipeline) {
+                    pass.set_pipeline(pipelines[d.pipeline as usize].base());
+                    bound = Some(d.pipeline);
+                }
+                let r = self.lods[d.model as usize][d.lod as usize];
+                pass.draw_indexed(
+                    r.first_index..r.first_index + r.index_count,
+                    r.base_vertex,
+                    first + d.first_instance..first + d.first_instance + d.instance_count,
+                );
+                stats.triangles += r.triangles() * d.instance_count as u64;
+                stats.draw_calls += 1;
             }
-            let r = self.lods[d.model as usize][d.lod as usize];
-            pass.draw_indexed(
-                r.first_index..r.first_index + r.index_count,
-                r.base_vertex,
-                first + d.first_instance..first + d.first_instance + d.instance_count,
-            );
-            stats.triangles += r.triangles() * d.instance_count as u64;
-            stats.draw_calls += 1;
+            return stats;
+        };
+        // Part by part, the opaque and cut-out parts of every draw first, then the blended ones (in the list's
+        // order, over what the opaque ones left), as an engine draws its transparent queue after its opaque one.
+        pass.set_vertex_buffer(3, materials.vertices.slice(..));
+        let mut bound: Option<(PipelineIndex, MaterialClass)> = None;
+        let mut bound_material: Option<u32> = None;
+        for blended in [false, true] {
+            for d in &list.draws {
+                let r = self.lods[d.model as usize][d.lod as usize];
+                let (p0, n) = r.parts;
+                for part in &self.parts[p0 as usize..(p0 + n) as usize] {
+                    if part.class.blends() != blended {
+                        continue;
+                    }
+                    let Some(pipeline) = pipelines[d.pipeline as usize].get(part.class) else {
+                        continue;
+                    };
+                    if bound != Some((d.pipeline, part.class)) {
+                        pass.set_pipeline(pipeline);
+                        bound = Some((d.pipeline, part.class));
+                    }
+                    if bound_material != Some(part.material) {
+                        pass.set_bind_group(
+                            MATERIAL_GROUP,
+                            &materials.groups[part.material as usize],
+                            &[],
+                        );
+                        bound_material = Some(part.material);
+                    }
+                    pass.draw_indexed(
+                        part.first_index..part.first_index + part.index_count,
+                        r.base_vertex,
+                        first + d.first_instance..first + d.first_instance + d.instance_count,
+                    );
+                    stats.triangles += part.index_count as u64 / 3 * d.instance_count as u64;
+                    stats.draw_calls += 1;
+                }
+            }
         }
         stats
     }

@@ -4,7 +4,7 @@
 
 use crate::gpu::draw_list::{DrawList, DrawStats, PipelineIndex};
 use crate::gpu::instances::InstanceBuffer;
-use crate::gpu::pipelines::shadow_pipeline;
+use crate::gpu::pipelines::{shadow_pipelines, MeshPipelines};
 use crate::gpu::scene_gpu::{SceneGpu, ShadowMap};
 
 /// Pipeline indices of a shadow draw list: a caster drawn whole, and one LOD of a dithered caster.
@@ -12,24 +12,15 @@ pub const CAST_WHOLE: PipelineIndex = 0;
 pub const CAST_DITHERED: PipelineIndex = 1;
 
 pub struct ShadowPass {
-    whole: wgpu::RenderPipeline,
-    dithered: wgpu::RenderPipeline,
+    whole: MeshPipelines,
+    dithered: MeshPipelines,
     /// One instance buffer per shadow map, so maps drawn in one submission keep their own instances.
     buffers: Vec<InstanceBuffer>,
 }
 
 impl ShadowPass {
     pub fn new(gpu: &SceneGpu, instances: u32) -> ShadowPass {
-        let p = |label, fragment| {
-            shadow_pipeline(
-                &gpu.device,
-                &gpu.shader,
-                &gpu.camera_layout,
-                gpu.alpha_test,
-                label,
-                fragment,
-            )
-        };
+        let p = |label, fragment| shadow_pipelines(&gpu.pipeline_context(), label, fragment);
         ShadowPass {
             whole: p("shadow caster", None),
             dithered: p("shadow caster, dithered", Some("fs_shadow_dither")),

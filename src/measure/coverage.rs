@@ -322,6 +322,7 @@ mod tests {
             indices: vec![0, 1, 2],
             aux: vec![[0.0, 0.0, AUX_BLADE, 1.0]; 3],
             data: Default::default(),
+            parts: Vec::new(),
         };
         let chain = LodChain {
             lods: vec![Lod {

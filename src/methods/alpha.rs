@@ -14,7 +14,7 @@ pub const OVER: wgpu::BlendState = wgpu::BlendState::ALPHA_BLENDING;
 pub struct Alpha {
     lists: BlendLists,
     buffer: InstanceBuffer,
-    translucent_pipeline: wgpu::RenderPipeline,
+    translucent_pipeline: crate::gpu::MeshPipelines,
 }
 
 impl Alpha {

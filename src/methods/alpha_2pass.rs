@@ -67,8 +67,8 @@ pub struct AlphaTwoPass {
     weights: Weights,
     lists: BlendLists,
     buffer: InstanceBuffer,
-    depth_only: wgpu::RenderPipeline,
-    colour: wgpu::RenderPipeline,
+    depth_only: crate::gpu::MeshPipelines,
+    colour: crate::gpu::MeshPipelines,
     scene_depth_layout: wgpu::BindGroupLayout,
     /// Bind groups of the scene-depth textures seen so far (one per render target: timing, quality).
     scene_depth_groups: Vec<(wgpu::Texture, wgpu::BindGroup)>,

@@ -33,7 +33,7 @@ struct TargetState {
 pub struct AlphaSorted {
     lists: BlendLists,
     buffer: InstanceBuffer,
-    peel_pipeline: wgpu::RenderPipeline,
+    peel_pipeline: crate::gpu::MeshPipelines,
     /// Depth of each peel (two, alternating) and a depth of 0 everywhere (before the first layer).
     peel_depth: [wgpu::Texture; 2],
     peel_depth_views: [wgpu::TextureView; 2],

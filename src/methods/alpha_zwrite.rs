@@ -17,8 +17,8 @@ const AFTER_SWAP: u8 = 1;
 pub struct AlphaZWrite {
     lists: BlendLists,
     buffer: InstanceBuffer,
-    less_equal: wgpu::RenderPipeline,
-    less: wgpu::RenderPipeline,
+    less_equal: crate::gpu::MeshPipelines,
+    less: crate::gpu::MeshPipelines,
     /// `blocks`: a unified scene's seams, between the blocks' opaque LODs, drawn with the opaque blocks.
     seams: Option<SeamDraws>,
 }

@@ -43,8 +43,8 @@ pub struct BlocksTree {
     color: [f32; 3],
     vertex_buffer: wgpu::Buffer,
     index_buffer: wgpu::Buffer,
-    less_equal: wgpu::RenderPipeline,
-    less: wgpu::RenderPipeline,
+    less_equal: crate::gpu::MeshPipelines,
+    less: crate::gpu::MeshPipelines,
     now: FrameBuffers,
     before: FrameBuffers,
     frame: Frame,
@@ -183,7 +183,7 @@ impl BlocksTree {
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, buffers.instances.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-        pass.set_pipeline(&gpu.opaque_pipeline);
+        pass.set_pipeline(gpu.opaque_pipeline.base());
         let mut stats = DrawStats {
             clusters: Some((frame.cut.opaque.len() + self.order.len()) as u64),
             ..Default::default()
@@ -203,14 +203,14 @@ impl BlocksTree {
         }
         for (i, &(k, _, swapped)) in self.order.iter().enumerate() {
             pass.set_pipeline(if swapped {
-                &self.less
+                self.less.base()
             } else {
-                &self.less_equal
+                self.less_equal.base()
             });
             range(&mut pass, k, 1 + i as u32);
         }
         if !frame.seams.is_empty() {
-            pass.set_pipeline(&gpu.opaque_pipeline);
+            pass.set_pipeline(gpu.opaque_pipeline.base());
             pass.set_index_buffer(buffers.seams.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..frame.seams.len() as u32, 0, 0..1);
             stats.triangles += frame.seams.len() as u64 / 3;

@@ -86,7 +86,7 @@ impl ClusterLod {
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, self.instance.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-        pass.set_pipeline(&gpu.opaque_pipeline);
+        pass.set_pipeline(gpu.opaque_pipeline.base());
         let mut stats = DrawStats {
             clusters: Some(cut.len() as u64),
             ..Default::default()

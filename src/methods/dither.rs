@@ -44,8 +44,8 @@ const ROLE_INCOMING: f32 = 1.0;
 pub struct Dither {
     list: DrawList,
     buffer: InstanceBuffer,
-    steady: wgpu::RenderPipeline,
-    dithered: wgpu::RenderPipeline,
+    steady: crate::gpu::MeshPipelines,
+    dithered: crate::gpu::MeshPipelines,
     noise_group: wgpu::BindGroup,
     params: wgpu::Buffer,
     /// `--noise-temporal`: the tile size (0: ign), whose pattern moves every frame.

@@ -385,8 +385,8 @@ pub struct Fsi {
     buffers: [LodBuffer; 2],
     lists: [DrawList; 2],
     instances: InstanceBuffer,
-    n_pipeline: wgpu::RenderPipeline,
-    t_pipeline: wgpu::RenderPipeline,
+    n_pipeline: crate::gpu::MeshPipelines,
+    t_pipeline: crate::gpu::MeshPipelines,
     vis_group: wgpu::BindGroup,
     /// The variant's combination (fsi_combine.wgsl's SAME_PIXEL and COMBINATION).
     combine_pipeline: wgpu::ComputePipeline,

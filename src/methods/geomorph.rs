@@ -6,10 +6,12 @@
 //! once per LOD pair and cached.
 
 use super::common::{instance_raw, FrameInput, Method};
+use crate::geometry::mesh::Mesh;
 use crate::geometry::morph::Correspondence;
-use crate::geometry::morph::{morph_targets, MorphTargets};
+use crate::geometry::morph::{morph_targets_by_material, MorphTargets};
 use crate::gpu::{
-    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu, Vertex,
+    DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu, SurfaceTarget,
+    Vertex,
 };
 use crate::scene::Scene;
 use std::sync::Arc;
@@ -39,7 +41,9 @@ pub struct Geomorph {
     /// Per vertex of the scene's vertex buffer: its target on the next coarser LOD of its model (the coarsest
     /// LOD's vertices target themselves and are never morphed).
     targets: wgpu::Buffer,
-    morph: wgpu::RenderPipeline,
+    /// With materials: per vertex, the texture coordinates and tangent at its target (slot 4).
+    surface_targets: Option<wgpu::Buffer>,
+    morph: crate::gpu::MeshPipelines,
     /// The deformed models' LODs (model, LOD, first vertex, their targets): their targets follow the coarser
     /// LOD's pose every frame.
     deformed: Vec<(u32, u32, u64, Arc<MorphTargets>)>,
@@ -50,6 +54,8 @@ pub struct Geomorph {
 impl Geomorph {
     pub fn new(gpu: &SceneGpu, scene: &Scene, options: &GeomorphOptions) -> Self {
         let mut targets: Vec<Vertex> = Vec::new();
+        let mut surface: Vec<SurfaceTarget> = Vec::new();
+        let with_surface = gpu.materials.is_some();
         let mut deformed = Vec::new();
         let deforms = |m: usize| match &scene.motion {
             crate::scene::Motion::Animated(a) => a.deformers.iter().any(|d| d.model as usize == m),
@@ -60,7 +66,14 @@ impl Geomorph {
             for (i, lod) in lods.iter().enumerate() {
                 match lods.get(i + 1) {
                     Some(coarse) => {
-                        let t = morph_targets(&lod.mesh, &coarse.mesh, options.correspondence);
+                        let t = morph_targets_by_material(
+                            &lod.mesh,
+                            &coarse.mesh,
+                            options.correspondence,
+                        );
+                        if with_surface {
+                            surface.extend(surface_targets(&lod.mesh, &coarse.mesh, &t));
+                        }
                         if deforms(m) {
                             deformed.push((m as u32, i as u32, targets.len() as u64, t.clone()));
                         }
@@ -70,13 +83,24 @@ impl Geomorph {
                             aux: [0.0; 4],
                         }));
                     }
-                    None => targets.extend(lod.mesh.positions.iter().zip(&lod.mesh.normals).map(
-                        |(p, n)| Vertex {
-                            position: *p,
-                            normal: *n,
-                            aux: [0.0; 4],
-                        },
-                    )),
+                    None => {
+                        targets.extend(lod.mesh.positions.iter().zip(&lod.mesh.normals).map(
+                            |(p, n)| Vertex {
+                                position: *p,
+                                normal: *n,
+                                aux: [0.0; 4],
+                            },
+                        ));
+                        if with_surface {
+                            surface.extend((0..lod.mesh.vertex_count()).map(|v| {
+                                let s = crate::gpu::surface_vertex(&lod.mesh, v);
+                                SurfaceTarget {
+                                    tex: s.tex,
+                                    tangent: s.tangent,
+                                }
+                            }));
+                        }
+                    }
                 }
             }
         }
@@ -94,6 +118,14 @@ impl Geomorph {
                         wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST
                     },
                 }),
+            surface_targets: with_surface.then(|| {
+                gpu.device
+                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("geomorph surface targets"),
+                        contents: bytemuck::cast_slice(&surface),
+                        usage: wgpu::BufferUsages::VERTEX,
+                    })
+            }),
             deformed,
             scratch: Default::default(),
             morph: gpu.mesh_pipeline(&MeshPipeline {
@@ -102,6 +134,36 @@ impl Geomorph {
             }),
         }
     }
+}
+
+/// Per vertex of `fine`, the texture coordinates and tangent at its target on `coarse` (the coarse vertices'
+/// interpolated by the target's weights; the tangent renormalised, its sign the fine vertex's).
+fn surface_targets(fine: &Mesh, coarse: &Mesh, t: &MorphTargets) -> Vec<SurfaceTarget> {
+    let of = |m: &Mesh, v: usize| crate::gpu::surface_vertex(m, v);
+    t.sources
+        .iter()
+        .enumerate()
+        .map(|(k, src)| {
+            let mine = of(fine, k);
+            let (mut tex, mut tangent) = ([0.0f32; 4], glam::Vec3::ZERO);
+            for &(i, w) in src {
+                if w != 0.0 {
+                    let c = of(coarse, i as usize);
+                    for (a, b) in tex.iter_mut().zip(c.tex) {
+                        *a += b * w;
+                    }
+                    tangent += glam::Vec3::from_slice(&c.tangent[..3]) * w;
+                }
+            }
+            let tangent = tangent
+                .try_normalize()
+                .unwrap_or(glam::Vec3::from_slice(&mine.tangent[..3]));
+            SurfaceTarget {
+                tex,
+                tangent: [tangent.x, tangent.y, tangent.z, mine.tangent[3]],
+            }
+        })
+        .collect()
 }
 
 impl Geomorph {
@@ -172,6 +234,9 @@ impl Method for Geomorph {
         self.follow_poses(gpu);
         let mut pass = gpu.begin_clear_pass(encoder, target, "geomorph pass");
         pass.set_vertex_buffer(2, self.targets.slice(..));
+        if let Some(s) = &self.surface_targets {
+            pass.set_vertex_buffer(4, s.slice(..));
+        }
         gpu.draw(
             &mut pass,
             &self.buffer,

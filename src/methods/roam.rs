@@ -225,7 +225,7 @@ impl Roam {
         pass.set_vertex_buffer(0, vertices.buffer.slice(..));
         pass.set_vertex_buffer(1, self.instance.buffer.slice(..));
         pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
-        pass.set_pipeline(&gpu.opaque_pipeline);
+        pass.set_pipeline(gpu.opaque_pipeline.base());
         let count = frame.indices.len() as u32;
         if count > 0 {
             pass.draw_indexed(0..count, 0, 0..1);

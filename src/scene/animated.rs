@@ -8,7 +8,7 @@
 //! rest, and deformed inside that frame, so the LOD schedule follows the character as it moves while the skin
 //! bends the vertices.
 
-use crate::geometry::deform::{deform, Placing};
+use crate::geometry::deform::{deform_with_tangents, Placing};
 use crate::geometry::gltf::Rig;
 use crate::geometry::lod::LodChain;
 use glam::{Mat4, Vec3};
@@ -69,6 +69,8 @@ pub struct PosedLod {
     pub lod: u32,
     pub positions: Vec<[f32; 3]>,
     pub normals: Vec<[f32; 3]>,
+    /// Empty when the mesh has no tangents.
+    pub tangents: Vec<[f32; 4]>,
 }
 
 /// Every deformed model's LODs as one frame poses them.
@@ -204,7 +206,16 @@ impl Animated {
                 (p.model, p.lod) = (d.model, l as u32);
                 p.positions.resize(data.base_positions.len(), [0.0; 3]);
                 p.normals.resize(data.base_positions.len(), [0.0; 3]);
-                deform(data, &weights, placing, &mut p.positions, &mut p.normals);
+                let n = data.base_tangents.as_ref().map_or(0, Vec::len);
+                p.tangents.resize(n, [0.0; 4]);
+                deform_with_tangents(
+                    data,
+                    &weights,
+                    placing,
+                    &mut p.positions,
+                    &mut p.normals,
+                    (n > 0).then_some(p.tangents.as_mut_slice()),
+                );
                 slot += 1;
             }
         }

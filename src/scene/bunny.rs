@@ -291,6 +291,7 @@ fn ground_model(bunny: &Model, far: f32) -> (Model, Vec3) {
         indices: vec![0, 2, 1, 0, 3, 2],
         positions,
         data: Default::default(),
+        parts: Vec::new(),
     };
     let model = Model {
         name: "ground".into(),

@@ -34,6 +34,8 @@ pub struct SceneConfig {
     pub animation: AnimationChoice,
     /// `--simplify`: how a user's mesh is simplified into its LOD chain.
     pub simplify: crate::geometry::lod::Simplify,
+    /// `--materials`: a user scene's materials drawn, or one flat colour per model.
+    pub materials: crate::geometry::material::MaterialMode,
     /// `--shader-work`: extra ALU iterations per shaded fragment (0: none).
     pub shader_work: u32,
     pub schedule: ScheduleParams,

@@ -242,6 +242,10 @@ impl SceneDef {
             shader_work: self.shader_work,
             shader_work_weight: 0.0,
             ground: None,
+            materials: match &self.family {
+                Family::User(u) => u.materials.clone(),
+                _ => Default::default(),
+            },
         }
     }
 }

@@ -173,6 +173,9 @@ pub struct Scene {
     /// The instance that is the bunny scenes' ground with `--shadows on`: static, always LOD0, receives
     /// shadows and casts none, left out of `lod_mean`.
     pub ground: Option<usize>,
+    /// A user scene's materials, which its meshes' parts name; empty for the built-in scenes and with
+    /// `--materials flat` (one colour per instance, `shaders/surface_flat.wgsl`).
+    pub materials: Arc<crate::geometry::material::Materials>,
 }
 
 /// What a scene family's builder places for one instance count: the parts of [`Scene`] that differ between

@@ -254,8 +254,8 @@ fn the_files_camera_animation_is_the_camera() {
     );
 }
 
-/// `lodbench export` then `run --scene FILE.glb` (the exported camera, the same viewport and frames) gives the
-/// built-in scene's schedule: per frame `t_instances` and `triangles` exactly, `lod_mean` to 1e-5 (it holds the
+/// `lodbench export` then `run --scene FILE.glb --materials flat` (the exported camera, the same viewport and
+/// frames, the built-in look) gives the built-in scene's schedule: per frame `t_instances` and `triangles` exactly, `lod_mean` to 1e-5 (it holds the
 /// blend factors k, which follow the camera-to-instance distances: the file stores the camera as a translation
 /// and a quaternion per frame and the instances as translation, rotation and scale, so a distance comes back
 /// within a few float32 ulps, and k moves by 1 / band width per unit of distance: measured 4.4e-6 on
@@ -310,7 +310,16 @@ fn export_then_run_gives_the_built_in_schedule() {
         let mut built_in = vec!["--scene", scene];
         built_in.extend_from_slice(&common);
         run_into(&a, &built_in);
-        let mut imported = vec!["--scene", glb.to_str().unwrap(), "--frames", frames];
+        // The built-in scenes' look: one colour per model (the exported file's materials drawn in full would be
+        // lit by glTF's BRDF instead of the built-in Lambert).
+        let mut imported = vec![
+            "--scene",
+            glb.to_str().unwrap(),
+            "--frames",
+            frames,
+            "--materials",
+            "flat",
+        ];
         imported.extend_from_slice(&common);
         run_into(&b, &imported);
         let (fa, fb) = (

@@ -1,21 +1,27 @@
-//! Every WGSL file in shaders/ must parse and validate with naga (errors shown with source locations), and the
-//! entry points the Rust side names must exist.
+//! Every WGSL file in shaders/ must parse and validate with naga (errors shown with source locations): each
+//! file that stands alone, and the mesh shader with each of its surfaces (shaders/surface/*.wgsl before
+//! shaders/mesh.wgsl, as the renderer composes them); and the entry points the Rust side names must exist.
 
+use lodbench::gpu::{mesh_wgsl, Surface};
 use std::path::Path;
 
 fn validate(path: &Path) -> naga::Module {
     let source = std::fs::read_to_string(path).unwrap();
-    let name = path.display().to_string();
+    validate_source(&source, &path.display().to_string())
+}
+
+fn validate_source(source: &str, name: &str) -> naga::Module {
+    let source = source.to_string();
     let module = match naga::front::wgsl::parse_str(&source) {
         Ok(m) => m,
-        Err(e) => panic!("{}", e.emit_to_string_with_path(&source, &name)),
+        Err(e) => panic!("{}", e.emit_to_string_with_path(&source, name)),
     };
     let mut validator = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::default(),
     );
     if let Err(e) = validator.validate(&module) {
-        panic!("{}", e.emit_to_string_with_path(&source, &name));
+        panic!("{}", e.emit_to_string_with_path(&source, name));
     }
     module
 }
@@ -30,7 +36,8 @@ fn every_shader_validates() {
     let mut count = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "wgsl") {
+        // mesh.wgsl is completed by a surface (below).
+        if path.extension().is_some_and(|e| e == "wgsl") && !path.ends_with("mesh.wgsl") {
             validate(&path);
             count += 1;
         }
@@ -40,27 +47,34 @@ fn every_shader_validates() {
         "expected the shaders in {}, found {count}",
         dir.display()
     );
+    let surfaces = std::fs::read_dir(dir.join("surface")).unwrap().count();
+    assert_eq!(surfaces, 2, "a surface the renderer does not compose");
+    for s in [Surface::Flat, Surface::Pbr] {
+        validate_source(&mesh_wgsl(s), &format!("mesh.wgsl with the {s:?} surface"));
+    }
 }
 
 #[test]
 fn entry_points_the_renderer_uses_exist() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
-    let mesh = entry_points(&validate(&dir.join("mesh.wgsl")));
-    for e in [
-        "vs_main",
-        "vs_morph",
-        "fs_opaque",
-        "fs_translucent",
-        "fs_translucent_occluded",
-        "fs_dither",
-        "fs_depth_masked",
-        "fs_fsi_n",
-        "fs_fsi_t",
-    ] {
-        assert!(
-            mesh.contains(&e.to_string()),
-            "mesh.wgsl lacks {e}: {mesh:?}"
-        );
+    for s in [Surface::Flat, Surface::Pbr] {
+        let mesh = entry_points(&validate_source(&mesh_wgsl(s), &format!("{s:?}")));
+        for e in [
+            "vs_main",
+            "vs_morph",
+            "fs_opaque",
+            "fs_translucent",
+            "fs_translucent_occluded",
+            "fs_dither",
+            "fs_depth_masked",
+            "fs_fsi_n",
+            "fs_fsi_t",
+        ] {
+            assert!(
+                mesh.contains(&e.to_string()),
+                "mesh.wgsl lacks {e}: {mesh:?}"
+            );
+        }
     }
     let mut metrics = entry_points(&validate(&dir.join("metrics.wgsl")));
     metrics.sort();

@@ -171,6 +171,22 @@ impl<'a> Doc<'a> {
         Ok(self.buffers[b].as_deref().unwrap_or(&[]))
     }
 
+    /// Buffer view `v`'s bytes (an image's, decoded when meshopt-compressed), `what` naming who reads it.
+    pub(super) fn view_bytes(&mut self, v: usize, what: &str) -> Result<Vec<u8>, String> {
+        if v >= self.views.len() {
+            return Err(format!(
+                "{what}'s bufferView is {v}, not an index below {}",
+                self.views.len()
+            ));
+        }
+        Ok(self.view(v)?.0.into_owned())
+    }
+
+    /// The folder external files are read from.
+    pub(super) fn dir(&self) -> &Path {
+        self.dir
+    }
+
     /// Buffer view `v`'s bytes (decoded when meshopt-compressed) and its stride.
     fn view(&mut self, v: usize) -> Result<(Cow<'_, [u8]>, Option<usize>), String> {
         let desc = self.json["bufferViews"][v].clone();

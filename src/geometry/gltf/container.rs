@@ -101,16 +101,22 @@ pub fn check_required(json: &Value) -> Result<(), String> {
 
 /// A buffer's bytes from a `data:` URI or a file relative to `dir`.
 pub fn read_buffer_uri(i: usize, uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
+    read_uri(&format!("buffer {i}"), uri, dir)
+}
+
+/// The bytes a `data:` URI holds or a file relative to `dir` (percent-encoded) has; `what` (a buffer, an image)
+/// names the owner in errors.
+pub fn read_uri(what: &str, uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (header, payload) = rest
             .split_once(',')
-            .ok_or_else(|| format!("buffer {i} has a data: URI without a ','"))?;
+            .ok_or_else(|| format!("{what} has a data: URI without a ','"))?;
         let bytes = if header.ends_with(";base64") {
             decode_base64(payload)
         } else {
             percent_decode(payload)
         };
-        return bytes.ok_or_else(|| format!("buffer {i} has a data: URI that does not decode"));
+        return bytes.ok_or_else(|| format!("{what} has a data: URI that does not decode"));
     }
     let scheme = uri.split_once(':').map(|(s, _)| s);
     if scheme.is_some_and(|s| {
@@ -120,18 +126,18 @@ pub fn read_buffer_uri(i: usize, uri: &str, dir: &Path) -> Result<Vec<u8>, Strin
                 .all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'))
     }) {
         return Err(format!(
-            "buffer {i} has URI '{uri}': lodbench reads only data: URIs and relative file paths"
+            "{what} has URI '{uri}': lodbench reads only data: URIs and relative file paths"
         ));
     }
     let relative = percent_decode(uri)
         .and_then(|b| String::from_utf8(b).ok())
-        .ok_or_else(|| format!("buffer {i} has URI '{uri}', which is not a valid file path"))?;
+        .ok_or_else(|| format!("{what} has URI '{uri}', which is not a valid file path"))?;
     let file = dir.join(relative);
     std::fs::read(&file).map_err(|e| {
         if e.kind() == std::io::ErrorKind::NotFound {
-            format!("buffer {i} file {} not found", file.display())
+            format!("{what} file {} not found", file.display())
         } else {
-            format!("buffer {i} file {} cannot be read ({e})", file.display())
+            format!("{what} file {} cannot be read ({e})", file.display())
         }
     })
 }

@@ -94,6 +94,16 @@ impl Content<'_> {
         Some([f[0], f[1], f[2]].map(|c| c.clamp(0.0, 1.0)))
     }
 
+    /// lodbench's index of glTF material `gltf` (None: glTF's default material) in `table`, read with its
+    /// images the first time.
+    pub fn material(
+        &mut self,
+        table: &mut super::materials::MaterialTable,
+        gltf: Option<usize>,
+    ) -> Result<u32, String> {
+        self.doc.material(table, gltf)
+    }
+
     /// Mesh `mesh`'s name ("" when it has none).
     pub fn mesh_name(&self, mesh: usize) -> &str {
         self.doc.json["meshes"][mesh]["name"].as_str().unwrap_or("")
@@ -216,12 +226,13 @@ impl Content<'_> {
             .collect();
         if let Some(d) = &parts.data.deform {
             let mut normals = vec![[0.0; 3]; d.base_positions.len()];
-            crate::geometry::deform::deform(
+            crate::geometry::deform::deform_with_tangents(
                 d,
                 &weights,
                 crate::geometry::deform::Placing::Skin(&joints),
                 &mut parts.positions,
                 &mut normals,
+                parts.data.tangents.as_deref_mut(),
             );
             parts.normals = Some(normals);
         }

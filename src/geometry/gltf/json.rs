@@ -94,6 +94,15 @@ pub fn float_list(v: &Value, what: &str) -> Result<Option<Vec<f32>>, String> {
         .map(Some)
 }
 
+/// A number property that defaults to `default` when absent; an error naming `what` when it is not a finite
+/// number.
+pub fn number_or(v: &Value, default: f32, what: impl FnOnce() -> String) -> Result<f32, String> {
+    match v {
+        Value::Null => Ok(default),
+        _ => finite(v).ok_or_else(|| format!("{} is {v}, not a finite number", what())),
+    }
+}
+
 /// A finite number that is also finite as an f32.
 fn finite(x: &Value) -> Option<f32> {
     x.as_f64().map(|x| x as f32).filter(|x| x.is_finite())

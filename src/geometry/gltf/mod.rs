@@ -11,13 +11,15 @@
 //! accessors, EXT_mesh_gpu_instancing (each instance of a node placed, whether the file marks the extension
 //! required or not), skins and morph targets, animations, and the authored LOD chains a file can hold (MSFT_lod
 //! on a node, or sibling nodes named `NAME_LOD0`, `NAME_LOD1`, ...; a level is a node with its descendants),
-//! reported as chains so that no caller merges their levels. Textures and images are never decoded, so
-//! extensions that only change them (KHR_texture_transform, KHR_texture_basisu, EXT_texture_webp, ...) and the
-//! material extensions are accepted even when required. Any other required extension is refused with its name and
-//! a remedy (for Draco: the glTF-Transform command that rewrites the file with meshopt compression).
+//! reported as chains so that no caller merges their levels. Materials (`materials.rs`: the core
+//! metallic-roughness model, KHR_texture_transform, PNG, JPEG and WebP images) are read when a scene asks for
+//! them; extensions that only change appearance are accepted even when required, and a texture lodbench cannot
+//! decode refuses the file when a scene draws it. Any other required extension is refused with its name and a
+//! remedy (for Draco: the glTF-Transform command that rewrites the file with meshopt compression).
 //!
 //! The files: `container.rs` (GLB, JSON, buffer URIs, required extensions), `json.rs` (properties), `accessors.rs`
 //! (buffer views and accessors), `nodes.rs` (hierarchy, placements), `chains.rs` (authored LOD chains),
+//! `materials.rs` (materials, textures, samplers, images),
 //! `primitives.rs` (triangles and their attributes, merging), `skins.rs`, `animation.rs`, `camera.rs` (the
 //! animated camera) and `content.rs` ([`read`] and what it gives).
 
@@ -28,6 +30,7 @@ mod chains;
 pub mod container;
 mod content;
 mod json;
+pub mod materials;
 pub mod nodes;
 pub mod primitives;
 mod skins;
@@ -37,6 +40,7 @@ pub use camera::AnimatedCamera;
 pub use chains::{AuthoredChain, ChainSource};
 pub use container::{decode_base64, percent_decode};
 pub use content::{read, Content};
+pub use materials::MaterialTable;
 pub use nodes::Placement;
 pub use primitives::{Merged, MergedParts, MeshPrimitives, Triangles};
 pub use skins::Skin;

@@ -21,6 +21,8 @@ pub struct Triangles {
     /// lodbench's own per-vertex shading extras (`_LODBENCH_AUX`, written by `lodbench export`).
     pub aux: Option<Vec<[f32; 4]>>,
     pub uv0: Option<Vec<[f32; 2]>>,
+    pub uv1: Option<Vec<[f32; 2]>>,
+    /// TANGENT, or MikkTSpace's when the primitive's material has a normal texture and the file gives none.
     pub tangents: Option<Vec<[f32; 4]>>,
     pub colors: Option<Vec<[f32; 4]>>,
     /// JOINTS_0/WEIGHTS_0 (and _1).
@@ -28,6 +30,106 @@ pub struct Triangles {
     /// Morph targets' POSITION (zeros where a target has none) and NORMAL displacements.
     pub targets: Vec<MorphTarget>,
     pub material: Option<usize>,
+}
+
+impl Triangles {
+    /// MikkTSpace tangents from texture coordinate set `set` (normals computed first when the primitive has
+    /// none); a vertex whose corners get different tangents is split, each copy keeping every other channel.
+    /// Nothing when the primitive lacks that set (the normal texture then has nothing to be oriented by, and
+    /// the shader draws without it).
+    fn generate_tangents(&mut self, set: u64) {
+        let uv = match set {
+            0 => self.uv0.clone(),
+            1 => self.uv1.clone(),
+            _ => None,
+        };
+        let Some(uv) = uv else { return };
+        let normals = self
+            .normals
+            .get_or_insert_with(|| vertex_normals(&self.positions, &self.indices))
+            .clone();
+        let Some(corners) = crate::geometry::tangents::mikktspace_corners(
+            &self.positions,
+            &normals,
+            &uv,
+            &self.indices,
+        ) else {
+            return;
+        };
+        let n = self.positions.len();
+        let mut tangents: Vec<Option<[f32; 4]>> = vec![None; n];
+        // Copies made of a vertex for a tangent its first corner did not have: (source, tangent) -> copy.
+        let mut copies: Vec<(u32, [f32; 4], u32)> = Vec::new();
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        for (c, ix) in self.indices.iter_mut().enumerate() {
+            let v = *ix as usize;
+            let t = corners[c];
+            match tangents[v] {
+                None => tangents[v] = Some(t),
+                Some(have) if crate::geometry::tangents::same_tangent(have, t) => {}
+                Some(_) => {
+                    let found = copies.iter().find(|(src, ct, _)| {
+                        *src as usize == v && crate::geometry::tangents::same_tangent(*ct, t)
+                    });
+                    *ix = match found {
+                        Some(&(_, _, copy)) => copy,
+                        None => {
+                            let copy = order.len() as u32;
+                            order.push(v as u32);
+                            tangents.push(Some(t));
+                            copies.push((v as u32, t, copy));
+                            copy
+                        }
+                    };
+                }
+            }
+        }
+        if order.len() > n {
+            self.gather(&order);
+        }
+        self.tangents = Some(
+            tangents
+                .into_iter()
+                .map(|t| t.unwrap_or([1.0, 0.0, 0.0, 1.0]))
+                .collect(),
+        );
+    }
+
+    /// Keeps the vertices `order` names, in that order (indices untouched: the caller renumbers them).
+    fn gather(&mut self, order: &[u32]) {
+        fn pick<T: Copy>(v: &mut Option<Vec<T>>, order: &[u32]) {
+            if let Some(all) = v {
+                *all = order.iter().map(|&i| all[i as usize]).collect();
+            }
+        }
+        let mut positions = Some(std::mem::take(&mut self.positions));
+        pick(&mut positions, order);
+        self.positions = positions.unwrap_or_default();
+        pick(&mut self.normals, order);
+        pick(&mut self.aux, order);
+        pick(&mut self.uv0, order);
+        pick(&mut self.uv1, order);
+        pick(&mut self.tangents, order);
+        pick(&mut self.colors, order);
+        if let Some(s) = &mut self.skin {
+            let k = s.per_vertex;
+            let (j, w) = (
+                std::mem::take(&mut s.joints),
+                std::mem::take(&mut s.weights),
+            );
+            for &i in order {
+                let at = i as usize * k;
+                s.joints.extend_from_slice(&j[at..at + k]);
+                s.weights.extend_from_slice(&w[at..at + k]);
+            }
+        }
+        for t in &mut self.targets {
+            let mut p = Some(std::mem::take(&mut t.positions));
+            pick(&mut p, order);
+            t.positions = p.unwrap_or_default();
+            pick(&mut t.normals, order);
+        }
+    }
 }
 
 /// A mesh's triangle primitives and the primitives it has that are not triangles.
@@ -143,14 +245,16 @@ impl Doc<'_> {
             }
             None => None,
         };
-        let uv0 = match attribute(attrs, "TEXCOORD_0", what, accessors)? {
-            Some(a) => {
+        let mut uvs = [None, None];
+        for (set, uv) in uvs.iter_mut().enumerate() {
+            let key = format!("TEXCOORD_{set}");
+            if let Some(a) = attribute(attrs, &key, what, accessors)? {
                 let v = self.read_vecs::<2>(a, what, "texture coordinates")?;
                 count_of(v.len(), "texture coordinates")?;
-                Some(v)
+                *uv = Some(v);
             }
-            None => None,
-        };
+        }
+        let [uv0, uv1] = uvs;
         let tangents = match attribute(attrs, "TANGENT", what, accessors)? {
             Some(a) => {
                 let v = self.read_vecs::<4>(a, what, "tangents")?;
@@ -221,22 +325,44 @@ impl Doc<'_> {
         let indices = triangulate(mode, &order)
             .ok_or_else(|| format!("{what} has {} indices, not a multiple of 3", order.len()))?;
         let materials = array(&self.json, "materials").len();
-        Ok(Triangles {
+        let material = opt_index(
+            &prim["material"],
+            || format!("{what}'s material"),
+            materials,
+        )?;
+        let mut t = Triangles {
             positions,
             normals,
             indices,
             aux,
             uv0,
+            uv1,
             tangents,
             colors,
             skin,
             targets,
-            material: opt_index(
-                &prim["material"],
-                || format!("{what}'s material"),
-                materials,
-            )?,
-        })
+            material,
+        };
+        if t.tangents.is_none() {
+            if let Some(set) = material.and_then(|m| self.normal_texcoord(m)) {
+                t.generate_tangents(set);
+            }
+        }
+        Ok(t)
+    }
+
+    /// The texture coordinate set of material `m`'s normal texture, when it has one.
+    fn normal_texcoord(&self, m: usize) -> Option<u64> {
+        let info = &self.json["materials"][m]["normalTexture"];
+        if info.is_null() {
+            return None;
+        }
+        let set = uint_or(&info["texCoord"], 0, String::new).unwrap_or(0);
+        Some(
+            info.pointer("/extensions/KHR_texture_transform/texCoord")
+                .and_then(super::json::uint)
+                .unwrap_or(set),
+        )
     }
 
     /// JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1: four influences a set, both of a set or neither.
@@ -311,7 +437,10 @@ pub struct Merged {
     all_normals: bool,
     aux: Option<Vec<[f32; 4]>>,
     pub indices: Vec<u32>,
+    /// Per primitive added: its glTF material (None: the default material) and its index count, in order.
+    parts: Vec<(Option<usize>, usize)>,
     uv0: Option<Vec<[f32; 2]>>,
+    uv1: Option<Vec<[f32; 2]>>,
     tangents: Option<Vec<[f32; 4]>>,
     colors: Option<Vec<[f32; 4]>>,
     base_positions: Vec<[f32; 3]>,
@@ -329,7 +458,9 @@ impl Default for Merged {
             all_normals: true,
             aux: None,
             indices: Vec::new(),
+            parts: Vec::new(),
             uv0: None,
+            uv1: None,
             tangents: None,
             colors: None,
             base_positions: Vec::new(),
@@ -348,6 +479,9 @@ pub struct MergedParts {
     /// None when some primitive had none (the caller computes them all).
     pub normals: Option<Vec<[f32; 3]>>,
     pub indices: Vec<u32>,
+    /// The triangles by material, in runs: (glTF material, None for the default one; index count), the runs
+    /// covering `indices` in order, one run per material.
+    pub parts: Vec<(Option<usize>, u32)>,
     pub aux: Option<Vec<[f32; 4]>>,
     pub data: VertexData,
 }
@@ -363,6 +497,7 @@ impl MergedParts {
             .ok_or_else(|| "has more vertices than 32-bit indices can address".to_string())?;
         self.indices
             .extend(other.indices.iter().map(|&i| offset + i));
+        self.parts.extend(other.parts);
         self.positions.extend(other.positions);
         self.normals = match (self.normals.take(), other.normals) {
             (Some(mut a), Some(b)) => {
@@ -381,6 +516,7 @@ impl MergedParts {
         }
         join(&mut self.aux, other.aux, base, n, [0.0; 4]);
         join(&mut self.data.uv0, other.data.uv0, base, n, [0.0; 2]);
+        join(&mut self.data.uv1, other.data.uv1, base, n, [0.0; 2]);
         join(
             &mut self.data.tangents,
             other.data.tangents,
@@ -448,6 +584,7 @@ impl Merged {
                 self.positions
                     .push(transform.transform_point3(morphed).to_array());
             }
+            self.parts.push((prim.material, prim.indices.len()));
             for t in prim.indices.chunks_exact(3) {
                 let t = if det < 0.0 {
                     [t[0], t[2], t[1]]
@@ -494,6 +631,7 @@ impl Merged {
                 [0.0; 4],
             );
             extend(&mut self.uv0, prim.uv0.clone(), base, n, [0.0; 2]);
+            extend(&mut self.uv1, prim.uv1.clone(), base, n, [0.0; 2]);
             let flip = if det < 0.0 { -1.0 } else { 1.0 };
             let tangents = prim.tangents.as_ref().map(|t| {
                 t.iter()
@@ -566,7 +704,9 @@ impl Merged {
 
     /// The merged mesh; its deformable part (when a primitive was skinned or had morph targets) holds the
     /// undeformed positions and normals (computed from them where the primitives had none).
-    pub fn finish(self) -> MergedParts {
+    pub fn finish(mut self) -> MergedParts {
+        let (indices, parts) = by_material(&self.indices, &self.parts);
+        self.indices = indices;
         let normals = self.all_normals.then_some(self.normals);
         let deform = (self.skin.is_some() || !self.targets.is_empty()).then(|| {
             let base_normals = match normals {
@@ -576,6 +716,7 @@ impl Merged {
             Box::new(Deformable {
                 base_positions: self.base_positions,
                 base_normals,
+                base_tangents: self.tangents.clone(),
                 skin: self.skin,
                 targets: self.targets,
             })
@@ -584,13 +725,46 @@ impl Merged {
             positions: self.positions,
             normals,
             indices: self.indices,
+            parts,
             aux: self.aux,
             data: VertexData {
                 uv0: self.uv0,
+                uv1: self.uv1,
                 tangents: self.tangents,
                 colors: self.colors,
                 deform,
             },
         }
     }
+}
+
+/// The triangles of `indices`, whose primitives `parts` lists in order (material, index count), regrouped so that
+/// each material's triangles are one run (materials in order of first use, triangles in their order within a
+/// material), and the runs.
+fn by_material(
+    indices: &[u32],
+    parts: &[(Option<usize>, usize)],
+) -> (Vec<u32>, Vec<(Option<usize>, u32)>) {
+    let mut order: Vec<Option<usize>> = Vec::new();
+    for (m, _) in parts {
+        if !order.contains(m) {
+            order.push(*m);
+        }
+    }
+    let mut out = Vec::with_capacity(indices.len());
+    let mut runs = Vec::with_capacity(order.len());
+    for m in order {
+        let before = out.len();
+        let mut at = 0;
+        for &(pm, count) in parts {
+            if pm == m {
+                out.extend_from_slice(&indices[at..at + count]);
+            }
+            at += count;
+        }
+        if out.len() > before {
+            runs.push((m, (out.len() - before) as u32));
+        }
+    }
+    (out, runs)
 }

@@ -64,7 +64,9 @@ pub fn def(
     let clip = motion::clip(&rig);
 
     // The models at rest, and how the clip moves their instances.
-    let collected = models::Collector::new(file, &mut content, &rig).collect()?;
+    let mut collected =
+        models::Collector::new(file, &mut content, &rig, cfg.materials).collect()?;
+    let materials = Arc::new(std::mem::take(&mut collected.materials));
     let placed = Placed::new(&content, &rig, clip.as_ref(), pv.frames, &collected);
     let deform_specs: Vec<Option<models::DeformSpec>> =
         collected.models.iter().map(|p| p.deform.clone()).collect();
@@ -147,6 +149,7 @@ pub fn def(
         ),
     };
     let parts = UserParts {
+        materials,
         instance_count: instances.len(),
         instances,
         from: from.to_array(),

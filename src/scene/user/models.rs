@@ -84,6 +84,8 @@ pub struct PendingInstance {
 /// The models and instances of a file, and what the reader noticed.
 #[derive(Debug, Default)]
 pub struct Collected {
+    /// The materials the models' parts name (empty with `--materials flat`: no model has parts).
+    pub materials: crate::geometry::material::Materials,
     pub models: Vec<PendingModel>,
     pub instances: Vec<PendingInstance>,
     pub notes: Vec<String>,
@@ -150,17 +152,26 @@ pub struct Collector<'c, 'a> {
     file: &'c str,
     content: &'c mut Content<'a>,
     rig: &'c gltf::Rig,
+    /// The materials read so far (None with `--materials flat`).
+    table: Option<gltf::MaterialTable>,
     prims: HashMap<usize, MeshPrimitives>,
     out: Collected,
     noted: Vec<usize>,
 }
 
 impl<'c, 'a> Collector<'c, 'a> {
-    pub fn new(file: &'c str, content: &'c mut Content<'a>, rig: &'c gltf::Rig) -> Self {
+    pub fn new(
+        file: &'c str,
+        content: &'c mut Content<'a>,
+        rig: &'c gltf::Rig,
+        materials: crate::geometry::material::MaterialMode,
+    ) -> Self {
         Collector {
             file,
             content,
             rig,
+            table: (materials == crate::geometry::material::MaterialMode::Full)
+                .then(gltf::MaterialTable::default),
             prims: HashMap::new(),
             out: Collected::default(),
             noted: Vec::new(),
@@ -230,6 +241,12 @@ impl<'c, 'a> Collector<'c, 'a> {
             }
         }
         self.content.placements = placements;
+        if let Some(t) = self.table.take() {
+            self.out
+                .notes
+                .extend(t.notes.iter().map(|n| format!("{}: {n}", self.file)));
+            self.out.materials = t.materials;
+        }
         if self.out.instances.is_empty() {
             let scene = match self.content.scene {
                 Some(s) => format!(" in scene {s}"),
@@ -403,12 +420,37 @@ impl<'c, 'a> Collector<'c, 'a> {
         if !deformed {
             parts.data.deform = None;
         }
+        self.mesh_from(parts)
+    }
+
+    /// The mesh of merged primitives, its parts' materials read when materials are drawn.
+    fn mesh_from(&mut self, parts: gltf::MergedParts) -> Result<Mesh> {
         let name = self.file;
+        let runs = match &mut self.table {
+            Some(table) => {
+                let mut runs = Vec::with_capacity(parts.parts.len());
+                for &(gltf_material, count) in &parts.parts {
+                    let m =
+                        self.content
+                            .material(table, gltf_material)
+                            .map_err(|e| Error::Mesh {
+                                path: name.to_string(),
+                                problem: e,
+                            })?;
+                    runs.push((m, count));
+                }
+                runs
+            }
+            None => Vec::new(),
+        };
         let mut m = Mesh::new(name, parts.positions, parts.normals, parts.indices)?;
         if let Some(aux) = parts.aux {
             m = m.with_aux(name, aux)?;
         }
         m = m.with_data(name, parts.data)?;
+        if !runs.is_empty() {
+            m = m.with_parts(name, &runs)?;
+        }
         m.check_area(name)?;
         Ok(m)
     }
@@ -472,14 +514,7 @@ impl<'c, 'a> Collector<'c, 'a> {
                 if parts.indices.is_empty() {
                     return Err(c.bad(format!("{what}: level {l} has no triangles")));
                 }
-                let name = c.file;
-                let mut m = Mesh::new(name, parts.positions, parts.normals, parts.indices)?;
-                if let Some(aux) = parts.aux {
-                    m = m.with_aux(name, aux)?;
-                }
-                m = m.with_data(name, parts.data)?;
-                m.check_area(name)?;
-                levels.push(m);
+                levels.push(c.mesh_from(parts)?);
                 colors.push(c.content.mesh_color(ps[0].mesh));
             }
             let color = colors[0].unwrap_or(PALETTE[c.out.models.len() % PALETTE.len()]);

@@ -12,6 +12,9 @@ use std::sync::Arc;
 pub struct UserParts {
     #[serde(skip)]
     pub instances: Vec<Instance>,
+    /// The materials the models' parts name (empty with `--materials flat`).
+    #[serde(skip)]
+    pub materials: Arc<crate::geometry::material::Materials>,
     /// The default camera flight: from, to, and the direction it looks in.
     pub from: [f32; 3],
     pub to: [f32; 3],
