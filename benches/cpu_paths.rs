@@ -97,6 +97,8 @@ fn csv_export(c: &mut Criterion) {
             rmse: Some(0.01),
             pop: Some(0.001),
             lodpop: Some(0.0),
+            lodpop_coverage: None,
+            lodpop_shading: None,
             de2000_mean: Some(0.1),
             uncovered_px: Some(0),
             crack_px: Some(0),

@@ -4,6 +4,10 @@
 //
 // Both images are read through Rgba8Unorm views of the sRGB targets, i.e. as the stored sRGB-encoded bytes.
 // Per pixel, with d = a - b per channel: |d.r|^2 + |d.g|^2 + |d.b|^2 -> rms = sqrt(sum / (3 * 255^2 * pixels)).
+// The sum is also split by where the pixel is: a pixel that is the background's colour (the device's encoding of
+// the clear colour, `params.bg`) in exactly one of the two frames is coverage (an object covers it in one frame
+// and not in the other); the rest is shading (covered in both, its colour changed). Each slot holds two 64-bit
+// sums, the whole and its coverage part: coverage^2 + shading^2 = rms^2 exactly in the sums.
 // One workgroup per row of the rectangle `x0..x1` by `y0..y1` (outside it the two frames are known to be equal:
 // lodpop's counterfactual is drawn only there, src/measure/quality.rs), LANES invocations (a pipeline constant,
 // as in shaders/metrics.wgsl: 64 on a GPU, 8 on a CPU adapter, one vector of lavapipe's 256-bit lanes adding an
@@ -19,6 +23,8 @@ struct Params {
     y0: u32,
     x1: u32,
     y1: u32,
+    // The background's bytes (r, g, b) and a pad.
+    bg: vec4<u32>,
 };
 
 @group(0) @binding(0) var a_img: texture_2d<f32>;
@@ -39,15 +45,28 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     var sum = 0u;
+    var coverage = 0u;
+    let bg = vec3<i32>(params.bg.xyz);
     for (var x = params.x0 + gid.x; x < params.x1; x = x + LANES) {
         let p = vec2<i32>(i32(x), i32(y));
-        let d = to_bytes(textureLoad(a_img, p, 0)) - to_bytes(textureLoad(b_img, p, 0));
-        sum = sum + u32(d.x * d.x + d.y * d.y + d.z * d.z);
+        let a = to_bytes(textureLoad(a_img, p, 0));
+        let b = to_bytes(textureLoad(b_img, p, 0));
+        let d = a - b;
+        let e = u32(d.x * d.x + d.y * d.y + d.z * d.z);
+        sum = sum + e;
+        if (all(a == bg) != all(b == bg)) {
+            coverage = coverage + e;
+        }
     }
-    if (sum != 0u) {
-        let lo = params.slot * 2u;
-        let old = atomicAdd(&sums[lo], sum);
-        if (old + sum < old) {
+    add(params.slot * 4u, sum);
+    add(params.slot * 4u + 2u, coverage);
+}
+
+// Adds `v` to the 64-bit sum in words `lo` and `lo + 1`.
+fn add(lo: u32, v: u32) {
+    if (v != 0u) {
+        let old = atomicAdd(&sums[lo], v);
+        if (old + v < old) {
             atomicAdd(&sums[lo + 1u], 1u);
         }
     }

@@ -447,5 +447,10 @@ pub fn summary_table(s: &RunSummary) -> String {
          no image figures)\n",
         baseline.as_deref().unwrap_or("the baseline (none run)")
     ));
+    for b in &s.blocks {
+        if let Some(limit) = &b.material_limits {
+            out.push_str(&format!("note: {} {}: {limit}\n", b.scene, b.method));
+        }
+    }
     out
 }

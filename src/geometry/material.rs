@@ -94,14 +94,16 @@ pub struct TextureRef {
 pub const IDENTITY_TRANSFORM: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
 
 impl TextureRef {
-    /// KHR_texture_transform's matrix: translation x rotation x scale, the rotation's matrix as the extension
-    /// writes it in GLSL (`mat3(cos, sin, 0, -sin, cos, 0, 0, 0, 1)`, column-major: rows [cos, -sin] and
-    /// [sin, cos]).
+    /// KHR_texture_transform's matrix: translation x rotation x scale, the rotation's rows [cos, sin] and
+    /// [-sin, cos]: the extension's GLSL listing, `mat3(cos, sin, 0, -sin, cos, 0, 0, 0, 1)`, read row by row. Read
+    /// column-major (as GLSL would), it turns the other way, and Khronos's TextureTransformTest shows its red
+    /// marker ("the rotation was applied in the opposite direction"); three.js and the Khronos Sample Viewer turn
+    /// as here.
     pub fn transform_of(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> [[f32; 3]; 2] {
         let (s, c) = rotation.sin_cos();
         [
-            [c * scale[0], -s * scale[1], offset[0]],
-            [s * scale[0], c * scale[1], offset[1]],
+            [c * scale[0], s * scale[1], offset[0]],
+            [-s * scale[0], c * scale[1], offset[1]],
         ]
     }
 
@@ -338,11 +340,10 @@ mod tests {
                 [2.0, 3.0],
             ),
         };
-        // scale: (1, 1) -> (2, 3); rotation by +90 degrees as the extension writes it: (x, y) -> (-y, x);
-        // then the offset.
+        // scale: (1, 1) -> (2, 3); rotation by +90 degrees: (x, y) -> (y, -x); then the offset.
         let [u, v] = t.apply([1.0, 1.0]);
-        assert!((u - (-3.0 + 0.5)).abs() < 1e-6, "{u}");
-        assert!((v - (2.0 + 0.25)).abs() < 1e-6, "{v}");
+        assert!((u - (3.0 + 0.5)).abs() < 1e-6, "{u}");
+        assert!((v - (-2.0 + 0.25)).abs() < 1e-6, "{v}");
         let id = TextureRef {
             transform: IDENTITY_TRANSFORM,
             ..t

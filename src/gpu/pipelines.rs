@@ -109,6 +109,8 @@ pub struct MeshPipelines {
     variants: [Option<wgpu::RenderPipeline>; 4],
     /// The first class's variant (every set has one).
     first: wgpu::RenderPipeline,
+    /// The surface the pipelines shade with (the flat one in a scene of materials: `reference-flat`).
+    pub surface: Surface,
 }
 
 impl MeshPipelines {
@@ -229,7 +231,11 @@ fn build(ctx: &PipelineContext<'_>, d: &MeshPipeline<'_>, shadow: bool) -> MeshP
         Some(p) => p.clone(),
         None => mesh_pipeline_from(ctx, d, shadow, MaterialClass::PLAIN),
     };
-    MeshPipelines { variants, first }
+    MeshPipelines {
+        variants,
+        first,
+        surface: ctx.surface,
+    }
 }
 
 fn mesh_pipeline_from(

@@ -111,6 +111,8 @@ pub struct SceneGpu {
     pub shadow_maps: Vec<wgpu::Texture>,
     pub shadow_size: u32,
     pub shader: wgpu::ShaderModule,
+    /// The flat surface's shader in a scene of materials ([`SceneGpu::flat_pipeline`]).
+    flat_shader: Option<wgpu::ShaderModule>,
     /// What the mesh shader's surface is: flat, or the scene's materials.
     pub surface: Surface,
     /// The material parts of every LOD ([`LodRange::parts`]).
@@ -191,6 +193,22 @@ impl SceneGpu {
     /// call this in their constructors).
     pub fn mesh_pipeline(&self, d: &MeshPipeline<'_>) -> MeshPipelines {
         mesh_pipelines(&self.pipeline_context(), d)
+    }
+
+    /// A pipeline with the flat surface whatever the scene's (one colour per instance, Lambert and ambient, no
+    /// material bound; every triangle of a LOD in one draw): what `reference-flat` draws, the same triangles as
+    /// the reference without the materials' cost.
+    pub fn flat_pipeline(&self, d: &MeshPipeline<'_>) -> MeshPipelines {
+        mesh_pipelines(
+            &PipelineContext {
+                shader: self.flat_shader.as_ref().unwrap_or(&self.shader),
+                surface: Surface::Flat,
+                material_layout: None,
+                classes: &[MaterialClass::PLAIN],
+                ..self.pipeline_context()
+            },
+            d,
+        )
     }
 
     /// An instance buffer for `capacity` instances.
@@ -398,6 +416,12 @@ impl SceneGpu {
             })
             .collect();
         let surface = if pbr { Surface::Pbr } else { Surface::Flat };
+        let flat_shader = pbr.then(|| {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("surface/flat.wgsl + mesh.wgsl"),
+                source: wgpu::ShaderSource::Wgsl(mesh_wgsl(Surface::Flat).into()),
+            })
+        });
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(match surface {
                 Surface::Flat => "surface/flat.wgsl + mesh.wgsl",
@@ -461,6 +485,7 @@ impl SceneGpu {
             shadow_maps,
             shadow_size,
             shader,
+            flat_shader,
             surface,
             parts,
             classes,
@@ -781,7 +806,10 @@ impl SceneGpu {
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, buffer.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-        let Some(materials) = &self.materials else {
+        let flat = pipelines
+            .first()
+            .is_some_and(|p| p.surface == Surface::Flat);
+        let Some(materials) = self.materials.as_ref().filter(|_| !flat) else {
             let mut bound: Option<PipelineIndex> = None;
             for d in &list.draws {
                 if bound != Some(d.pipeline) {

@@ -1,6 +1,7 @@
 //! The difference kernel of `shaders/diff.wgsl`: the RMS difference between two frames, per frame, as exact
-//! integer sums in one slot per frame, read back once at the end of a pass. It compares fixed pairs of targets
-//! (bound once); `encode` picks the pair.
+//! integer sums in one slot per frame, read back once at the end of a pass, split into its coverage part (pixels
+//! that are the background in one frame only) and its shading part (the rest). It compares fixed pairs of
+//! targets (bound once); `encode` picks the pair.
 
 use crate::error::Result;
 use crate::gpu::compute::{bind_group, kernel_lanes, results_buffers, uniform_buffer};
@@ -9,6 +10,16 @@ use crate::gpu::targets::RenderTarget;
 use crate::measure::coverage::PixelRect;
 
 pub const DIFF_WGSL: &str = include_str!("../../shaders/diff.wgsl");
+
+/// One frame's difference: its RMS over every pixel, and the RMS of its two parts over every pixel (coverage:
+/// the pixels that are the background in one frame only; shading: the others), `coverage^2 + shading^2 =
+/// rms^2` exactly in the integer sums.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DiffFigure {
+    pub rms: f64,
+    pub coverage: f64,
+    pub shading: f64,
+}
 
 pub struct DiffKernel {
     pipeline: wgpu::ComputePipeline,
@@ -19,15 +30,19 @@ pub struct DiffKernel {
     width: u32,
     height: u32,
     frames: u32,
+    /// The background's bytes on this device (`SceneGpu::background_bytes`).
+    background: [u8; 3],
 }
 
 impl DiffKernel {
-    /// Compares each pair `(a, b)` of `pairs` (all of one size), with a slot for each of up to `frames` frames.
+    /// Compares each pair `(a, b)` of `pairs` (all of one size), with a slot for each of up to `frames` frames;
+    /// `background` is the device's bytes of the clear colour.
     pub fn new(
         ctx: &GpuContext,
         label: &str,
         pairs: &[(&RenderTarget, &RenderTarget)],
         frames: u32,
+        background: [u8; 3],
     ) -> Result<DiffKernel> {
         let device = &ctx.device;
         let (width, height) = pairs.first().map_or((1, 1), |(a, _)| (a.width, a.height));
@@ -47,8 +62,8 @@ impl DiffKernel {
             },
             cache: None,
         });
-        let [sums, readback] = results_buffers(device, [label, label], frames as u64 * 8);
-        let params = uniform_buffer(device, label, 32);
+        let [sums, readback] = results_buffers(device, [label, label], frames as u64 * 16);
+        let params = uniform_buffer(device, label, 48);
         let layout = pipeline.get_bind_group_layout(0);
         let bind_groups = pairs
             .iter()
@@ -72,6 +87,7 @@ impl DiffKernel {
             width,
             height,
             frames,
+            background,
         })
     }
 
@@ -103,6 +119,7 @@ impl DiffKernel {
         rect: PixelRect,
     ) {
         let slot = frame.min(self.frames - 1);
+        let [r, g, b] = self.background.map(u32::from);
         let params = [
             self.width,
             self.height,
@@ -112,6 +129,10 @@ impl DiffKernel {
             rect.y0,
             rect.x1.min(self.width),
             rect.y1.min(self.height),
+            r,
+            g,
+            b,
+            0,
         ];
         queue.write_buffer(&self.params, 0, bytemuck::cast_slice(&params));
         if rect.is_empty() {
@@ -128,12 +149,28 @@ impl DiffKernel {
 
     /// The RMS difference of frames `0..frames` (0 for a frame never encoded), after their submissions.
     pub fn read(&self, ctx: &GpuContext, frames: u32) -> Result<Vec<f64>> {
-        let pixels = self.width as f64 * self.height as f64;
-        let n = frames.min(self.frames) as usize;
-        let sums = ctx.read_u64_sums(&self.sums, &self.readback, n)?;
-        Ok(sums
+        Ok(self
+            .read_parts(ctx, frames)?
             .into_iter()
-            .map(|sum| (sum as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt())
+            .map(|d| d.rms)
+            .collect())
+    }
+
+    /// The difference of frames `0..frames` with its coverage and shading parts.
+    pub fn read_parts(&self, ctx: &GpuContext, frames: u32) -> Result<Vec<DiffFigure>> {
+        let scale = 3.0 * 255.0 * 255.0 * self.width as f64 * self.height as f64;
+        let n = frames.min(self.frames) as usize;
+        let sums = ctx.read_u64_sums(&self.sums, &self.readback, 2 * n)?;
+        Ok(sums
+            .chunks_exact(2)
+            .map(|s| {
+                let (all, coverage) = (s[0], s[1].min(s[0]));
+                DiffFigure {
+                    rms: (all as f64 / scale).sqrt(),
+                    coverage: (coverage as f64 / scale).sqrt(),
+                    shading: ((all - coverage) as f64 / scale).sqrt(),
+                }
+            })
             .collect())
     }
 }

@@ -152,12 +152,30 @@ pub struct ShadowShare {
 }
 
 impl ShadowShare {
-    pub fn new(ctx: &GpuContext, scene: &Scene, reference: &RenderTarget) -> Result<ShadowShare> {
+    pub fn new(
+        ctx: &GpuContext,
+        scene: &Scene,
+        reference: &RenderTarget,
+        background: [u8; 3],
+    ) -> Result<ShadowShare> {
         let (w, h) = (scene.width, scene.height);
         let now = RenderTarget::new(&ctx.device, "shadow share now", w, h);
         let before = RenderTarget::new(&ctx.device, "shadow share before", w, h);
-        let rmse = DiffKernel::new(ctx, "shadow rmse", &[(&now, reference)], scene.frames)?;
-        let lodpop = DiffKernel::new(ctx, "shadow lodpop", &[(&now, &before)], scene.frames)?;
+        let pair = |a, b| [(a, b)];
+        let rmse = DiffKernel::new(
+            ctx,
+            "shadow rmse",
+            &pair(&now, reference),
+            scene.frames,
+            background,
+        )?;
+        let lodpop = DiffKernel::new(
+            ctx,
+            "shadow lodpop",
+            &pair(&now, &before),
+            scene.frames,
+            background,
+        )?;
         Ok(ShadowShare {
             now,
             before,

@@ -132,15 +132,16 @@ impl QualityKernels {
     ) -> Result<QualityKernels> {
         let frames = scene.frames;
         let pairs = [(&t.method, &t.before), (&t.now, &t.before)];
+        let background = gpu.background_bytes(ctx)?;
         Ok(QualityKernels {
-            lodpop: DiffKernel::new(ctx, "lodpop", &pairs, frames)?,
-            lag: DiffKernel::new(ctx, "lag", &[(&t.method, &t.now)], frames)?,
+            lodpop: DiffKernel::new(ctx, "lodpop", &pairs, frames, background)?,
+            lag: DiffKernel::new(ctx, "lag", &[(&t.method, &t.now)], frames, background)?,
             metric: MetricKernel::new(
                 ctx,
                 (&t.method, &t.reference),
                 frames,
                 (quality.metrics.contains(&Metric::De2000), quality.reduction),
-                gpu.background_bytes(ctx)?,
+                background,
             )?,
             metric_timer: GpuTimer::new(ctx, frames.div_ceil(METRIC_TIMED_EVERY)),
         })
@@ -158,7 +159,8 @@ pub struct QualityPass {
     pub metrics: Vec<FrameMetrics>,
     /// `--metrics flip`: mean FLIP per frame.
     pub flip: Vec<Option<f64>>,
-    pub lodpop: Vec<f64>,
+    /// lodpop per frame, with its coverage and shading parts.
+    pub lodpop: Vec<super::diff_kernel::DiffFigure>,
     /// Methods with a lag (FSI): lag_rmse per frame.
     pub lag: Option<Vec<f64>>,
     pub shadow: Option<ShadowFigures>,
@@ -344,7 +346,12 @@ impl QualityStage {
         });
         let shadow_share = match scene.shadows {
             None => None,
-            Some(_) => Some(ShadowShare::new(ctx, scene, &targets.reference)?),
+            Some(_) => Some(ShadowShare::new(
+                ctx,
+                scene,
+                &targets.reference,
+                base.gpu.background_bytes(ctx)?,
+            )?),
         };
         let taa = TaaStreams::new(ctx, scene);
         Ok(QualityStage {
@@ -967,7 +974,7 @@ impl QualityStage {
         Ok(QualityPass {
             metrics: k.metric.read(ctx, frames)?,
             flip: walk.flip,
-            lodpop: k.lodpop.read(ctx, frames)?,
+            lodpop: k.lodpop.read_parts(ctx, frames)?,
             lag: if walk.has_lag {
                 Some(k.lag.read(ctx, frames)?)
             } else {

@@ -38,6 +38,12 @@ pub struct FrameRecord {
     /// frame's LOD schedule at this frame's pose (docs/measurement.md, "lodpop"); 0 where the schedule did not
     /// change.
     pub lodpop: Option<f64>,
+    /// lodpop's two parts, each an RMS over every pixel of the frame (`lodpop_coverage^2 + lodpop_shading^2 =
+    /// lodpop^2`, exactly in the integer sums): coverage, the pixels that are the background in one of the two
+    /// frames only (the silhouette moved); shading, the pixels covered in both whose colour changed
+    /// (docs/measurement.md, "lodpop in parts").
+    pub lodpop_coverage: Option<f64>,
+    pub lodpop_shading: Option<f64>,
     /// Mean CIEDE2000 over pixels between method and reference frame (sRGB D65 -> XYZ -> CIELAB), with
     /// `--metrics de2000` (empty otherwise).
     pub de2000_mean: Option<f64>,
@@ -505,6 +511,11 @@ pub struct TransitionRecord {
     /// frame, with `--quality off`).
     pub lodpop_max: Option<f64>,
     pub lodpop_max_frame: Option<u32>,
+    /// lodpop_max's parts on its frame: coverage^2 + shading^2 = lodpop_max^2 (FrameRecord::lodpop_coverage).
+    #[serde(default)]
+    pub lodpop_coverage: Option<f64>,
+    #[serde(default)]
+    pub lodpop_shading: Option<f64>,
     pub pop_max: Option<f64>,
     pub pop_max_frame: Option<u32>,
     pub rmse_max: Option<f64>,
@@ -539,6 +550,7 @@ pub fn transitions(rows: &[FrameRecord], pairs: &[TransitionPair]) -> Vec<Transi
                 .unzip()
         };
         let (lodpop_max, lodpop_max_frame) = argmax(|r| r.lodpop);
+        let at_max = lodpop_max_frame.and_then(|f| window.iter().find(|r| r.frame == f));
         let (pop_max, pop_max_frame) = argmax(|r| r.pop);
         let r0 = &rows[first];
         out.push(TransitionRecord {
@@ -558,6 +570,8 @@ pub fn transitions(rows: &[FrameRecord], pairs: &[TransitionPair]) -> Vec<Transi
                 .text(),
             lodpop_max,
             lodpop_max_frame,
+            lodpop_coverage: at_max.and_then(|r| r.lodpop_coverage),
+            lodpop_shading: at_max.and_then(|r| r.lodpop_shading),
             pop_max,
             pop_max_frame,
             rmse_max: argmax(|r| r.rmse).0,
@@ -579,6 +593,10 @@ pub struct BlockInfo {
     /// The options the method reads (`MethodEntry::options`; absent for methods without options).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub method_options: Option<serde_json::Value>,
+    /// What of the scene's materials the method does not draw as the reference does (`Method::material_limits`;
+    /// absent when it draws them all).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub material_limits: Option<String>,
     pub count: u32,
     pub width: u32,
     pub height: u32,
@@ -819,6 +837,8 @@ impl FrameTimes {
             rmse: None,
             pop: None,
             lodpop: None,
+            lodpop_coverage: None,
+            lodpop_shading: None,
             de2000_mean: None,
             uncovered_px: None,
             crack_px: None,
@@ -863,6 +883,8 @@ pub(crate) mod tests {
             rmse: Some(rmse),
             pop: Some(pop),
             lodpop: Some(0.0),
+            lodpop_coverage: None,
+            lodpop_shading: None,
             de2000_mean: Some(rmse / 2.0),
             uncovered_px: Some(0),
             crack_px: Some(0),
@@ -1099,6 +1121,8 @@ pub(crate) mod tests {
             .map(|(f, &n)| FrameRecord {
                 t_instances: n,
                 lodpop: Some([0.0, 0.1, 0.3, 0.2, 0.0, 0.05, 0.4, 0.0][f]),
+                lodpop_coverage: None,
+                lodpop_shading: None,
                 ..row(f as u32, None, 0.01 * f as f64, 0.0)
             })
             .collect();
@@ -1151,6 +1175,8 @@ pub(crate) mod tests {
                 rmse: None,
                 pop: None,
                 lodpop: None,
+                lodpop_coverage: None,
+                lodpop_shading: None,
                 de2000_mean: None,
                 uncovered_px: None,
                 crack_px: None,

@@ -156,6 +156,14 @@ impl AlphaTwoPass {
 }
 
 impl Method for AlphaTwoPass {
+    fn material_limits(&self, materials: &crate::geometry::material::Materials) -> Option<String> {
+        materials
+            .materials
+            .iter()
+            .any(|m| m.alpha == crate::geometry::material::AlphaMode::Blend)
+            .then(|| "BLEND materials' parts of an instance in transition are not drawn: the double pass keeps the fragments at each translucent LOD's nearest opaque surface (a depth-equal test), and a blended surface writes no depth".to_string())
+    }
+
     fn image_confined_to_instances(&self) -> bool {
         true
     }

@@ -259,6 +259,14 @@ impl AlphaSorted {
 }
 
 impl Method for AlphaSorted {
+    fn material_limits(&self, materials: &crate::geometry::material::Materials) -> Option<String> {
+        materials
+            .materials
+            .iter()
+            .any(|m| m.alpha == crate::geometry::material::AlphaMode::Blend)
+            .then(|| "BLEND materials' parts of an instance in transition are blended in draw order over the peeled layers, not peeled with them".to_string())
+    }
+
     fn image_confined_to_instances(&self) -> bool {
         true
     }

@@ -157,6 +157,12 @@ pub trait Method {
         false
     }
 
+    /// What of a scene's materials this method does not draw as the reference does, in a sentence (run.json's
+    /// `material_limits`, a note under the run's table); None when it draws them all. Default: None.
+    fn material_limits(&self, _materials: &crate::geometry::material::Materials) -> Option<String> {
+        None
+    }
+
     /// How many earlier frames' states this method's frame depends on (1 for a frame that is a function of the
     /// current states; FSI's older LOD buffer makes it 2).
     fn lodpop_history(&self) -> usize {
@@ -475,6 +481,8 @@ pub struct OpaqueInstances {
     list: DrawList,
     buffer: InstanceBuffer,
     seams: Option<SeamDraws>,
+    /// A pipeline of its own in place of the scene's opaque one (`reference-flat`'s flat surface).
+    pipeline: Option<crate::gpu::MeshPipelines>,
 }
 
 impl OpaqueInstances {
@@ -483,6 +491,15 @@ impl OpaqueInstances {
             list: DrawList::default(),
             buffer: gpu.create_instance_buffer(label, scene.instances.len() as u32),
             seams: None,
+            pipeline: None,
+        }
+    }
+
+    /// The same, drawn with the flat surface whatever the scene's ([`SceneGpu::flat_pipeline`]).
+    pub fn flat(gpu: &SceneGpu, scene: &Scene, label: &str) -> Self {
+        OpaqueInstances {
+            pipeline: Some(gpu.flat_pipeline(&crate::gpu::MeshPipeline::opaque(label))),
+            ..Self::new(gpu, scene, label)
         }
     }
 
@@ -525,7 +542,7 @@ impl OpaqueInstances {
             &self.buffer,
             0,
             &self.list,
-            &[&gpu.opaque_pipeline],
+            &[self.pipeline.as_ref().unwrap_or(&gpu.opaque_pipeline)],
         );
         match &self.seams {
             Some(seams) => stats + seams.draw(gpu, &mut pass),

@@ -91,6 +91,7 @@ fn fsi_ablation_options(o: &MethodOptions) -> Option<serde_json::Value> {
 #[rustfmt::skip]
 pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "reference", about: "LOD0 everywhere: the high-poly reference", create: |b| Ok(Box::new(reference::Reference::new(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "reference-flat", about: "the reference drawn flat (one colour per model, no texture): paired with reference, the cost of a user scene's materials (not run by default)", create: |b| Ok(Box::new(reference::Reference::flat(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "discrete", about: "discrete LOD switching: a hard switch at k = 0.5", create: |b| Ok(Box::new(discrete::Discrete::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "alpha", about: "Giegl's unpopping: one LOD opaque, the other blended over it", create: |b| Ok(Box::new(alpha::Alpha::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "alpha-2pass", about: "unpopping, double pass: each translucent LOD shows only its nearest surface", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene, alpha_2pass::Weights::Unpop))), options: no_options },
@@ -215,7 +216,7 @@ pub const UNIFIED_DEFAULT: [&str; 5] = [
 
 /// Built-in methods a run draws only when `--method` names them: variants that test a claim (their image is
 /// another method's, or they ablate one).
-pub const NOT_DEFAULT: [&str; 3] = ["alpha-sorted", "dither-skip", "fsi-blend"];
+pub const NOT_DEFAULT: [&str; 4] = ["reference-flat", "alpha-sorted", "dither-skip", "fsi-blend"];
 
 /// Whether the method of `label` needs a unified scene.
 pub fn needs_unified(label: &str) -> bool {

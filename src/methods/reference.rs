@@ -17,6 +17,15 @@ impl Reference {
             draw: OpaqueInstances::new(gpu, scene, "reference instances"),
         }
     }
+
+    /// `reference-flat`: the reference's triangles with the flat surface (one colour per model, Lambert and
+    /// ambient, no texture read), whatever the scene's materials: paired with `reference`, the cost of drawing
+    /// the materials (the same image as `reference` in a scene without them).
+    pub fn flat(gpu: &SceneGpu, scene: &Scene) -> Self {
+        Reference {
+            draw: OpaqueInstances::flat(gpu, scene, "reference-flat instances"),
+        }
+    }
 }
 
 impl Method for Reference {
