@@ -42,6 +42,31 @@ pub fn rms_difference(a: &[u8], b: &[u8]) -> f64 {
     (sum / (3 * pixels) as f64).sqrt()
 }
 
+/// [`rms_difference`] and its two parts (shaders/diff.wgsl's CPU twin): coverage, over the pixels whose RGB is
+/// `background` in exactly one of the two images; shading, over the rest. Each is an RMS over every pixel, so
+/// `coverage^2 + shading^2 = rms^2`.
+pub fn rms_difference_parts(a: &[u8], b: &[u8], background: [u8; 3]) -> (f64, f64, f64) {
+    assert_eq!(a.len(), b.len(), "images of different sizes");
+    let pixels = a.len() / 4;
+    if pixels == 0 {
+        return (0.0, 0.0, 0.0);
+    }
+    let (mut all, mut coverage) = (0u64, 0u64);
+    for (p, q) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        let e: u64 = (0..3).map(|c| (p[c].abs_diff(q[c]) as u64).pow(2)).sum();
+        all += e;
+        if (p[..3] == background) != (q[..3] == background) {
+            coverage += e;
+        }
+    }
+    let scale = 3.0 * 255.0 * 255.0 * pixels as f64;
+    (
+        (all as f64 / scale).sqrt(),
+        (coverage as f64 / scale).sqrt(),
+        ((all - coverage) as f64 / scale).sqrt(),
+    )
+}
+
 /// The signed per-channel error image E = method - reference (RGB, encoded values in [-1, 1]).
 pub fn error_image(method: &[u8], reference: &[u8]) -> Vec<f32> {
     assert_eq!(method.len(), reference.len(), "images of different sizes");
@@ -379,6 +404,22 @@ pub fn difference_image(method: &[u8], reference: &[u8]) -> Vec<f32> {
 
 #[cfg(test)]
 mod tests {
+    /// A pixel that is the background in one image only is coverage, one covered in both is shading, one that
+    /// is the background in both adds nothing; the parts' squares add up to the whole's.
+    #[test]
+    fn a_difference_splits_into_coverage_and_shading() {
+        let bg = [10, 20, 30];
+        let px = |c: [u8; 3]| [c[0], c[1], c[2], 255];
+        let a: Vec<u8> = [px(bg), px([200, 20, 30]), px([100, 100, 100]), px(bg)].concat();
+        let b: Vec<u8> = [px(bg), px(bg), px([110, 100, 90]), px(bg)].concat();
+        let (rms, coverage, shading) = rms_difference_parts(&a, &b, bg);
+        let scale = 3.0 * 255.0 * 255.0 * 4.0;
+        assert!((coverage - (190.0f64 * 190.0 / scale).sqrt()).abs() < 1e-12);
+        assert!((shading - (200.0f64 / scale).sqrt()).abs() < 1e-12);
+        assert!((rms * rms - coverage * coverage - shading * shading).abs() < 1e-15);
+        assert!((rms - rms_difference(&a, &b)).abs() < 1e-12);
+    }
+
     use super::*;
 
     fn img(px: &[[u8; 3]]) -> Vec<u8> {

@@ -21,6 +21,8 @@ mod cli_input;
 mod commands_clips;
 mod commands_compare;
 mod commands_experiment;
+// src/gpu: what the GPU draws of a scene's materials.
+mod gpu_materials;
 // src/measure: the quality pass's figures, and runs without it.
 mod measure_coverage;
 mod measure_lodpop;

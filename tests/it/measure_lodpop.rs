@@ -1,7 +1,9 @@
 //! lodpop, the popping score that holds the pose fixed (docs/measurement.md, "lodpop"), on the software
 //! adapter: (a) zero without transitions while pop is not; (b) discrete's only on its switch frames; (c) every
 //! smooth method below discrete at every transition of a bunny sweep; (d) the GPU kernel against the CPU
-//! oracle on dumped frames, for lodpop and FSI's lag_rmse; and fsi-sameframe, which has no lag, at lag 0.
+//! oracle on dumped frames, for lodpop, its coverage and shading parts and FSI's lag_rmse; and fsi-sameframe,
+//! which has no lag, at lag 0; (e) a switch that changes colours only is all shading, one that changes the
+//! outline only all coverage.
 
 use crate::common::{col, read_csv, run_into, Rows};
 
@@ -146,15 +148,25 @@ fn gpu_lodpop_and_lag_match_the_cpu_oracle() {
         };
         let now = load(&stem, "lodpop-now");
         if let Some(before) = load(&stem, "lodpop-before") {
-            let cpu = lodbench::measure::metrics::rms_difference(
+            // The background's bytes: a corner of the reference frame, which the bunny never reaches.
+            let corner = load(&stem, "reference").unwrap();
+            let bg = [corner[0], corner[1], corner[2]];
+            let (cpu, coverage, shading) = lodbench::measure::metrics::rms_difference_parts(
                 now.as_ref().unwrap_or(&method),
                 &before,
+                bg,
             );
-            let gpu: f64 = r["lodpop"].parse().unwrap();
-            assert!(
-                (cpu - gpu).abs() < 1e-5,
-                "{stem}: lodpop gpu {gpu} cpu {cpu}"
-            );
+            for (c, want) in [
+                ("lodpop", cpu),
+                ("lodpop_coverage", coverage),
+                ("lodpop_shading", shading),
+            ] {
+                let gpu: f64 = r[c].parse().unwrap();
+                assert!(
+                    (want - gpu).abs() < 1e-5,
+                    "{stem}: {c} gpu {gpu} cpu {want}"
+                );
+            }
             lodpop_checked += 1;
         }
         if let Some(now) = &now {
@@ -225,4 +237,42 @@ fn a_moving_dither_pattern_pops_at_a_fixed_state() {
     assert_eq!(full, lodpop, "--metric-region full differs");
     let (fixed, _) = lodpop_of(false, MetricRegion::Covered);
     assert!(fixed.iter().all(|&x| x == 0.0), "fixed pattern: {fixed:?}");
+}
+
+/// (e) lodpop's parts on two authored chains (tests/data/gltf/make_materials.py), unlit so that a colour is its
+/// material's whatever the light: pop-shading's levels share their outline and differ in colour, so its switch is
+/// all shading (coverage exactly 0); pop-coverage's share their colour and differ in outline, so its switch is all
+/// coverage (shading exactly 0). Each crosses its switch on the default flight within the 40 frames.
+#[test]
+fn a_switch_of_colour_is_shading_and_a_switch_of_outline_is_coverage() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gltf");
+    for (file, part, other) in [
+        ("pop-shading.gltf", "lodpop_shading", "lodpop_coverage"),
+        ("pop-coverage.gltf", "lodpop_coverage", "lodpop_shading"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = data.join(file);
+        #[rustfmt::skip]
+        let rows = run(dir.path(), &[
+            "--scene", scene.to_str().unwrap(), "--method", "discrete", "--frames", "40", "--width", "96",
+            "--height", "72",
+        ]);
+        let lodpop = col(&rows, "discrete", "lodpop");
+        let (mine, theirs) = (col(&rows, "discrete", part), col(&rows, "discrete", other));
+        let switches: Vec<usize> = (0..lodpop.len()).filter(|&f| lodpop[f] > 0.0).collect();
+        assert_eq!(switches.len(), 1, "{file}: one switch: {lodpop:?}");
+        for f in 0..lodpop.len() {
+            assert_eq!(theirs[f], 0.0, "{file} frame {f}: {other} {}", theirs[f]);
+            assert!(
+                (mine[f] - lodpop[f]).abs() <= 1e-12 * lodpop[f].max(1.0),
+                "{file} frame {f}: {part} {} lodpop {}",
+                mine[f],
+                lodpop[f]
+            );
+        }
+        let transitions = read_csv(&dir.path().join("transitions.csv"));
+        assert_eq!(transitions.len(), 1, "{file}");
+        assert_eq!(transitions[0][other].parse::<f64>().unwrap(), 0.0, "{file}");
+        assert_eq!(transitions[0][part], transitions[0]["lodpop_max"], "{file}");
+    }
 }
