@@ -160,7 +160,8 @@ def transition_pops(by_method, window=TRANSITION_WINDOW):
 
 def transition_table(rows, scene):
     """Per transition from transitions.csv (one scene, the first count): [(first, last, lods, {method: (max lodpop,
-    max pop)})], the reference left out. A transition is its frames as well as its index: runs of a sweep whose
+    max pop, its coverage part, its shading part)})] (the parts nan in folders older than them), the reference left
+    out. A transition is its frames as well as its index: runs of a sweep whose
     schedules differ (band, pixel error) have different transitions under one index, and each is its own entry,
     the methods of the other runs missing from it."""
     rows = [r for r in rows if r["scene"] == scene]
@@ -173,7 +174,8 @@ def transition_table(rows, scene):
             continue
         key = (int(r["transition"]), int(r["first_frame"]), int(r["last_frame"]), r["lods"])
         entry = out.setdefault(key, (int(r["first_frame"]), int(r["last_frame"]), r["lods"], OrderedDict()))
-        entry[3][r["method"]] = (num(r["lodpop_max"]), num(r["pop_max"]))
+        entry[3][r["method"]] = (num(r["lodpop_max"]), num(r["pop_max"]),
+                                 num(r.get("lodpop_coverage", "")), num(r.get("lodpop_shading", "")))
     return [out[k] for k in sorted(out, key=lambda k: (k[1], k[0], k[2], k[3]))]
 
 
@@ -182,12 +184,21 @@ def transition_methods(per_transition):
     return list(OrderedDict.fromkeys(m for p in per_transition for m in p[-1]))
 
 
+def stacked_parts(lodpop, coverage, shading):
+    """lodpop split into two heights that add up to it, each part's share of lodpop^2 (coverage^2 + shading^2 =
+    lodpop^2): (coverage height, shading height), or None where the parts are missing."""
+    if any(v != v for v in (lodpop, coverage, shading)) or lodpop <= 0:
+        return None
+    return coverage * coverage / lodpop, shading * shading / lodpop
+
+
 def transitions_figure(scene, per_transition, path):
-    """Bars per transition and method: lodpop (top) and pop (bottom) from transitions.csv, or pop alone from the
-    frames (older folders: `per_transition` entries are (first, last, {method: pop}))."""
+    """Bars per transition and method: lodpop (top; each bar stacked by its parts, coverage hatched below shading,
+    heights in proportion to their squares) and pop (bottom) from transitions.csv, or pop alone from the frames
+    (older folders: `per_transition` entries are (first, last, {method: pop}))."""
     with_lodpop = len(per_transition[0]) == 4
     methods = transition_methods(per_transition)
-    missing = (float("nan"), float("nan")) if with_lodpop else float("nan")
+    missing = (float("nan"),) * 4 if with_lodpop else float("nan")
     x = np.arange(len(per_transition))
     width = 0.8 / len(methods)
     panels = [("max lodpop (pose held)", 0), ("max pop (motion included)", 1)] if with_lodpop else \
@@ -196,11 +207,23 @@ def transitions_figure(scene, per_transition, path):
                              squeeze=False)
     for ax, (label, k) in zip(axes[:, 0], panels):
         for i, m in enumerate(methods):
+            at = x - 0.4 + (i + 0.5) * width
+            colour = f"C{i % 10}"
+            if k == 0:
+                figures = [p[-1].get(m, missing) for p in per_transition]
+                parts = [stacked_parts(f[0], f[2], f[3]) for f in figures]
+                if all(pt is not None for pt in parts):
+                    cov = [pt[0] for pt in parts]
+                    ax.bar(at, cov, width, color=colour, hatch="///", edgecolor="white", linewidth=0)
+                    ax.bar(at, [pt[1] for pt in parts], width, bottom=cov, color=colour, label=m)
+                    continue
             vals = [p[-1].get(m, missing) if k is None else p[-1].get(m, missing)[k] for p in per_transition]
-            ax.bar(x - 0.4 + (i + 0.5) * width, vals, width, label=m)
+            ax.bar(at, vals, width, label=m, color=colour)
         ticks = [f"frames {p[0]}-{p[1]}" + (f"\n{p[2]}" if with_lodpop else "") for p in per_transition]
         ax.set_xticks(x, ticks, rotation=20, fontsize=8)
         ax.set_ylabel(label)
+    if with_lodpop:
+        axes[0, 0].set_ylabel("max lodpop (pose held);\nhatched: its coverage part")
     axes[0, 0].set_title(f"{scene}: popping per transition and method")
     axes[0, 0].legend(fontsize=7, ncol=2)
     save(fig, path)
@@ -571,7 +594,10 @@ def report(folder: Path, transition: str = "worst") -> list:
     for scene, per_transition in tables:
         methods = transition_methods(per_transition)
         if len(per_transition[0]) == 4:
-            for k, what in ((0, "max lodpop (pose held)"), (1, "max pop (motion included)")):
+            for k, what in ((0, "max lodpop (pose held)"), (2, "max lodpop's coverage part"),
+                            (3, "max lodpop's shading part"), (1, "max pop (motion included)")):
+                if all(p[m][k] != p[m][k] for *_, p in per_transition for m in p):
+                    continue
                 rows = [{"transition": f"frames {a}-{b} ({lods})", **{m: f"{p[m][k]:.4f}" for m in methods if m in p}}
                         for a, b, lods, p in per_transition]
                 sections.append((f"{scene}: {what} of each transition (its frames and the 2 after)", rows,

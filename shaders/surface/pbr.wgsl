@@ -12,8 +12,12 @@
 //   (1 - F) plus the GGX specular lobe (Trowbridge-Reitz D, height-correlated Smith V, Schlick F, F0 = 0.04 for
 //   dielectrics), lit by one directional light of irradiance pi x (1 - ambient) at normal incidence from
 //   camera.light.xyz (shadowed under --shadows on), plus a uniform ambient environment of radiance `ambient`
-//   (camera.light.w): diffuse c_diff x ambient and specular ambient x (F0 x A + B) with Karis's analytic fit of
-//   the split-sum's A and B, both x occlusion. A white matte surface facing the light thus shows
+//   (camera.light.w) reflected as Fdez-Aguera's multiple-scattering split sum (JCGT 8(1), 2019) has it, the
+//   split sum's A and B read from a table integrated at start-up (`dfg`, src/geometry/material.rs dfg_table):
+//   specular ambient x (F0 A + B + multiple scattering), diffuse
+//   ambient x c_diff x (1 - the specular's largest channel), both x occlusion. It conserves energy (a white
+//   rough metal in the uniform environment reflects all of it) and is the image-based lighting three.js computes
+//   for a constant environment map. A white matte surface facing the light thus shows about
 //   (1 - F) x (1 - ambient) + ambient of its colour, as the flat surface's Lambert shows 1. No tone mapping:
 //   the sum is clamped by the sRGB target.
 
@@ -86,6 +90,8 @@ const EMISSIVE: u32 = 4u;
 @group(2) @binding(8) var normal_sampler: sampler;
 @group(2) @binding(9) var occlusion_sampler: sampler;
 @group(2) @binding(10) var emissive_sampler: sampler;
+// The split sum's (A, B) at roughness (i + 0.5) / 16 and n.v (j + 0.5) / 16, texel j * 16 + i, two texels a vec4.
+@group(2) @binding(11) var<uniform> dfg: array<vec4<f32>, 128>;
 
 fn vertex(v: VertexIn, inst: InstanceIn) -> VsOut {
     var out = transform(v.position, v.normal, v.aux, inst);
@@ -148,13 +154,22 @@ fn masked(in: VsOut) -> bool {
     return material.alpha.x == 1.0 && base_color(in).a < material.alpha.y;
 }
 
-// Karis 2014's analytic fit of the split-sum environment BRDF: (scale of F0, bias).
+fn dfg_texel(i: u32, j: u32) -> vec2<f32> {
+    let k = j * 16u + i;
+    let v = dfg[k / 2u];
+    return select(v.xy, v.zw, (k & 1u) == 1u);
+}
+
+// The split sum of the specular lobe: (scale of F0, bias), read from `dfg` bilinearly, as a texture's texel
+// centres at (i + 0.5) / 16, clamped at the edges.
 fn env_brdf(roughness: f32, nv: f32) -> vec2<f32> {
-    let c0 = vec4<f32>(-1.0, -0.0275, -0.572, 0.022);
-    let c1 = vec4<f32>(1.0, 0.0425, 1.04, -0.04);
-    let r = roughness * c0 + c1;
-    let a004 = min(r.x * r.x, exp2(-9.28 * nv)) * r.x + r.y;
-    return vec2<f32>(-1.04, 1.04) * a004 + r.zw;
+    let p = clamp(vec2<f32>(roughness, nv) * 16.0 - 0.5, vec2<f32>(0.0), vec2<f32>(15.0));
+    let i0 = vec2<u32>(floor(p));
+    let i1 = min(i0 + vec2<u32>(1u), vec2<u32>(15u));
+    let t = p - floor(p);
+    let bottom = mix(dfg_texel(i0.x, i0.y), dfg_texel(i1.x, i0.y), t.x);
+    let top = mix(dfg_texel(i0.x, i1.y), dfg_texel(i1.x, i1.y), t.x);
+    return mix(bottom, top, t.y);
 }
 
 fn shade(in: VsOut, front: bool) -> vec4<f32> {
@@ -219,7 +234,13 @@ fn shade(in: VsOut, front: bool) -> vec4<f32> {
         irradiance = irradiance * lit(in.world);
     }
     let ab = env_brdf(roughness, nv);
-    let indirect = (c_diff + f0 * ab.x + vec3<f32>(ab.y)) * ambient * occlusion;
+    let single = f0 * ab.x + vec3<f32>(ab.y);
+    let e_ss = ab.x + ab.y;
+    let f_avg = f0 + (vec3<f32>(1.0) - f0) / 21.0;
+    let multiple = single * f_avg / (vec3<f32>(1.0) - (1.0 - e_ss) * f_avg) * (1.0 - e_ss);
+    let specular = single + multiple;
+    let diffuse = c_diff * (1.0 - max(max(specular.r, specular.g), specular.b));
+    let indirect = (specular + diffuse) * ambient * occlusion;
     let rgb = brdf * irradiance + indirect + emissive + shader_work(in.world);
     return vec4<f32>(rgb, alpha);
 }

@@ -425,6 +425,11 @@ pub struct DescribeArgs {
     /// surface (object-space units), a measure independent of the simplifier's own error.
     #[arg(long)]
     pub deviation: bool,
+    /// Print instead the camera of frame F as JSON: eye, the view matrix (world to camera, column-major),
+    /// the vertical field of view, near and far planes and the viewport (what another renderer needs to draw
+    /// lodbench's view; the projection is glam's right-handed one with depth in 0..1).
+    #[arg(long, value_name = "F")]
+    pub camera_json: Option<u32>,
 }
 
 #[derive(Debug, Clone, Args)]

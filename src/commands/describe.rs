@@ -9,6 +9,34 @@ use crate::scene::{SceneConfig, SceneDef, SceneDescription, SceneKind};
 pub fn execute(args: &DescribeArgs) -> Result<()> {
     let cfg = SceneConfig::from_args(&args.scene_args)?;
     let def = SceneDef::new(SceneKind::from_name(&args.scene)?, &cfg)?;
+    if let Some(f) = args.camera_json {
+        let scene = def.instantiate(def.counts[0]);
+        if f >= scene.frames {
+            return Err(crate::error::Error::Config(format!(
+                "--camera-json {f}: the scene has {} frames (0..{})",
+                scene.frames,
+                scene.frames.saturating_sub(1)
+            )));
+        }
+        let c = scene.camera(f);
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "frame": f,
+                "eye": c.eye.to_array(),
+                "view": c.view.to_cols_array(),
+                "projection": c.proj.to_cols_array(),
+                "fov_y_deg": scene.fov_y.to_degrees(),
+                "near": scene.near,
+                "far": scene.far,
+                "width": scene.width,
+                "height": scene.height,
+                "light_direction": glam::Vec3::from(crate::gpu::LIGHT_DIR).normalize().to_array(),
+                "ambient": crate::gpu::AMBIENT,
+            }))?
+        );
+        return Ok(());
+    }
     let d = match args.deviation {
         true => def.describe_with_deviation(&cfg),
         false => def.describe(&cfg),

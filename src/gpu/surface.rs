@@ -118,6 +118,16 @@ fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             count: None,
         });
     }
+    entries.push(wgpu::BindGroupLayoutEntry {
+        binding: 11,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    });
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("material layout"),
         entries: &entries,
@@ -249,6 +259,13 @@ impl MaterialsGpu {
             );
             texture.create_view(&Default::default())
         };
+        // The split-sum table every material reads (shaders/surface/pbr.wgsl `dfg`), made once per process.
+        static DFG: std::sync::OnceLock<Vec<[f32; 2]>> = std::sync::OnceLock::new();
+        let dfg = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("split-sum table"),
+            contents: bytemuck::cast_slice(DFG.get_or_init(crate::geometry::material::dfg_table)),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
         let mut groups = Vec::with_capacity(materials.materials.len());
         for m in &materials.materials {
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -296,6 +313,10 @@ impl MaterialsGpu {
                     resource: wgpu::BindingResource::Sampler(s),
                 });
             }
+            entries.push(wgpu::BindGroupEntry {
+                binding: 11,
+                resource: dfg.as_entire_binding(),
+            });
             groups.push(device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("material"),
                 layout: &layout,
