@@ -18,9 +18,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-/// Direction towards the light (world) and the ambient term of the Lambert shading.
-pub const LIGHT_DIR: [f32; 3] = [-0.45, 0.8, 0.4];
-pub const AMBIENT: f32 = 0.22;
+pub use crate::scene::model::{AMBIENT, LIGHT_DIR};
 
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]

@@ -52,6 +52,25 @@ pub struct SceneDescription {
     /// A user scene's instances, authored chains and camera flight.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub user: Option<crate::scene::user::UserParts>,
+    /// How the scene's triangles are shaded, and the light.
+    pub surface: SurfaceDescription,
+}
+
+/// How a scene is shaded (docs/methods.md, "Materials as engines draw them").
+#[derive(Debug, Clone, Serialize)]
+pub struct SurfaceDescription {
+    /// `flat` (one colour per instance, Lambert and ambient: the built-in scenes, `--materials flat`) or `pbr`
+    /// (glTF's metallic-roughness materials, glTF 2.0 Appendix B's BRDF).
+    pub kind: &'static str,
+    /// Towards the directional light (normalised).
+    pub light_direction: [f32; 3],
+    /// flat: the ambient share of the colour; pbr: the uniform environment's radiance (the light's irradiance at
+    /// normal incidence is pi x (1 - ambient)).
+    pub ambient: f32,
+    pub materials: usize,
+    pub images: usize,
+    /// Texels of every image at full size.
+    pub texels: u64,
 }
 
 /// Blow's hierarchy of the terrain as `blocks-tree` builds it.
@@ -191,6 +210,25 @@ impl SceneDef {
             cut: self.unified().map(|u| cut_along_path(&first, &u.data)),
             hierarchy: self.unified().and_then(|u| hierarchy(&u.data)),
             user: self.user().cloned(),
+            surface: SurfaceDescription {
+                kind: if first.materials.is_empty() {
+                    "flat"
+                } else {
+                    "pbr"
+                },
+                light_direction: glam::Vec3::from(crate::scene::model::LIGHT_DIR)
+                    .normalize()
+                    .to_array(),
+                ambient: crate::scene::model::AMBIENT,
+                materials: first.materials.materials.len(),
+                images: first.materials.images.len(),
+                texels: first
+                    .materials
+                    .images
+                    .iter()
+                    .map(|i| u64::from(i.width) * u64::from(i.height))
+                    .sum(),
+            },
         }
     }
 

@@ -20,6 +20,12 @@ pub const SCENE_SEED: u64 = 2008;
 /// Background colour (linear RGB) behind every scene.
 pub const BACKGROUND: [f32; 3] = [0.045, 0.05, 0.06];
 
+/// Direction towards the one directional light (world, not normalised; the shaders normalise it) and the ambient
+/// term, the same for every scene and method: the flat surface's Lambert mixes the two, the PBR surface reads the
+/// ambient as a uniform environment's radiance and gives the light an irradiance of pi x (1 - ambient).
+pub const LIGHT_DIR: [f32; 3] = [-0.45, 0.8, 0.4];
+pub const AMBIENT: f32 = 0.22;
+
 pub const ORBIT_AMPLITUDE_DEG: f32 = 30.0;
 pub const ORBIT_PERIOD_FRAMES: f32 = 240.0;
 
