@@ -19,7 +19,12 @@ pub fn execute(args: &ExportArgs) -> Result<()> {
             args.scene
         )));
     }
-    let cfg = SceneConfig::from_args(&args.scene_args)?;
+    let mut cfg = SceneConfig::from_args(&args.scene_args)?;
+    if obj {
+        // An OBJ holds the geometry alone: no image is decoded (a file whose textures are missing or KTX2 still
+        // exports).
+        cfg.materials = crate::geometry::material::MaterialMode::Flat;
+    }
     let def = SceneDef::new(kind, &cfg)?;
     if kind.is_unified() {
         return Err(Error::Config(format!(

@@ -3,7 +3,7 @@
 //!
 //! What the file holds, for the instance count exported:
 //! - per model and LOD, a mesh (float positions and normals, 32-bit indices) with a material whose base colour is
-//!   the LOD's colour; the per-vertex shading extras that the procedural models need (windmill blades, leaf
+//!   the LOD's colour, dielectric, fully rough and double-sided (the built-in scenes draw both faces); the per-vertex shading extras that the procedural models need (windmill blades, leaf
 //!   cards) as the application-specific attribute `_LODBENCH_AUX` (glTF 2.0 section 3.7.2.1 allows attributes
 //!   starting with `_`);
 //! - per instance, a node placing the model's LOD0 at the instance's frame-0 transform, with MSFT_lod naming the
@@ -196,7 +196,7 @@ impl Writer {
     fn material(&mut self, color: [f32; 3]) -> usize {
         let m = json!({"pbrMetallicRoughness": {
             "baseColorFactor": [color[0], color[1], color[2], 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0
-        }});
+        }, "doubleSided": true});
         match self.materials.iter().position(|x| *x == m) {
             Some(i) => i,
             None => {
