@@ -3,7 +3,7 @@
 use clap::Parser;
 use lodbench::cli::{Cli, Command};
 use lodbench::commands::{
-    clips, compare, describe, experiment, export, list, merge, perceptual, run,
+    clips, compare, describe, experiment, export, list, merge, perceptual, run, tune,
 };
 use lodbench::Error;
 use std::process::ExitCode;
@@ -21,6 +21,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare::execute(&args),
         Command::Perceptual(args) => perceptual::execute(&args),
         Command::Clips(args) => clips::execute(&args),
+        Command::Tune(args) => tune::execute(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -55,6 +55,53 @@ pub enum Command {
     /// --dump-transitions): the reference, each method and its error heat-map; animated PNG, GIF, and MP4
     /// with ffmpeg.
     Clips(ClipsArgs),
+    /// Choose each model's LOD switch distances from a popping budget, by measurement: every LOD pair drawn
+    /// alone from N directions at a range of distances; writes tune.csv, tune.json, the settings in each
+    /// engine's units (engines/) and the scene rewritten with them (tuned.glb).
+    Tune(TuneArgs),
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct TuneArgs {
+    /// The scene whose models to tune: a built-in scene's name or a glTF file.
+    #[arg(long)]
+    pub scene: String,
+    #[command(flatten)]
+    pub scene_args: SceneArgs,
+    /// The budget as lodpop: the largest RMS change over the frame (sRGB-encoded, in [0, 1]) a switch may
+    /// cause, at the run's viewport.
+    #[arg(long, conflicts_with = "budget_jod")]
+    pub budget_lodpop: Option<f64>,
+    /// The budget as ColorVideoVDP's JOD between the two frames (10: no visible difference): the least a switch
+    /// may score.
+    #[arg(long)]
+    pub budget_jod: Option<f64>,
+    /// View directions per LOD pair: the scene's own (+z) and the rest from a seeded Fibonacci sphere.
+    #[arg(long, default_value_t = 8)]
+    pub views: u32,
+    /// Distances per view, evenly spaced in log distance from where the model fits the view to where it is two
+    /// pixels across.
+    #[arg(long, default_value_t = 24)]
+    pub distances: u32,
+    /// The camera's speed in world units per second: with it, the narrowest band (`--band`) alpha, dither and
+    /// geomorph need for every frame's change to stay within a lodpop budget.
+    #[arg(long)]
+    pub speed: Option<f32>,
+    /// Frames per second the speed is measured at.
+    #[arg(long, default_value_t = 60.0)]
+    pub fps: f32,
+    /// Seed of the view directions (recorded in tune.json).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// ColorVideoVDP display model of --budget-jod.
+    #[arg(long, default_value = "standard_fhd")]
+    pub display: String,
+    /// Output folder (default results/tune-<scene>-<time>/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// GPU adapter, by index or name substring (`lodbench list`).
+    #[arg(long)]
+    pub adapter: Option<String>,
 }
 
 #[derive(Debug, Clone, Args)]

@@ -1,5 +1,6 @@
-//! `lodbench export --scene NAME --out FILE.glb|FILE.obj`: a built-in scene as glTF 2.0 (`scene/export.rs`), or
-//! any non-unified scene's geometry on one frame as OBJ (`scene/export_obj.rs`).
+//! `lodbench export --scene NAME --out FILE.glb|FILE.obj`: a scene as glTF 2.0 (`scene/export.rs`: a built-in
+//! scene, or a glTF scene as lodbench draws it, its LOD chains and materials, at frame 0), or any non-unified
+//! scene's geometry on one frame as OBJ (`scene/export_obj.rs`).
 
 use crate::cli::ExportArgs;
 use crate::error::{Error, Result};
@@ -12,13 +13,6 @@ pub fn execute(args: &ExportArgs) -> Result<()> {
         .out
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-    if kind.is_user() && !obj {
-        return Err(Error::Config(format!(
-            "export: {} is already a glTF file; export writes the built-in scenes as .glb, and any scene's \
-             geometry on one frame as .obj (--out FILE.obj)",
-            args.scene
-        )));
-    }
     let mut cfg = SceneConfig::from_args(&args.scene_args)?;
     if obj {
         // An OBJ holds the geometry alone: no image is decoded (a file whose textures are missing or KTX2 still

@@ -70,6 +70,23 @@ fn load(path: &Path) -> Result<Image> {
     Image::new(w as usize, h as usize, 3, data).map_err(|e| Error::Perceptual(e.to_string()))
 }
 
+/// ColorVideoVDP's JOD of image `a` against image `b` (RGBA8, `width` x `height`, sRGB).
+pub fn jod_of_images(metric: &Cvvdp, a: &[u8], b: &[u8], width: u32, height: u32) -> Result<f64> {
+    let image = |px: &[u8]| -> Result<Image> {
+        let data = px
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .map(|b| b as f32 / 255.0)
+            .collect();
+        Image::new(width as usize, height as usize, 3, data)
+            .map_err(|e| Error::Perceptual(e.to_string()))
+    };
+    metric
+        .predict_image(&image(a)?, &image(b)?, Color::Srgb)
+        .map(|p| p.jod as f64)
+        .map_err(|e| Error::Perceptual(e.to_string()))
+}
+
 /// `lodbench perceptual`: scores the clips, prints the table and where perceptual.csv is.
 pub fn execute(args: &PerceptualArgs) -> Result<()> {
     let settings = PerceptualSettings {
@@ -88,11 +105,15 @@ pub fn execute(args: &PerceptualArgs) -> Result<()> {
 
 /// ColorVideoVDP on the display `settings.display` names.
 fn metric(settings: &PerceptualSettings) -> Result<Cvvdp> {
-    let display = DisplayModel::from_name(&settings.display).map_err(|e| {
+    metric_on(&settings.display)
+}
+
+/// ColorVideoVDP on the display model `display` names.
+pub fn metric_on(display_name: &str) -> Result<Cvvdp> {
+    let display = DisplayModel::from_name(display_name).map_err(|e| {
         let names = DisplayModel::names().unwrap_or_default().join(", ");
         Error::Perceptual(format!(
-            "display {}: {e} (the displays: {names})",
-            settings.display
+            "display {display_name}: {e} (the displays: {names})"
         ))
     })?;
     Cvvdp::new(

@@ -24,6 +24,7 @@ pub mod records;
 pub mod reference_cache;
 pub mod stats;
 pub mod timing;
+pub mod tune;
 
 pub use block::{BlockOutput, BlockRunner, DumpPolicy};
 pub use context::{BlockGpu, MethodSetup};

@@ -2,6 +2,7 @@
 //! here measures anything.
 
 pub mod csv;
+pub mod engines;
 pub mod files;
 pub mod manifest;
 pub mod png;

@@ -19,6 +19,9 @@
 //! Not exported: the unified scenes (their blocks and seams have no glTF form), the ground of `--shadows on`.
 
 use crate::error::{Error, Result};
+use crate::geometry::material::{
+    AlphaMode, Filter, Materials, TextureRef, Wrap, IDENTITY_TRANSFORM,
+};
 use crate::geometry::mesh::{Mesh, AUX_SOLID};
 use crate::scene::model::Scene;
 use glam::Vec3;
@@ -29,6 +32,12 @@ pub const FRAME_SECONDS: f64 = 1.0 / 60.0;
 
 /// The GLB of `scene` (one instance count of a built-in scene).
 pub fn glb(scene: &Scene) -> Result<Vec<u8>> {
+    glb_with(scene, true)
+}
+
+/// [`glb`], with the scene's camera path as a camera animation or (`camera` false: what `lodbench tune` writes)
+/// without one, so that a run of the file flies its own default flight through the switches it holds.
+pub fn glb_with(scene: &Scene, camera: bool) -> Result<Vec<u8>> {
     if scene.unified.is_some() {
         return Err(Error::Config(format!(
             "export: {} is a unified scene; its blocks and seams have no glTF form, so it is not exported",
@@ -36,13 +45,15 @@ pub fn glb(scene: &Scene) -> Result<Vec<u8>> {
         )));
     }
     let mut w = Writer::default();
+    // A user scene's materials, with their images as PNG.
+    let drawn = w.materials_of(&scene.materials)?;
     // Meshes and materials, per model and LOD.
     let mut lod_meshes: Vec<Vec<usize>> = Vec::new();
     for m in scene.models.iter() {
         let mut ids = Vec::new();
         for (l, lod) in m.chain.lods.iter().enumerate() {
             let material = w.material(m.color_of(l as u32));
-            ids.push(w.mesh(&format!("{}_LOD{l}", m.name), &lod.mesh, material));
+            ids.push(w.mesh(&format!("{}_LOD{l}", m.name), &lod.mesh, material, &drawn));
         }
         lod_meshes.push(ids);
     }
@@ -97,13 +108,19 @@ pub fn glb(scene: &Scene) -> Result<Vec<u8>> {
     if scene.models.iter().any(|m| m.chain.lods.len() > 1) {
         w.used.push("MSFT_lod");
     }
+    if !camera {
+        return Ok(w.finish(scene, roots));
+    }
     // The camera, one key per frame; the instances' motion given to it.
     let frames = scene.frames.max(2);
     let mut times = Vec::new();
     let mut eyes = Vec::new();
     let mut rotations = Vec::new();
-    // Every moving instance moves alike (bunny-sweep's one bunny, `Motion::SweepX`); the ground comes last.
-    let moving = !scene.instances.is_empty() && scene.ground != Some(0);
+    // Every moving instance moves alike (bunny-sweep's one bunny, `Motion::SweepX`); the ground comes last. A user
+    // scene's animation is not exported: its instances stand where frame 0 has them.
+    let moving = matches!(scene.motion, crate::scene::model::Motion::SweepX { .. })
+        && !scene.instances.is_empty()
+        && scene.ground != Some(0);
     for f in 0..frames {
         let c = scene.camera(f.min(scene.frames - 1));
         let shift = match moving {
@@ -152,6 +169,9 @@ struct Writer {
     nodes: Vec<Value>,
     cameras: Vec<Value>,
     animations: Vec<Value>,
+    images: Vec<Value>,
+    samplers: Vec<Value>,
+    textures: Vec<Value>,
     used: Vec<&'static str>,
 }
 
@@ -174,6 +194,7 @@ impl Writer {
     fn floats(&mut self, values: &[f32], kind: &str, target: Option<u32>) -> usize {
         let n = match kind {
             "SCALAR" => 1,
+            "VEC2" => 2,
             "VEC3" => 3,
             _ => 4,
         };
@@ -206,26 +227,188 @@ impl Writer {
         }
     }
 
-    fn mesh(&mut self, name: &str, mesh: &Mesh, material: usize) -> usize {
+    /// A mesh of one primitive per material part (`materials[part]` its glTF material), or of one primitive in
+    /// the flat `material` when it has no parts; its texture coordinates, tangents and colours where it has them.
+    fn mesh(&mut self, name: &str, mesh: &Mesh, material: usize, materials: &[usize]) -> usize {
         let positions: Vec<f32> = mesh.positions.iter().flatten().copied().collect();
         let normals: Vec<f32> = mesh.normals.iter().flatten().copied().collect();
         let position = self.floats(&positions, "VEC3", Some(34962));
         let normal = self.floats(&normals, "VEC3", Some(34962));
-        let view = self.view(bytemuck::cast_slice(&mesh.indices), Some(34963));
-        self.accessors.push(json!({
-            "bufferView": view, "componentType": 5125, "count": mesh.indices.len(), "type": "SCALAR",
-        }));
-        let indices = self.accessors.len() - 1;
         let mut attributes = json!({"POSITION": position, "NORMAL": normal});
         if mesh.aux.iter().any(|a| a[2] != AUX_SOLID) {
             let aux: Vec<f32> = mesh.aux.iter().flatten().copied().collect();
             attributes["_LODBENCH_AUX"] = json!(self.floats(&aux, "VEC4", Some(34962)));
         }
-        self.meshes.push(json!({
-            "name": name,
-            "primitives": [{"attributes": attributes, "indices": indices, "material": material, "mode": 4}],
-        }));
+        if !mesh.parts.is_empty() && !materials.is_empty() {
+            let d = &mesh.data;
+            for (key, uv) in [("TEXCOORD_0", &d.uv0), ("TEXCOORD_1", &d.uv1)] {
+                if let Some(uv) = uv {
+                    let flat: Vec<f32> = uv.iter().flatten().copied().collect();
+                    attributes[key] = json!(self.floats(&flat, "VEC2", Some(34962)));
+                }
+            }
+            for (key, v) in [("TANGENT", &d.tangents), ("COLOR_0", &d.colors)] {
+                if let Some(v) = v {
+                    let flat: Vec<f32> = v.iter().flatten().copied().collect();
+                    attributes[key] = json!(self.floats(&flat, "VEC4", Some(34962)));
+                }
+            }
+        }
+        let runs: Vec<(usize, &[u32])> = match (mesh.parts.is_empty(), materials.is_empty()) {
+            (false, false) => mesh
+                .parts
+                .iter()
+                .map(|p| {
+                    let a = p.first_index as usize;
+                    (
+                        materials[p.material as usize],
+                        &mesh.indices[a..a + p.index_count as usize],
+                    )
+                })
+                .collect(),
+            _ => vec![(material, &mesh.indices[..])],
+        };
+        let mut primitives = Vec::with_capacity(runs.len());
+        for (material, indices) in runs {
+            let view = self.view(bytemuck::cast_slice(indices), Some(34963));
+            self.accessors.push(json!({
+                "bufferView": view, "componentType": 5125, "count": indices.len(), "type": "SCALAR",
+            }));
+            primitives.push(json!({
+                "attributes": attributes, "indices": self.accessors.len() - 1, "material": material, "mode": 4
+            }));
+        }
+        self.meshes
+            .push(json!({"name": name, "primitives": primitives}));
         self.meshes.len() - 1
+    }
+
+    /// A user scene's materials (none for a built-in scene): their images as PNG, samplers, textures; the glTF
+    /// index of each.
+    fn materials_of(&mut self, materials: &Materials) -> Result<Vec<usize>> {
+        let mut images = Vec::with_capacity(materials.images.len());
+        for img in &materials.images {
+            let rgba = image::RgbaImage::from_raw(img.width, img.height, img.rgba.clone())
+                .ok_or_else(|| Error::Config(format!("export: {} is not whole RGBA", img.name)))?;
+            let mut png = std::io::Cursor::new(Vec::new());
+            rgba.write_to(&mut png, image::ImageFormat::Png)
+                .map_err(|e| {
+                    Error::Config(format!("export: {} cannot be encoded: {e}", img.name))
+                })?;
+            let view = self.view(png.get_ref(), None);
+            self.images
+                .push(json!({"bufferView": view, "mimeType": "image/png", "name": img.name}));
+            images.push(self.images.len() - 1);
+        }
+        let mut out = Vec::with_capacity(materials.materials.len());
+        for m in &materials.materials {
+            let mut pbr = json!({
+                "baseColorFactor": m.base_color, "metallicFactor": m.metallic, "roughnessFactor": m.roughness,
+            });
+            let mut doc = json!({"name": m.name, "doubleSided": m.double_sided});
+            if let Some(t) = &m.base_color_texture {
+                pbr["baseColorTexture"] = self.texture_info(t, &images);
+            }
+            if let Some(t) = &m.metallic_roughness_texture {
+                pbr["metallicRoughnessTexture"] = self.texture_info(t, &images);
+            }
+            doc["pbrMetallicRoughness"] = pbr;
+            if let Some(t) = &m.normal_texture {
+                doc["normalTexture"] = self.texture_info(t, &images);
+                doc["normalTexture"]["scale"] = json!(m.normal_scale);
+            }
+            if let Some(t) = &m.occlusion_texture {
+                doc["occlusionTexture"] = self.texture_info(t, &images);
+                doc["occlusionTexture"]["strength"] = json!(m.occlusion_strength);
+            }
+            if let Some(t) = &m.emissive_texture {
+                doc["emissiveTexture"] = self.texture_info(t, &images);
+            }
+            let strength = m.emissive.iter().copied().fold(1.0f32, f32::max);
+            doc["emissiveFactor"] = json!(m.emissive.map(|e| e / strength));
+            let mut extensions = serde_json::Map::new();
+            if strength > 1.0 {
+                extensions.insert(
+                    "KHR_materials_emissive_strength".into(),
+                    json!({"emissiveStrength": strength}),
+                );
+                self.use_extension("KHR_materials_emissive_strength");
+            }
+            if m.unlit {
+                extensions.insert("KHR_materials_unlit".into(), json!({}));
+                self.use_extension("KHR_materials_unlit");
+            }
+            if !extensions.is_empty() {
+                doc["extensions"] = Value::Object(extensions);
+            }
+            match m.alpha {
+                AlphaMode::Opaque => {}
+                AlphaMode::Mask(c) => {
+                    doc["alphaMode"] = json!("MASK");
+                    doc["alphaCutoff"] = json!(c);
+                }
+                AlphaMode::Blend => doc["alphaMode"] = json!("BLEND"),
+            }
+            self.materials.push(doc);
+            out.push(self.materials.len() - 1);
+        }
+        Ok(out)
+    }
+
+    /// A textureInfo of `t`: its texture (image and sampler), texture coordinates and transform.
+    fn texture_info(&mut self, t: &TextureRef, images: &[usize]) -> Value {
+        let wrap = |w: Wrap| match w {
+            Wrap::Repeat => 10497,
+            Wrap::MirroredRepeat => 33648,
+            Wrap::ClampToEdge => 33071,
+        };
+        let s = t.sampler;
+        let min = match (s.min, s.mipmap) {
+            (Filter::Nearest, None) => 9728,
+            (Filter::Linear, None) => 9729,
+            (Filter::Nearest, Some(Filter::Nearest)) => 9984,
+            (Filter::Linear, Some(Filter::Nearest)) => 9985,
+            (Filter::Nearest, Some(Filter::Linear)) => 9986,
+            (Filter::Linear, Some(Filter::Linear)) => 9987,
+        };
+        let sampler = json!({
+            "magFilter": if s.mag == Filter::Nearest { 9728 } else { 9729 },
+            "minFilter": min, "wrapS": wrap(s.wrap_s), "wrapT": wrap(s.wrap_t),
+        });
+        let sampler = match self.samplers.iter().position(|x| *x == sampler) {
+            Some(i) => i,
+            None => {
+                self.samplers.push(sampler);
+                self.samplers.len() - 1
+            }
+        };
+        let texture = json!({"source": images[t.image as usize], "sampler": sampler});
+        let texture = match self.textures.iter().position(|x| *x == texture) {
+            Some(i) => i,
+            None => {
+                self.textures.push(texture);
+                self.textures.len() - 1
+            }
+        };
+        let mut info = json!({"index": texture, "texCoord": t.texcoord});
+        if t.transform != IDENTITY_TRANSFORM {
+            // rows [c sx, s sy, ox] and [-s sx, c sy, oy] (TextureRef::transform_of)
+            let [a, b] = t.transform;
+            let sx = a[0].hypot(b[0]);
+            let sy = a[1].hypot(b[1]);
+            let rotation = (-b[0] / sx).atan2(a[0] / sx);
+            info["extensions"] = json!({"KHR_texture_transform": {
+                "offset": [a[2], b[2]], "rotation": rotation, "scale": [sx, sy],
+            }});
+            self.use_extension("KHR_texture_transform");
+        }
+        info
+    }
+
+    fn use_extension(&mut self, name: &'static str) {
+        if !self.used.contains(&name) {
+            self.used.push(name);
+        }
     }
 
     fn node(&mut self, node: Value) -> usize {
@@ -253,6 +436,9 @@ impl Writer {
             "materials": self.materials,
             "cameras": self.cameras,
             "animations": self.animations,
+            "images": self.images,
+            "samplers": self.samplers,
+            "textures": self.textures,
             "accessors": self.accessors,
             "bufferViews": self.views,
             "buffers": [{"byteLength": self.bin.len()}],

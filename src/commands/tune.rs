@@ -1,0 +1,358 @@
+//! `lodbench tune --scene FILE|NAME --budget-lodpop X | --budget-jod J`: each model's LOD switch distances chosen
+//! from a popping budget by measurement (`measure/tune.rs`), written as tune.csv (every curve), tune.json (the
+//! settings, views and switches), engines/ (the switches in Unity's, Unreal's, Godot's, Bevy's and three.js's
+//! units, `results/engines.rs`) and tuned.glb (the scene with its chains and the chosen switches, MSFT_lod with
+//! MSFT_screencoverage and lodbench's exact distances, no camera: `lodbench run --scene tuned.glb` flies its
+//! default flight out through the chosen switches and measures what was chosen).
+
+use crate::cli::TuneArgs;
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use crate::measure::tune::{
+    tune_model, view_directions, Budget, ModelCamera, ModelSwitches, Sample, TuneSettings,
+};
+use crate::results::engines::{self, EngineModel};
+use crate::scene::{SceneConfig, SceneDef, SceneKind};
+use glam::Quat;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// What tune.json holds.
+#[derive(Serialize)]
+struct TuneManifest<'a> {
+    lodbench_version: &'static str,
+    git_commit: &'static str,
+    scene: String,
+    adapter: crate::gpu::AdapterSummary,
+    width: u32,
+    height: u32,
+    fov_y_deg: f32,
+    settings: &'a TuneSettings,
+    /// The view directions (unit vectors from the model's centre towards the camera), in order.
+    views: Vec<[f32; 3]>,
+    models: &'a [ModelSwitches],
+    engines: Vec<EngineModel>,
+}
+
+fn budget_of(args: &TuneArgs) -> Result<Budget> {
+    match (args.budget_lodpop, args.budget_jod) {
+        (Some(x), None) if x.is_finite() && x > 0.0 && x < 1.0 => Ok(Budget::Lodpop(x)),
+        (Some(x), None) => Err(Error::Config(format!(
+            "--budget-lodpop {x}: a lodpop budget is a change in (0, 1)"
+        ))),
+        (None, Some(j)) if j.is_finite() && j > 0.0 && j <= 10.0 => Ok(Budget::Jod(j)),
+        (None, Some(j)) => Err(Error::Config(format!(
+            "--budget-jod {j}: a JOD budget lies in (0, 10] (10: no visible difference)"
+        ))),
+        _ => Err(Error::Config(
+            "tune needs a budget: --budget-lodpop X (the largest lodpop a switch may cause, RMS over the frame in \
+             [0, 1]) or --budget-jod J (ColorVideoVDP's JOD a switch may not go below, 10 = invisible)"
+                .into(),
+        )),
+    }
+}
+
+fn settings_of(args: &TuneArgs, band: f32) -> Result<TuneSettings> {
+    if args.views == 0 || args.distances < 2 {
+        return Err(Error::Config(format!(
+            "tune: --views {} and --distances {}: at least one view and two distances",
+            args.views, args.distances
+        )));
+    }
+    let speed = match args.speed {
+        Some(s) if s.is_finite() && s > 0.0 && args.fps.is_finite() && args.fps > 0.0 => {
+            Some((s, args.fps))
+        }
+        Some(s) => {
+            return Err(Error::Config(format!(
+                "--speed {s} --fps {}: both must be positive",
+                args.fps
+            )))
+        }
+        None => None,
+    };
+    Ok(TuneSettings {
+        budget: budget_of(args)?,
+        views: args.views,
+        distances: args.distances,
+        seed: args.seed,
+        speed,
+        band,
+    })
+}
+
+/// The chosen switches of `m` as the engines take them: the LODs up to the first switch no distance allows; the
+/// hard switches, or `blend`'s switches and bands (with `--speed`).
+fn engine_model(m: &ModelSwitches, blend: Option<&str>) -> EngineModel {
+    let usable: Vec<&crate::measure::tune::PairSwitch> = m
+        .pairs
+        .iter()
+        .take_while(|p| p.switch_distance.is_some())
+        .collect();
+    let of = |p: &crate::measure::tune::PairSwitch| -> (f32, f32) {
+        match blend.and_then(|b| p.bands.iter().find(|x| x.method == b)) {
+            Some(x) => (x.switch_distance, x.band),
+            None => (p.switch_distance.unwrap_or(0.0), 0.0),
+        }
+    };
+    EngineModel {
+        name: m.name.clone(),
+        radius: m.radius,
+        center: m.center,
+        switches: usable.iter().map(|p| of(p).0).collect(),
+        bands: usable.iter().map(|p| of(p).1).collect(),
+    }
+}
+
+/// `lodbench tune`.
+pub fn execute(args: &TuneArgs) -> Result<()> {
+    let kind = SceneKind::from_name(&args.scene)?;
+    let cfg = SceneConfig::from_args(&args.scene_args)?;
+    let settings = settings_of(args, cfg.schedule.band)?;
+    let def = SceneDef::new(kind, &cfg)?;
+    if kind.is_unified() {
+        return Err(Error::Config(format!(
+            "tune: {} is a unified scene; its blocks are one mesh, not models with switch distances",
+            def.name()
+        )));
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| super::run::default_out_dir(&[&format!("tune-{}", def.name())]));
+    super::run::prepare_output(&out)?;
+    let mut scene = def.instantiate(def.counts[0]);
+    // Each model alone, its first instance's rotation, at rest.
+    scene.motion = crate::scene::Motion::Static;
+    let ctx = GpuContext::new(args.adapter.as_deref())?;
+    let views = view_directions(settings.views, settings.seed);
+    let mut jod = jod_of(args, &settings, scene.width, scene.height)?;
+    let mut camera = ModelCamera::new(&ctx, &scene)?;
+    let mut samples: Vec<Sample> = Vec::new();
+    let mut models = Vec::new();
+    for (m, model) in scene.models.iter().enumerate() {
+        if model.chain.lods.len() < 2 {
+            continue;
+        }
+        let Some(inst) = scene.instances.iter().find(|i| i.model as usize == m) else {
+            continue;
+        };
+        let rotation = Quat::from_rotation_y(inst.yaw) * inst.rotation;
+        models.push(tune_model(
+            &mut camera,
+            m as u32,
+            rotation,
+            &settings,
+            &views,
+            &mut jod,
+            &mut samples,
+        )?);
+    }
+    let engine_models: Vec<EngineModel> = models.iter().map(|m| engine_model(m, None)).collect();
+    write_samples(&out, &samples)?;
+    write_engines(&out, &engine_models, scene.fov_y)?;
+    if settings.speed.is_some() {
+        // The engines that cross-fade: Unity and Bevy dither (LOD cross-fade shaders, Bevy's visibility-range
+        // fade), Godot blends (its fade modes change the node's transparency).
+        let with = |b: &str| -> Vec<EngineModel> {
+            models.iter().map(|m| engine_model(m, Some(b))).collect()
+        };
+        write_fading(&out, &with("dither"), &with("alpha"), scene.fov_y)?;
+    }
+    let tuned = tuned_scene(&scene, &models);
+    let glb = crate::scene::export::glb_with(&tuned, false)?;
+    write(&out.join("tuned.glb"), &glb)?;
+    let manifest = TuneManifest {
+        lodbench_version: env!("CARGO_PKG_VERSION"),
+        git_commit: env!("LODBENCH_GIT_COMMIT"),
+        scene: def.name().to_string(),
+        adapter: ctx.info.clone(),
+        width: scene.width,
+        height: scene.height,
+        fov_y_deg: scene.fov_y.to_degrees(),
+        settings: &settings,
+        views: views.iter().map(|v| v.to_array()).collect(),
+        models: &models,
+        engines: engine_models,
+    };
+    write(
+        &out.join("tune.json"),
+        serde_json::to_string_pretty(&manifest)?.as_bytes(),
+    )?;
+    out!("{}", table(&models, settings.budget));
+    outln!("results in {}", out.display());
+    Ok(())
+}
+
+/// Scores two frames (RGBA8).
+type PairScore = Box<dyn FnMut(&[u8], &[u8]) -> Result<f64>>;
+
+/// ColorVideoVDP's JOD of two frames when the budget is a JOD (else a function never called).
+fn jod_of(args: &TuneArgs, settings: &TuneSettings, width: u32, height: u32) -> Result<PairScore> {
+    if !matches!(settings.budget, Budget::Jod(_)) {
+        return Ok(Box::new(|_: &[u8], _: &[u8]| Ok(0.0)));
+    }
+    let metric = super::perceptual::metric_on(&args.display)?;
+    Ok(Box::new(move |a: &[u8], b: &[u8]| {
+        super::perceptual::jod_of_images(&metric, a, b, width, height)
+    }))
+}
+
+/// The scene with each tuned model's chain cut after its last usable LOD and its switches the chosen ones (what
+/// tuned.glb holds).
+fn tuned_scene(scene: &crate::scene::Scene, models: &[ModelSwitches]) -> crate::scene::Scene {
+    let mut out = scene.clone();
+    let mut list: Vec<crate::scene::Model> = out.models.to_vec();
+    for t in models {
+        let m = &mut list[t.model as usize];
+        let switches: Vec<f32> = t.pairs.iter().map_while(|p| p.switch_distance).collect();
+        m.chain.lods.truncate(switches.len() + 1);
+        m.switches = switches;
+        m.switch_source = "tune";
+    }
+    out.models = list.into();
+    out
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<()> {
+    std::fs::write(path, bytes).map_err(|e| Error::Output {
+        path: path.to_path_buf(),
+        problem: format!("cannot be written ({e})"),
+    })
+}
+
+fn write_samples(out: &Path, samples: &[Sample]) -> Result<()> {
+    let path = out.join("tune.csv");
+    let mut w = ::csv::Writer::from_path(&path).map_err(|e| Error::Output {
+        path: path.clone(),
+        problem: e.to_string(),
+    })?;
+    for s in samples {
+        w.serialize(s).map_err(|e| Error::Output {
+            path: path.clone(),
+            problem: e.to_string(),
+        })?;
+    }
+    w.flush().map_err(|e| Error::io(&path, e))
+}
+
+/// The cross-fading engines' files with blending methods' bands: `dithered` for Unity and Bevy, `blended` for
+/// Godot.
+fn write_fading(
+    out: &Path,
+    dithered: &[EngineModel],
+    blended: &[EngineModel],
+    fov_y: f32,
+) -> Result<()> {
+    let dir = out.join("engines");
+    let unity: Vec<_> = dithered.iter().map(|m| engines::unity(m, fov_y)).collect();
+    let bevy: Vec<_> = dithered
+        .iter()
+        .map(|m| (m.name.clone(), engines::bevy(m)))
+        .collect();
+    let godot: Vec<_> = blended
+        .iter()
+        .map(|m| (m.name.clone(), engines::godot(m)))
+        .collect();
+    use erased::Json;
+    write(
+        &dir.join("unity-lodgroup-crossfade.json"),
+        unity.text().as_bytes(),
+    )?;
+    write(
+        &dir.join("bevy-visibility-ranges-fade.json"),
+        bevy.text().as_bytes(),
+    )?;
+    write(
+        &dir.join("godot-visibility-ranges-fade.json"),
+        godot.text().as_bytes(),
+    )
+}
+
+fn write_engines(out: &Path, models: &[EngineModel], fov_y: f32) -> Result<()> {
+    let dir: PathBuf = out.join("engines");
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let json = |v: &dyn erased::Json| v.text();
+    let unity: Vec<_> = models.iter().map(|m| engines::unity(m, fov_y)).collect();
+    let unreal: Vec<_> = models.iter().map(|m| engines::unreal(m, fov_y)).collect();
+    let godot: Vec<_> = models
+        .iter()
+        .map(|m| (m.name.clone(), engines::godot(m)))
+        .collect();
+    let bevy: Vec<_> = models
+        .iter()
+        .map(|m| (m.name.clone(), engines::bevy(m)))
+        .collect();
+    write(&dir.join("unity-lodgroup.json"), json(&unity).as_bytes())?;
+    write(
+        &dir.join("unreal-screen-sizes.json"),
+        json(&unreal).as_bytes(),
+    )?;
+    write(
+        &dir.join("godot-visibility-ranges.json"),
+        json(&godot).as_bytes(),
+    )?;
+    write(
+        &dir.join("bevy-visibility-ranges.json"),
+        json(&bevy).as_bytes(),
+    )?;
+    let three: String = models.iter().map(engines::threejs).collect();
+    write(&dir.join("threejs-lod.js"), three.as_bytes())
+}
+
+/// Serialising what `write_engines` writes, whatever its type.
+mod erased {
+    pub trait Json {
+        fn text(&self) -> String;
+    }
+    impl<T: serde::Serialize> Json for T {
+        fn text(&self) -> String {
+            serde_json::to_string_pretty(self).unwrap_or_default()
+        }
+    }
+}
+
+/// The table printed at the end: per model and pair, the triangles, the switch distance and screen size, the
+/// budget's figure there and the pixel error the LOD's simplifier error projects to at the switch.
+pub fn table(models: &[ModelSwitches], budget: Budget) -> String {
+    let what = match budget {
+        Budget::Lodpop(x) => format!("lodpop at switch (budget {x})"),
+        Budget::Jod(j) => format!("JOD at switch (budget {j})"),
+    };
+    let name_w = models
+        .iter()
+        .map(|m| m.name.len())
+        .max()
+        .unwrap_or(5)
+        .max(5);
+    let mut out = format!(
+        "{:<name_w$}  {:>5}  {:>21}  {:>11}  {:>11}  {:>w2$}  {:>12}\n",
+        "model",
+        "LODs",
+        "triangles",
+        "switch (d)",
+        "screen size",
+        what,
+        "error px",
+        w2 = what.len()
+    );
+    for m in models {
+        for p in &m.pairs {
+            let fig = |v: Option<f64>| v.map_or("-".into(), |x| format!("{x:.5}"));
+            out.push_str(&format!(
+                "{:<name_w$}  {:>5}  {:>21}  {:>11}  {:>11}  {:>w2$}  {:>12}\n",
+                m.name,
+                format!("{}->{}", p.lod_from, p.lod_to),
+                format!("{} -> {}", p.triangles_from, p.triangles_to),
+                p.switch_distance
+                    .map_or("never".into(), |d| format!("{d:.4}")),
+                p.screen_size.map_or("-".into(), |s| format!("{s:.4}")),
+                fig(p.value_at_switch),
+                p.error_px_at_switch
+                    .map_or("-".into(), |e| format!("{e:.3}")),
+                w2 = what.len()
+            ));
+        }
+    }
+    out
+}
