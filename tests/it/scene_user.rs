@@ -131,6 +131,20 @@ fn authored_chains_are_the_models_lods() {
 
 /// A missing file, a Draco file (with the command that rewrites it) and a file without triangles: one error
 /// line each, naming the file.
+/// A file without scenes is drawn as the glTF spec leaves it to the client (every mesh once, untransformed), with a
+/// note saying so, even when an animation targets its nodes (the fuzzer's find: it once indexed node usize::MAX).
+#[test]
+fn a_file_without_scenes_is_drawn_untransformed_with_a_note() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fuzz/regressions/gltf_scene/no-scene-animated.gltf");
+    let out = lodbench(&["describe", "--scene", file.to_str().unwrap()], &[]);
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("the file has no scenes"), "{text}");
+    assert!(text.contains("\"kind\":\"static\""), "{text}");
+}
+
 #[test]
 fn bad_user_scenes_are_one_error() {
     let dir = tempfile::tempdir().unwrap();

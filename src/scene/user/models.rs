@@ -247,6 +247,13 @@ impl<'c, 'a> Collector<'c, 'a> {
                 .extend(t.notes.iter().map(|n| format!("{}: {n}", self.file)));
             self.out.materials = t.materials;
         }
+        if self.content.scene.is_none() && !self.out.instances.is_empty() {
+            self.out.notes.push(format!(
+                "{}: the file has no scenes: every mesh is drawn once, untransformed, and no node's transform or \
+                 animation moves it (glTF 2.0 leaves what to show to the client); add a scene to place them",
+                self.file
+            ));
+        }
         if self.out.instances.is_empty() {
             let scene = match self.content.scene {
                 Some(s) => format!(" in scene {s}"),

@@ -76,8 +76,9 @@ pub fn tracks(
     let Some(anim) = &rig.animation else {
         return vec![None; instances.len()];
     };
+    // A file without scenes places its meshes on no node (`usize::MAX`): nothing moves them.
     let moves = |node: usize| {
-        let mut n = Some(node);
+        let mut n = Some(node).filter(|&i| i < content.nodes.parent.len());
         while let Some(i) = n {
             if anim.moves(i) {
                 return true;
