@@ -32,6 +32,10 @@ nothing but the folder's own files, see scripts/report_html.py):
                             the baseline on transition frames) against its largest lodpop, the perceptual popping
                             figure where `lodbench perceptual` ran, and mean rmse, one curve across the last swept
                             variable; with the table "cheapest at or below a popping" (scripts/frontier.py).
+A `lodbench tune` folder (tune.csv, tune.json, rules.csv) gets instead:
+  - tune_<model>.png        per LOD pair of the model, each view's curve of the budget's figure (lodpop, or JOD with
+                            --budget-jod) against distance, the budget, tune's switch and where Unreal's, Godot's and
+                            meshoptimizer's rules would switch; with report.md, the switch table and rules.csv's.
 Experiment folders carry the swept variables as the first CSV columns, one per sweep. A lone `viewport` sweep gets
 fig8 and a lone `pixel-error` sweep the unified figure, and their first value in the other figures; any other sweep
 (`fsi-check`, `noise`, ..., or several crossed) makes each (method, values) combination its own series, labelled
@@ -619,6 +623,73 @@ def report(folder: Path, transition: str = "worst") -> list:
     return made
 
 
+RULE_STYLE = {"tune": ("black", "-"), "unreal": ("tab:red", "--"), "godot": ("tab:blue", "-."),
+              "meshopt": ("tab:green", ":")}
+
+
+def tune_figure(model, samples, rules, budget, path):
+    """One panel per LOD pair: each view's curve of the budget's figure against distance (log), the budget, and the
+    switch distance of tune and of each engine rule."""
+    pairs = sorted({(int(r["lod_from"]), int(r["lod_to"])) for r in samples})
+    metric, limit = budget["metric"], float(budget["value"])
+    fig, axes = plt.subplots(1, len(pairs), figsize=(4.2 * len(pairs), 3.4), squeeze=False)
+    for ax, (a, b) in zip(axes[0], pairs):
+        rows = [r for r in samples if int(r["lod_from"]) == a and r["refined"] == "false"]
+        for (view,), vrows in group(rows, "view").items():
+            xs = [num(r["distance"]) for r in vrows]
+            ys = [num(r["jod" if metric == "jod" else "lodpop"]) for r in vrows]
+            ax.plot(xs, ys, color="0.55", lw=0.8, label="views" if view == "0" else None)
+        ax.axhline(limit, color="tab:orange", lw=1.2, label=f"budget {limit:g}")
+        for r in rules:
+            if int(r["lod_from"]) == a:
+                colour, style = RULE_STYLE.get(r["rule"], ("0.3", "-"))
+                flag = "" if r["within_budget"] == "true" else " (breaks)"
+                ax.axvline(num(r["distance"]), color=colour, ls=style, lw=1.2, label=f"{r['rule']}{flag}")
+        ax.set_xscale("log")
+        ax.set_xlabel("distance from the bounding sphere's centre")
+        ax.set_ylabel("JOD" if metric == "jod" else "lodpop (RMS over the frame)")
+        ax.set_title(f"{model}: LOD {a} -> {b}", fontsize=9)
+        ax.legend(fontsize=7)
+    save(fig, path)
+
+
+def tune_report(folder: Path) -> list:
+    """A tune folder's figures and report.md; returns [(file name, caption)]."""
+    import json
+    meta = json.loads((folder / "tune.json").read_text())
+    samples = read_csv(folder / "tune.csv")
+    rules = read_csv(folder / "rules.csv") if (folder / "rules.csv").is_file() else []
+    figs = folder / "figures"
+    figs.mkdir(exist_ok=True)
+    made = []
+    budget = meta["settings"]["budget"]
+    for (model,), rows in group(samples, "model").items():
+        safe = "".join(c if c.isalnum() or c in "-_" else "_" for c in model)
+        name = f"tune_{safe}.png"
+        tune_figure(model, rows, [r for r in rules if r["model"] == model], budget, figs / name)
+        made.append((name, f"{model}: the budget's figure against distance per view, and each rule's switch"))
+    columns = ["model", "lod_from", "lod_to", "rule", "distance", "screen_size", "value", "within_budget"]
+    fmt = lambda v, f: "-" if v is None else format(v, f)  # noqa: E731
+    switches = [{"model": m["name"], "LODs": f"{p['lod_from']}->{p['lod_to']}",
+                 "triangles": f"{p['triangles_from']} -> {p['triangles_to']}",
+                 "switch distance": fmt(p["switch_distance"], ".4g"), "screen size": fmt(p["screen_size"], ".4f"),
+                 "worst from switch": fmt(p.get("checked_worst", p["value_at_switch"]), ".5f"),
+                 "error px at switch": fmt(p["error_px_at_switch"], ".3f"),
+                 "bands (method: half-width, frames)": ", ".join(f"{b['method']}: {b['band']:.3f}, {b['frames']}"
+                                                                 for b in p["bands"]) or "-"}
+                for m in meta["models"] for p in m["pairs"]]
+    switch_cols = list(switches[0]) if switches else []
+    text = [f"# lodbench tune: {meta['scene']}", "",
+            f"Budget: {budget['metric']} {budget['value']}, {meta['settings']['views']} views, "
+            f"{meta['width']}x{meta['height']}, {meta['fov_y_deg']:.1f} degrees vertical field of view.", "",
+            "## Switches", "", markdown_table(switches, switch_cols), "",
+            "## Switch distances by rule", "", markdown_table(rules, columns), ""]
+    for name, caption in made:
+        text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
+    (folder / "report.md").write_text("\n".join(text))
+    return made
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("results", type=Path, nargs="+")
@@ -630,6 +701,10 @@ def main() -> int:
         print(f"error: --transition {args.transition!r}: expected worst, first or a number", file=sys.stderr)
         return 2
     for folder in args.results:
+        if (folder / "tune.csv").is_file() and (folder / "tune.json").is_file():
+            made = tune_report(folder)
+            print(f"{folder}: report.md and {len(made)} figures in {folder / 'figures'}")
+            continue
         if not (folder / "frames.csv").is_file() or not (folder / "summary.csv").is_file():
             print(f"error: {folder} has no frames.csv and summary.csv (a complete lodbench run?)", file=sys.stderr)
             return 2

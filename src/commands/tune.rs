@@ -8,6 +8,7 @@
 use crate::cli::TuneArgs;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
+use crate::measure::engine_rules::RULES;
 use crate::measure::tune::{
     tune_model, view_directions, Budget, ModelCamera, ModelSwitches, Sample, TuneSettings,
 };
@@ -179,8 +180,15 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
         &out.join("tune.json"),
         serde_json::to_string_pretty(&manifest)?.as_bytes(),
     )?;
+    write_rules(&out, &models)?;
     out!("{}", table(&models, settings.budget));
+    out!("{}", rules_table(&models));
     outln!("results in {}", out.display());
+    outln!(
+        "figures: python3 scripts/plot.py {}; the rules along a path: python3 scripts/tune_rules.py {}",
+        out.display(),
+        out.display()
+    );
     Ok(())
 }
 
@@ -222,18 +230,68 @@ fn write(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 fn write_samples(out: &Path, samples: &[Sample]) -> Result<()> {
-    let path = out.join("tune.csv");
-    let mut w = ::csv::Writer::from_path(&path).map_err(|e| Error::Output {
-        path: path.clone(),
+    write_csv(&out.join("tune.csv"), samples)
+}
+
+/// A CSV of `rows`, whole or an error naming the file.
+fn write_csv<T: Serialize>(path: &Path, rows: &[T]) -> Result<()> {
+    let mut w = ::csv::Writer::from_path(path).map_err(|e| Error::Output {
+        path: path.to_path_buf(),
         problem: e.to_string(),
     })?;
-    for s in samples {
-        w.serialize(s).map_err(|e| Error::Output {
-            path: path.clone(),
+    for r in rows {
+        w.serialize(r).map_err(|e| Error::Output {
+            path: path.to_path_buf(),
             problem: e.to_string(),
         })?;
     }
-    w.flush().map_err(|e| Error::io(&path, e))
+    w.flush().map_err(|e| Error::io(path, e))
+}
+
+/// One row of rules.csv.
+#[derive(Serialize)]
+struct RuleRow<'a> {
+    model: &'a str,
+    lod_from: u32,
+    lod_to: u32,
+    rule: &'static str,
+    distance: f32,
+    screen_size: f32,
+    value: Option<f64>,
+    within_budget: bool,
+}
+
+/// rules.csv: per model, pair and rule (tune's own first, then the engines'), the switch distance, its screen
+/// size and the budget's figure there, the worst over the views.
+fn write_rules(out: &Path, models: &[ModelSwitches]) -> Result<()> {
+    let mut rows = Vec::new();
+    for m in models {
+        for p in &m.pairs {
+            let tuned = p
+                .switch_distance
+                .zip(p.screen_size)
+                .map(|(d, s)| ("tune", d, s, p.checked_worst.or(p.value_at_switch), true));
+            let rules = p
+                .rules
+                .iter()
+                .map(|r| (r.rule.name(), r.distance, r.screen_size, r.value, r.within));
+            for (rule, distance, screen_size, value, within_budget) in
+                tuned.into_iter().chain(rules)
+            {
+                rows.push(RuleRow {
+                    model: &m.name,
+                    lod_from: p.lod_from,
+                    lod_to: p.lod_to,
+                    rule,
+                    distance,
+                    screen_size,
+                    value,
+                    within_budget,
+                });
+            }
+        }
+    }
+    write_csv(&out.join("rules.csv"), &rows)
 }
 
 /// The cross-fading engines' files with blending methods' bands: `dithered` for Unity and Bevy, `blended` for
@@ -316,8 +374,8 @@ mod erased {
 /// budget's figure there and the pixel error the LOD's simplifier error projects to at the switch.
 pub fn table(models: &[ModelSwitches], budget: Budget) -> String {
     let what = match budget {
-        Budget::Lodpop(x) => format!("lodpop at switch (budget {x})"),
-        Budget::Jod(j) => format!("JOD at switch (budget {j})"),
+        Budget::Lodpop(x) => format!("worst lodpop from switch (budget {x})"),
+        Budget::Jod(j) => format!("worst JOD from switch (budget {j})"),
     };
     let name_w = models
         .iter()
@@ -347,11 +405,54 @@ pub fn table(models: &[ModelSwitches], budget: Budget) -> String {
                 p.switch_distance
                     .map_or("never".into(), |d| format!("{d:.4}")),
                 p.screen_size.map_or("-".into(), |s| format!("{s:.4}")),
-                fig(p.value_at_switch),
+                fig(p.checked_worst.or(p.value_at_switch)),
                 p.error_px_at_switch
                     .map_or("-".into(), |e| format!("{e:.3}")),
                 w2 = what.len()
             ));
+        }
+    }
+    out
+}
+
+/// The second table printed: per model and pair, where tune and each engine's rule switch, and the budget's figure
+/// there (`*`: breaks the budget).
+pub fn rules_table(models: &[ModelSwitches]) -> String {
+    let name_w = models
+        .iter()
+        .map(|m| m.name.len())
+        .max()
+        .unwrap_or(5)
+        .max(5);
+    let mut out = format!("{:<name_w$}  {:>5}", "model", "LODs");
+    for rule in std::iter::once("tune").chain(RULES.iter().map(|r| r.name())) {
+        out.push_str(&format!("  {:>20}", format!("{rule} (d, figure)")));
+    }
+    out.push('\n');
+    let fig = |d: Option<f32>, v: Option<f64>, within: bool| match (d, v) {
+        (Some(d), Some(v)) => format!("{d:.3}, {v:.5}{}", if within { " " } else { "*" }),
+        (Some(d), None) => format!("{d:.3}, -"),
+        _ => "never".into(),
+    };
+    for m in models {
+        for p in &m.pairs {
+            out.push_str(&format!(
+                "{:<name_w$}  {:>5}  {:>20}",
+                m.name,
+                format!("{}->{}", p.lod_from, p.lod_to),
+                fig(
+                    p.switch_distance,
+                    p.checked_worst.or(p.value_at_switch),
+                    true
+                )
+            ));
+            for r in &p.rules {
+                out.push_str(&format!(
+                    "  {:>20}",
+                    fig(Some(r.distance), r.value, r.within)
+                ));
+            }
+            out.push('\n');
         }
     }
     out

@@ -490,6 +490,16 @@ pub fn switch_distances(
     out
 }
 
+/// The screen size of a sphere of radius `r` at distance `d` (vertical field of view `fov_y`).
+pub fn screen_size(r: f32, d: f32, fov_y: f32) -> f32 {
+    r / (d * (fov_y * 0.5).tan())
+}
+
+/// The distance at which a sphere of radius `r` has screen size `s`.
+pub fn distance_of(r: f32, s: f32, fov_y: f32) -> f32 {
+    r / (s * (fov_y * 0.5).tan())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

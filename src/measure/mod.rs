@@ -17,6 +17,7 @@ pub mod coverage;
 pub mod diff_kernel;
 pub mod driver;
 pub mod effects;
+pub mod engine_rules;
 pub mod metric_kernel;
 pub mod metrics;
 pub mod quality;

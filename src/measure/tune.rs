@@ -10,10 +10,14 @@
 //! that is not monotone (a coarse LOD whose error shows only from some angles and distances) is within the budget
 //! from the switch outwards, at every grid distance. A dip below the budget nearer than its last excess is not
 //! taken. A LOD that breaks the budget even at the farthest distance measured (its projected size two pixels) is
-//! never switched to.
+//! never switched to. Every view is then measured at the switch (moving it out a grid distance while one
+//! breaks the budget), and, since rasterisation makes the curve jagged between grid distances, at
+//! [`DENSE_PER_STEP`] distances per grid step from the switch to where the grid's worst view stays below
+//! [`NEAR_BUDGET`] of the budget, the switch moving past any distance that breaks it.
 
 use crate::error::Result;
 use crate::gpu::{DrawList, GpuContext, InstanceRaw, RenderTarget, SceneGpu, TextureReadback};
+use crate::measure::engine_rules::{Rule, RULES};
 use crate::measure::metrics::rms_difference_parts;
 use crate::scene::{Camera, Scene};
 use glam::{Mat4, Quat, Vec3};
@@ -30,6 +34,30 @@ pub enum Budget {
 }
 
 impl Budget {
+    /// How far `value` is from no change at all: lodpop itself, or 10 - JOD.
+    pub fn excess(self, value: f64) -> f64 {
+        match self {
+            Budget::Lodpop(_) => value,
+            Budget::Jod(_) => 10.0 - value,
+        }
+    }
+
+    /// The budget as an excess ([`Budget::excess`]).
+    pub fn excess_limit(self) -> f64 {
+        match self {
+            Budget::Lodpop(x) => x,
+            Budget::Jod(j) => 10.0 - j,
+        }
+    }
+
+    /// The worse of two values.
+    pub fn worse(self, a: f64, b: f64) -> f64 {
+        match self {
+            Budget::Lodpop(_) => a.max(b),
+            Budget::Jod(_) => a.min(b),
+        }
+    }
+
     /// Whether `value` (of this budget's metric) breaks the budget.
     pub fn broken_by(self, value: f64) -> bool {
         match self {
@@ -78,6 +106,38 @@ pub fn nearest_within(
         }
     }
     Ok(Crossing::From(hi))
+}
+
+/// Where the grid's worst view (as an excess, [`Budget::excess`]) comes within this share of the budget, the
+/// switch is checked between grid distances too.
+pub const NEAR_BUDGET: f64 = 0.8;
+
+/// Distances per grid step of that check.
+pub const DENSE_PER_STEP: u32 = 8;
+
+/// Whether a grid's worst excess `e` lies within [`NEAR_BUDGET`] of `budget`.
+fn close_excess(e: f64, budget: Budget) -> bool {
+    e > NEAR_BUDGET * budget.excess_limit()
+}
+
+/// `per_step` distances in each step of `grid` (increasing distances) that overlaps `from .. to`, evenly spaced in
+/// log distance within the step, its far end included: the dense check's distances, increasing, from `from` to
+/// `to`.
+pub fn dense_points(grid: &[f32], from: f32, to: f32, per_step: u32) -> Vec<f32> {
+    let mut out = Vec::new();
+    for w in grid.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b <= from || a >= to {
+            continue;
+        }
+        for i in 1..=per_step {
+            let p = a * (b / a).powf(i as f32 / per_step as f32);
+            if p > from && p <= to * 1.0001 {
+                out.push(p);
+            }
+        }
+    }
+    out
 }
 
 /// `n` distances from `near` to `far`, evenly spaced in log distance.
@@ -290,6 +350,10 @@ pub struct PairSwitch {
     pub limiting_view: Option<u32>,
     /// The largest value over the views at the switch (the budget's metric).
     pub value_at_switch: Option<f64>,
+    /// How far beyond the switch the dense check went (where the grid's worst view stays below
+    /// [`NEAR_BUDGET`] of the budget from there on), and the worst it saw from the switch to there.
+    pub checked_to: Option<f32>,
+    pub checked_worst: Option<f64>,
     /// LOD `lod_to`'s simplifier error (object-space units) and what it projects to at the switch, in pixels:
     /// the error bound an engine's rule (Godot's pixel threshold, Simplygon's deviation) would have used there.
     pub error_abs: f32,
@@ -298,6 +362,19 @@ pub struct PairSwitch {
     pub per_view: Vec<Option<f32>>,
     /// With `--speed`: alpha's, dither's and geomorph's bands.
     pub bands: Vec<BlendBand>,
+    /// Where the engines' rules would switch, and what the views see there.
+    pub rules: Vec<RuleAt>,
+}
+
+/// An engine's rule at one pair: where it switches and the budget's figure there (the worst over the views).
+#[derive(Debug, Clone, Serialize)]
+pub struct RuleAt {
+    pub rule: Rule,
+    pub distance: f32,
+    pub screen_size: f32,
+    pub value: Option<f64>,
+    /// Whether every view stays within the budget at the rule's distance.
+    pub within: bool,
 }
 
 /// One model's switches.
@@ -364,6 +441,38 @@ pub fn blend_band(
     None
 }
 
+/// The budget's figure at distance `d` for the pair (`lod`, `lod + 1`), the worst over `views` (the largest
+/// lodpop, the smallest JOD); None without views.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "the pair, its pose and the measurement's settings"
+)]
+fn worst_at(
+    camera: &mut ModelCamera<'_>,
+    model: u32,
+    lod: u32,
+    rotation: Quat,
+    views: &[Vec3],
+    d: f32,
+    settings: &TuneSettings,
+    jod: FrameScore<'_>,
+) -> Result<Option<f64>> {
+    let mut worst = None::<f64>;
+    for &dir in views {
+        let ((pop, _, _), [a, b]) = camera.switch_at(model, lod, rotation, dir, d)?;
+        let v = match settings.budget {
+            Budget::Jod(_) => jod(&a, &b)?,
+            Budget::Lodpop(_) => pop,
+        };
+        worst = Some(match (worst, settings.budget) {
+            (None, _) => v,
+            (Some(x), Budget::Lodpop(_)) => x.max(v),
+            (Some(x), Budget::Jod(_)) => x.min(v),
+        });
+    }
+    Ok(worst)
+}
+
 /// The switches of every pair of `model` (drawn by `camera`), each view's grid measured and refined, every sample
 /// appended to `samples`. `jod` scores two frames (RGBA bytes) when the budget is a JOD.
 pub fn tune_model(
@@ -384,6 +493,14 @@ pub fn tune_model(
     let grid = log_grid(near, far, settings.distances);
     let screen = |d: f32| m.radius / (d * tan);
     let mut pairs: Vec<PairSwitch> = Vec::new();
+    let errors: Vec<f32> = m.chain.lods[1..]
+        .iter()
+        .map(|l| l.error_abs * m.scale)
+        .collect();
+    let rule_distances: Vec<Vec<f32>> = RULES
+        .iter()
+        .map(|r| r.distances(&errors, m.radius, h, scene.fov_y))
+        .collect();
     // Per blending method, where its previous band ends.
     let mut band_end = [0.0f32; 3];
     for lod in 0..m.chain.lods.len().saturating_sub(1) as u32 {
@@ -455,19 +572,7 @@ pub fn tune_model(
         // distance, where none does.
         let mut value_at_switch = None;
         while let Some(d) = switch {
-            let mut worst_here = None::<f64>;
-            for &dir in views {
-                let ((pop, _, _), [a, b]) = camera.switch_at(model, lod, rotation, dir, d)?;
-                let v = match settings.budget {
-                    Budget::Jod(_) => jod(&a, &b)?,
-                    Budget::Lodpop(_) => pop,
-                };
-                worst_here = Some(match (worst_here, settings.budget) {
-                    (None, _) => v,
-                    (Some(x), Budget::Lodpop(_)) => x.max(v),
-                    (Some(x), Budget::Jod(_)) => x.min(v),
-                });
-            }
+            let worst_here = worst_at(camera, model, lod, rotation, views, d, settings, jod)?;
             value_at_switch = worst_here;
             match worst_here {
                 Some(v) if settings.budget.broken_by(v) => {
@@ -475,6 +580,82 @@ pub fn tune_model(
                 }
                 _ => break,
             }
+        }
+        // Between grid distances the figure is not smooth: a pixel's coverage flips with sub-pixel motion, and
+        // lodpop moves by some per cent from one distance to a nearby one. Where the grid's worst view comes
+        // within NEAR_BUDGET of the budget beyond the switch, the switch is checked at DENSE_PER_STEP distances per
+        // grid step, every view, and moves past any that breaks the budget.
+        let mut checked_max = value_at_switch;
+        let mut checked_to = switch;
+        if let Some(mut d) = switch {
+            let last_close = worst
+                .iter()
+                .rposition(|&(_, e)| close_excess(e, settings.budget));
+            let until = last_close
+                .and_then(|i| grid.get(i + 1).copied())
+                .unwrap_or(d)
+                .max(d);
+            let points = dense_points(&grid, d, until, DENSE_PER_STEP);
+            let mut worst_checked = value_at_switch;
+            for (i, &p) in points.iter().enumerate() {
+                if p < d {
+                    continue;
+                }
+                let v = worst_at(camera, model, lod, rotation, views, p, settings, jod)?;
+                if p == d {
+                    // The switch moved here: its own figure.
+                    value_at_switch = v;
+                }
+                match v {
+                    Some(v) if settings.budget.broken_by(v) => {
+                        // Past it: the next dense distance, or the grid distance after the last (within the
+                        // budget at every view: the check ends where the grid stays below NEAR_BUDGET of it).
+                        let next = points
+                            .get(i + 1)
+                            .copied()
+                            .or_else(|| grid.iter().copied().find(|&g| g > p * 1.0001));
+                        let Some(next) = next else {
+                            switch = None;
+                            break;
+                        };
+                        d = next;
+                        worst_checked = None;
+                        if i + 1 == points.len() {
+                            value_at_switch =
+                                worst_at(camera, model, lod, rotation, views, d, settings, jod)?;
+                            worst_checked = value_at_switch;
+                        }
+                    }
+                    Some(v) => {
+                        worst_checked = Some(match worst_checked {
+                            None => v,
+                            Some(x) => settings.budget.worse(x, v),
+                        });
+                    }
+                    None => {}
+                }
+            }
+            if switch.is_some() {
+                switch = Some(d);
+            } else {
+                value_at_switch = None;
+                worst_checked = None;
+            }
+            checked_max = worst_checked;
+            checked_to = switch.map(|s| until.max(s));
+        }
+        // The engines' rules at this pair: their distance and the worst the views see there.
+        let mut rules = Vec::with_capacity(RULES.len());
+        for (rule, distances) in RULES.iter().zip(&rule_distances) {
+            let d = distances[lod as usize];
+            let value = worst_at(camera, model, lod, rotation, views, d, settings, jod)?;
+            rules.push(RuleAt {
+                rule: *rule,
+                distance: d,
+                screen_size: screen(d),
+                value,
+                within: value.is_some_and(|v| !settings.budget.broken_by(v)),
+            });
         }
         let error_abs = m.chain.lods[lod as usize + 1].error_abs;
         let mut bands = Vec::new();
@@ -506,12 +687,15 @@ pub fn tune_model(
             screen_size: switch.map(screen),
             limiting_view: limiting.map(|l| l.0),
             value_at_switch,
+            checked_to,
+            checked_worst: checked_max,
             error_abs,
             error_px_at_switch: switch.map(|d| {
-                crate::geometry::lod::switch_distance(error_abs, 1.0, 1.0, h, scene.fov_y) / d
+                crate::geometry::lod::switch_distance(error_abs, m.scale, 1.0, h, scene.fov_y) / d
             }),
             per_view,
             bands,
+            rules,
         });
     }
     Ok(ModelSwitches {
@@ -622,6 +806,20 @@ mod tests {
         // dither needs more frames, so a wider band, so a farther switch.
         let (dd, _, nd) = blend_band(&worst, 0.001, 0.1, 0.0, true).unwrap();
         assert!(dd >= d && nd >= n);
+    }
+
+    /// The dense check's distances: per_step of them in each grid step from the switch to where it ends,
+    /// increasing, the far end of each step included and nothing before the switch.
+    #[test]
+    fn dense_points_fill_the_steps_from_the_switch() {
+        let grid = log_grid(1.0, 16.0, 5); // 1, 2, 4, 8, 16
+        let p = dense_points(&grid, 2.5, 8.0, 4);
+        assert!(p.windows(2).all(|w| w[1] > w[0]));
+        assert!(p.iter().all(|&x| x > 2.5 && x <= 8.0 * 1.0001));
+        // The step 2..4 past 2.5 (2.83, 3.36, 4), the whole step 4..8 (4.76, 5.66, 6.73, 8).
+        assert_eq!(p.len(), 7, "{p:?}");
+        assert!((p[2] - 4.0).abs() < 1e-4 && (p[6] - 8.0).abs() < 1e-4);
+        assert!(dense_points(&grid, 5.0, 5.0, 4).is_empty());
     }
 
     #[test]

@@ -14,8 +14,11 @@
 //!   zone, a share of its range of heights from that end, reaches `screen size(s_(k+1) (1 - b))`:
 //!   `fade = (h(s (1 - b)) - h_k) / (h_(k-1) - h_k)` (h_(-1) = 1). The last LOD's height is 0: never culled.
 //! - **Godot** (a node per LOD, `visibility_range_begin` / `_end` and their margins, distances to the node's AABB
-//!   centre): LOD k is visible from `s_k (1 - b)` to `s_(k+1) (1 - b)` with margins `2 b s` (0 where no band),
-//!   the fade mode `Self` where there is a band; LOD0's begin and the last LOD's end are 0 (open).
+//!   centre): LOD k's range is `s_k` to `s_(k+1)` with margins `b s` (0 where no band), the fade mode `Self`
+//!   where there is a band; LOD0's begin and the last LOD's end are 0 (open). Godot
+//!   (`RendererSceneCull::_visibility_range_check`) draws a node from `begin - margin` to `end + margin` and fades
+//!   it over `end - margin .. end + margin` (and `begin - margin .. begin + margin`): the band `s (1 - b) ..
+//!   s (1 + b)`, both LODs drawn across it.
 //! - **Bevy** (`VisibilityRange` per LOD entity: `start_margin` and `end_margin`, ranges of distance over which it
 //!   fades in and out): LOD k's `start_margin` is `s_k (1 - b) .. s_k (1 + b)` and its `end_margin` the next
 //!   switch's (LOD0 starts at `0..0`, the last LOD ends never).
@@ -37,15 +40,7 @@ pub struct EngineModel {
     pub bands: Vec<f32>,
 }
 
-/// The screen size of a sphere of radius `r` at distance `d` (vertical field of view `fov_y`).
-pub fn screen_size(r: f32, d: f32, fov_y: f32) -> f32 {
-    r / (d * (fov_y * 0.5).tan())
-}
-
-/// The distance at which a sphere of radius `r` has screen size `s`.
-pub fn distance_of(r: f32, s: f32, fov_y: f32) -> f32 {
-    r / (s * (fov_y * 0.5).tan())
-}
+pub use crate::geometry::lod::{distance_of, screen_size};
 
 /// Unreal: `ScreenSize` per LOD (LOD0 first).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -154,7 +149,7 @@ pub fn godot(m: &EngineModel) -> Vec<GodotNode> {
         match m.switches.get(k) {
             Some(&s) => {
                 let b = m.bands.get(k).copied().unwrap_or(0.0);
-                (s * (1.0 - b), 2.0 * b * s)
+                (s, b * s)
             }
             None => (0.0, 0.0),
         }
@@ -180,8 +175,8 @@ pub fn from_godot(nodes: &[GodotNode]) -> (Vec<f32>, Vec<f32>) {
     nodes[..nodes.len().saturating_sub(1)]
         .iter()
         .map(|n| {
-            let s = n.visibility_range_end + n.visibility_range_end_margin * 0.5;
-            (s, n.visibility_range_end_margin / (2.0 * s))
+            let s = n.visibility_range_end;
+            (s, n.visibility_range_end_margin / s)
         })
         .unzip()
 }
@@ -308,5 +303,47 @@ mod tests {
             (g[0].visibility_range_begin, g[3].visibility_range_end),
             (0.0, 0.0)
         );
+    }
+
+    /// Godot's visibility range as `_visibility_range_check` applies it with a fade mode: a node is drawn from
+    /// `begin - margin` to `end + margin` and fading within a margin of either end. (drawn, fading).
+    fn godot_state(n: &GodotNode, d: f32) -> (bool, bool) {
+        let far = n.visibility_range_end > 0.0;
+        let near = n.visibility_range_begin > 0.0;
+        let drawn = (!far || d <= n.visibility_range_end + n.visibility_range_end_margin)
+            && (!near || d >= n.visibility_range_begin - n.visibility_range_begin_margin);
+        let fading = (far && d > n.visibility_range_end - n.visibility_range_end_margin)
+            || (near && d < n.visibility_range_begin + n.visibility_range_begin_margin);
+        (drawn, drawn && fading)
+    }
+
+    /// Godot's nodes cross-fade exactly over each band s (1 - b) .. s (1 + b): both LODs drawn and fading inside
+    /// it, one LOD drawn and not fading outside.
+    #[test]
+    fn godot_fades_over_the_band() {
+        let m = model();
+        let nodes = godot(&m);
+        for (k, (&s, &b)) in m.switches.iter().zip(&m.bands).enumerate() {
+            let (lo, hi) = (s * (1.0 - b), s * (1.0 + b));
+            let probes = if b > 0.0 {
+                vec![lo * 0.99, lo * 1.01, s, hi * 0.99, hi * 1.01]
+            } else {
+                vec![s * 0.99, s * 1.01]
+            };
+            for d in probes {
+                let a = godot_state(&nodes[k], d);
+                let c = godot_state(&nodes[k + 1], d);
+                if b > 0.0 && d > lo && d < hi {
+                    assert!(
+                        a == (true, true) && c == (true, true),
+                        "LOD {k} at {d}: {a:?} {c:?}"
+                    );
+                } else if d <= lo || (b == 0.0 && d < s) {
+                    assert!(a.0 && !c.0, "LOD {k} at {d}: {a:?} {c:?}");
+                } else {
+                    assert!(!a.0 && c.0, "LOD {k} at {d}: {a:?} {c:?}");
+                }
+            }
+        }
     }
 }
