@@ -57,6 +57,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 import numpy as np  # noqa: E402
 from PIL import Image  # noqa: E402
 
+import answer  # noqa: E402  (scripts/answer.py, beside this file)
 import frontier  # noqa: E402  (scripts/frontier.py, beside this file)
 import report_html  # noqa: E402  (scripts/report_html.py, beside this file)
 
@@ -479,26 +480,39 @@ def fsi_buffers(scene, frames_dir, by_method, path):
     return None
 
 
-def table_cells(rows, columns):
-    """The text of each cell of a table of `rows` (dicts) under `columns`: numbers to 4 significant digits, other
-    values as they are, a missing one empty. report.md and report.html show the same cells."""
+def table_cells(rows, columns, raw=()):
+    """The text of each cell of a table of `rows` (dicts) under `columns`, numbers by unit (scripts/answer.py:
+    counts with thousands separators, a ratio with its interval, other figures to 3 significant figures; full
+    precision stays in the CSVs), other values as they are, a missing one empty. report.md and report.html show
+    the same cells. Columns in `raw` (the swept variables, labels) are shown as they are."""
     out = []
     for r in rows:
         cells = []
         for c in columns:
             v = r.get(c, "")
+            if c in raw:
+                cells.append(v)
+                continue
+            if c.startswith("ratio_to_baseline") and f"{c}_ci95_lo" in r:
+                cells.append(answer.ratio_text(num(v), num(r.get(f"{c}_ci95_lo")), num(r.get(f"{c}_ci95_hi")))
+                             if v != "" else "")
+                continue
             try:
                 x = float(v)
-                cells.append(f"{x:.4g}")
-            except ValueError:
+            except (TypeError, ValueError):
                 cells.append(v)
+                continue
+            if x != x or c in ("count",):
+                cells.append(v)
+            else:
+                cells.append(answer.thousands(x) if c in COUNT_COLUMNS else answer.sig3(x))
         out.append(cells)
     return out
 
 
-def markdown_table(rows, columns):
+def markdown_table(rows, columns, raw=()):
     lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    for cells in table_cells(rows, columns):
+    for cells in table_cells(rows, columns, raw):
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -515,6 +529,7 @@ def report(folder: Path, transition: str = "worst") -> list:
     figs = folder / "figures"
     figs.mkdir(exist_ok=True)
     made = []
+    headline = []  # the figures that follow the answer: cost against popping, popping per transition
     tables = []
     header = list(summary[0]) if summary else []
     # The swept variables lead the columns, one per sweep; a merged folder's `adapter` column follows them.
@@ -531,11 +546,27 @@ def report(folder: Path, transition: str = "worst") -> list:
             first_count = scene_pts[0]["count"]
             scene_pts = [p for p in scene_pts if p["count"] == first_count]
             frontier.figure(scene, scene_pts, variables[-1], figs / f"frontier_{scene}.png")
-            made.append((f"frontier_{scene}.png", f"{scene}: cost against popping across {variables[-1]}"))
+            headline.append((f"frontier_{scene}.png", f"{scene}: cost against popping across {variables[-1]}"))
             rows = frontier.cheapest(scene, scene_pts, pairs, variables)
             if rows:
                 frontier_tables.append((f"{scene}: cheapest at or below a popping (paired within a run)", rows,
                                         frontier.COLUMNS))
+    # The answer first (scripts/answer.py), from the rows as the runs name their methods.
+    pairs_all = read_csv(folder / "pairs.csv") if (folder / "pairs.csv").is_file() else []
+    answers = []
+    for name, key, rows, said in answer.answers(summary, pairs_all, lambda values: budget_of(folder, variables,
+                                                                                           values), variables):
+        jods = frontier.perceptual_popping(folder, variables, key[0])
+        answers.append({"name": name, "sentences": said, "columns": answer.DECISION_COLUMNS,
+                        "rows": answer.decision_rows(key, rows, transitions_csv, jods, variables)})
+    if not variables:
+        for (scene,), rows in group(summary, "scene").items():
+            first_count = rows[0]["count"]
+            rows = [r for r in rows if r["count"] == first_count]
+            if any(r.get("lodpop_max") for r in rows) and any(r.get("ratio_to_baseline") for r in rows):
+                level = budget_of(folder, variables, ())
+                decision_figure(scene, rows, level, figs / f"decision_{scene}.png")
+                headline.append((f"decision_{scene}.png", f"{scene}: cost against popping, one point per method"))
     if variables and not swept:
         # Each combination of swept values is its own series, in the figures and the tables.
         for r in summary + frames + (transitions_csv or []):
@@ -576,7 +607,7 @@ def report(folder: Path, transition: str = "worst") -> list:
                 per_transition = transition_pops(by_method)
             if 0 < len(per_transition) <= 16:
                 transitions_figure(scene, per_transition, figs / f"transitions_{scene}.png")
-                made.append((f"transitions_{scene}.png", f"{scene}: popping per transition"))
+                headline.append((f"transitions_{scene}.png", f"{scene}: popping per transition"))
                 tables.append((scene, per_transition))
             if (folder / "frames").is_dir():
                 episode = contact(scene, folder / "frames", by_method, figs / f"contact_{scene}.png", transition)
@@ -587,14 +618,10 @@ def report(folder: Path, transition: str = "worst") -> list:
         if any(r["rmse_mean"] != "" for r in scene_summary):
             cost(scene, scene_summary, figs / f"cost_{scene}.png")
             made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
-    columns = variables + (["adapter"] if len(adapters) > 1 else []) + [
-               "scene", "method", "count", "frames", "gpu_ms_median",
-               "gpu_ms_median_transition", "ratio_to_baseline", "ratio_to_baseline_ci95_lo", "ratio_to_baseline_ci95_hi",
-               "triangles_mean", "rmse_mean", "rmse_max", "pop_max", "pop_p95",
-               "de2000_mean"] + (["lodpop_max", "lodpop_sum"] if summary and "lodpop_max" in summary[0] else []) \
-        + (["crack_px_mean", "units_drawn_mean"] if summary and "crack_px_mean" in summary[0] else [])
+    lead = variables + (["adapter"] if len(adapters) > 1 else []) + ["scene", "method", "count"]
     # The tables once, as (heading, rows, columns): report.md and report.html render the same ones.
-    sections = [("Summary", summary, columns)] + frontier_tables
+    sections = [(f"Summary: {what}", summary, lead + cols) for what, cols in summary_groups(header, lead)] \
+        + frontier_tables
     for scene, per_transition in tables:
         methods = transition_methods(per_transition)
         if len(per_transition[0]) == 4:
@@ -602,25 +629,105 @@ def report(folder: Path, transition: str = "worst") -> list:
                             (3, "max lodpop's shading part"), (1, "max pop (motion included)")):
                 if all(p[m][k] != p[m][k] for *_, p in per_transition for m in p):
                     continue
-                rows = [{"transition": f"frames {a}-{b} ({lods})", **{m: f"{p[m][k]:.4f}" for m in methods if m in p}}
+                rows = [{"transition": f"frames {a}-{b} ({lods})", **{m: answer.sig3(p[m][k]) for m in methods if m in p}}
                         for a, b, lods, p in per_transition]
                 sections.append((f"{scene}: {what} of each transition (its frames and the 2 after)", rows,
                                  ["transition"] + methods))
         else:
-            rows = [{"transition": f"frames {a}-{b}", **{m: f"{p[m]:.4f}" for m in methods if m in p}}
+            rows = [{"transition": f"frames {a}-{b}", **{m: answer.sig3(p[m]) for m in methods if m in p}}
                     for a, b, p in per_transition]
             sections.append((f"{scene}: max pop within {TRANSITION_WINDOW} frames of each transition", rows,
                              ["transition"] + methods))
     title = f"lodbench report: {folder.name}"
     text = [f"# {title}", ""]
+    for a in answers:
+        text += [f"## {a['name']}", ""] + [answer.text(s) for s in a["sentences"]] + [""]
+        text += ["| " + " | ".join(a["columns"]) + " |", "|" + "---|" * len(a["columns"])]
+        text += ["| " + " | ".join(str(c) for c in row) + " |" for row in a["rows"]] + [""]
+    for name, caption in headline:
+        text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
     for heading, rows, cols in sections:
-        text += [f"## {heading}", "", markdown_table(rows, cols), ""]
+        text += [f"## {heading}", "", markdown_table(rows, cols, lead), ""]
     for name, caption in made:
         text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
     (folder / "report.md").write_text("\n".join(text))
-    tables_html = [(heading, cols, table_cells(rows, cols)) for heading, rows, cols in sections]
-    (folder / "report.html").write_text(report_html.page(title, tables_html, made, clips, runs))
-    return made
+    tables_html = [(heading, cols, table_cells(rows, cols, lead)) for heading, rows, cols in sections]
+    (folder / "report.html").write_text(report_html.page(title, answers, headline, tables_html, made, clips, runs))
+    return headline + made
+
+
+# summary.csv's columns in the report's folded tables, a table per group (each fits a window); the intervals are
+# shown with their ratio, and a column of no group goes to "other".
+SUMMARY_GROUPS = (
+    ("time", ("frames", "gpu_ms_median", "gpu_ms_median_transition", "gpu_ms_median_steady", "gpu_ms_p5",
+              "gpu_ms_p95", "cpu_ms_median", "combine_gpu_ms_median")),
+    ("paired ratios", ("baseline", "rounds", "ratio_to_baseline", "ratio_to_baseline_transition",
+                       "ratio_to_baseline_steady")),
+    ("image error", ("rmse_mean", "rmse_max", "de2000_mean", "de2000_max", "flip_mean", "lag_rmse_mean",
+                     "lag_rmse_max", "shadow_rmse_mean")),
+    ("popping", ("pop_max", "pop_p95", "lodpop_max", "lodpop_p95", "lodpop_sum", "shadow_lodpop_max")),
+    ("geometry", ("triangles_mean", "draw_calls_mean", "t_instances_mean", "units_drawn_mean", "uncovered_px_mean",
+                  "crack_px_mean", "crack_px_max", "extra_target_bytes", "tri_alternation_max")),
+)
+# Counts, shown with thousands separators.
+COUNT_COLUMNS = {"frames", "rounds", "triangles_mean", "draw_calls_mean", "units_drawn_mean", "crack_px_max",
+                 "extra_target_bytes", "uncovered_px_mean", "crack_px_mean"}
+
+
+def summary_groups(header, lead):
+    """[(group, its columns present in `header`)], the groups of SUMMARY_GROUPS then "other"."""
+    placed = set(lead)
+    out = []
+    for what, cols in SUMMARY_GROUPS:
+        present = [c for c in cols if c in header]
+        placed.update(present)
+        placed.update(f"{c}_ci95_{e}" for c in present for e in ("lo", "hi"))
+        if present:
+            out.append((what, present))
+    rest = [c for c in header if c not in placed and not c.endswith(("_ci95_lo", "_ci95_hi"))]
+    if rest:
+        out.append(("other", rest))
+    return out
+
+
+def budget_of(folder: Path, variables, values):
+    """The run's --budget-lodpop (its run.json's config), or None."""
+    import json
+    path = frontier.run_folder(folder, variables, values) / "run.json"
+    try:
+        cfg = json.loads(path.read_text()).get("config") or {}
+    except (OSError, ValueError, AttributeError):
+        return None
+    b = cfg.get("budget_lodpop")
+    return float(b) if isinstance(b, (int, float)) and not isinstance(b, bool) else None
+
+
+def decision_figure(scene, rows, budget, path):
+    """Each method's cost (time over the baseline's, all frames, with its 95 % interval) against its largest
+    lodpop, the budget of the answer drawn across: the answer's two sentences at a glance."""
+    fig, ax = plt.subplots(figsize=(9, 4.4))
+    hard = next((r for r in rows if r["method"] == "discrete"), None) or \
+        next((r for r in rows if r["method"] == r.get("baseline")), None)
+    level = budget if budget is not None else (num(hard["lodpop_max"]) / 2 if hard else None)
+    for i, r in enumerate(rows):
+        x, lo, hi, y = (num(r.get(c)) for c in ("ratio_to_baseline", "ratio_to_baseline_ci95_lo",
+                                                  "ratio_to_baseline_ci95_hi", "lodpop_max"))
+        if x != x or y != y:
+            continue
+        err = [[x - lo], [hi - x]] if lo == lo and hi == hi else None
+        ax.errorbar([x], [y], xerr=err, fmt="o", color=f"C{i % 10}", capsize=3, label=r["method"])
+        ax.annotate(r["method"], (x, y), fontsize=7, xytext=(4, 4), textcoords="offset points")
+    if level is not None:
+        ax.axhline(level, color="tab:orange", lw=1.2, ls="--",
+                   label=f"budget {answer.sig3(level)}" + (" (--budget-lodpop)" if budget is not None else
+                                                            f" (half of {hard['method']}'s)"))
+    baseline = next((r["baseline"] for r in rows if r.get("baseline")), "the baseline")
+    ax.set_xlabel(f"time over {baseline}'s, all frames (95 % interval)")
+    ax.set_ylabel("largest lodpop (lower: less popping)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
+    ax.set_title(f"{scene}: cost against popping")
+    save(fig, path)
 
 
 RULE_STYLE = {"tune": ("black", "-"), "unreal": ("tab:red", "--"), "godot": ("tab:blue", "-."),
@@ -687,7 +794,86 @@ def tune_report(folder: Path) -> list:
     for name, caption in made:
         text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
     (folder / "report.md").write_text("\n".join(text))
+    answers = tune_answers(folder, meta, rules)
+    cells = table_cells(rules, columns)
+    (folder / "report.html").write_text(report_html.page(
+        f"lodbench tune: {meta['scene']}", answers, made, [("Switch distances by rule (rules.csv)", columns, cells)],
+        [], None, report_html.tune_manifest(meta), players=False, note=report_html.TUNE_NOTE))
     return made
+
+
+def engine_units(folder: Path):
+    """{model: {lod_from: {engine column: value}}} from the tune folder's engines/ files (what an engine is given):
+    Unity's screenRelativeTransitionHeight, Unreal's screen size, Godot's visibility_range_end, Bevy's end margin
+    and three.js's LOD.addLevel distance, each of the switch from LOD k; missing files give no entries."""
+    import json
+
+    def load(name):
+        try:
+            return json.loads((folder / "engines" / name).read_text())
+        except (OSError, ValueError):
+            return None
+    out = {}
+
+    def put(model, k, col, v):
+        out.setdefault(model, {}).setdefault(k, {})[col] = v
+    for m in load("unity-lodgroup.json") or []:
+        for k, lod in enumerate(m.get("lods", [])[:-1]):
+            put(m["name"], k, "Unity transition height", lod.get("screenRelativeTransitionHeight"))
+    for m in load("unreal-screen-sizes.json") or []:
+        for k, size in enumerate(m.get("screen_size", [])[1:]):
+            put(m["name"], k, "Unreal screen size", size)
+    for name, lods in load("godot-visibility-ranges.json") or []:
+        for lod in lods[:-1]:
+            put(name, lod["lod"], "Godot visibility_range_end", lod.get("visibility_range_end"))
+    for name, lods in load("bevy-visibility-ranges.json") or []:
+        for k, lod in enumerate(lods[:-1]):
+            put(name, k, "Bevy end_margin", (lod.get("end_margin") or [None])[-1])
+    return out
+
+
+def tune_answers(folder: Path, meta, rules):
+    """A tune folder's answer per model: where it switches within the budget, how the engines' rules fare there,
+    and a table of the switches in each engine's units with the measured popping against the budget."""
+    budget = meta["settings"]["budget"]
+    metric, limit = budget["metric"], float(budget["value"])
+    units = engine_units(folder)
+    columns = ["LODs", "triangles", "distance", f"worst {metric} from the switch", "budget", "within",
+               "error px at switch", "Unity transition height", "Unreal screen size", "Godot visibility_range_end",
+               "Bevy end_margin", "three.js addLevel"]
+    out = []
+    for m in meta["models"]:
+        pairs = m["pairs"]
+        where = ", ".join(f"{p['lod_from']}->{p['lod_to']} at {answer.sig3(p['switch_distance'])}"
+                          if p["switch_distance"] is not None else f"{p['lod_from']}->{p['lod_to']} never"
+                          for p in pairs)
+        said = [[f"{m['name']}: within a {metric} of {limit:g} ({meta['width']}x{meta['height']}, "
+                 f"{meta['settings']['views']} views), the switches are {where} (distance from the bounding "
+                 f"sphere's centre, radius {answer.sig3(m['radius'])})."]]
+        broken = []
+        for rule in ("unreal", "godot", "meshopt"):
+            rs = [r for r in rules if r["model"] == m["name"] and r["rule"] == rule]
+            if rs:
+                n = sum(r["within_budget"] != "true" for r in rs)
+                broken.append(f"{RULE_NAMES[rule]} breaks it at {n} of {len(rs)}")
+        if broken:
+            said.append(["Switching by the engines' error bounds instead: " + "; ".join(broken) + " (rules.csv)."])
+        rows = []
+        for p in pairs:
+            worst = p.get("checked_worst", p["value_at_switch"])
+            ok = worst is not None and (worst >= limit if metric == "jod" else worst <= limit)
+            u = units.get(m["name"], {}).get(p["lod_from"], {})
+            rows.append([f"{p['lod_from']}->{p['lod_to']}",
+                         f"{answer.thousands(p['triangles_from'])} -> {answer.thousands(p['triangles_to'])}",
+                         answer.sig3(p["switch_distance"]), answer.sig3(worst), f"{limit:g}",
+                         "yes" if ok else "no", answer.sig3(p["error_px_at_switch"]),
+                         *(answer.sig3(u.get(c)) for c in columns[7:11]), answer.sig3(p["switch_distance"])])
+        out.append({"name": m["name"], "sentences": said, "columns": columns, "rows": rows})
+    return out
+
+
+RULE_NAMES = {"unreal": "Unreal's auto screen size", "godot": "Godot's mesh_lod_threshold",
+              "meshopt": "meshoptimizer's 1 pixel"}
 
 
 def main() -> int:
@@ -703,7 +889,7 @@ def main() -> int:
     for folder in args.results:
         if (folder / "tune.csv").is_file() and (folder / "tune.json").is_file():
             made = tune_report(folder)
-            print(f"{folder}: report.md and {len(made)} figures in {folder / 'figures'}")
+            print(f"{folder}: report.md, report.html and {len(made)} figures in {folder / 'figures'}")
             continue
         if not (folder / "frames.csv").is_file() or not (folder / "summary.csv").is_file():
             print(f"error: {folder} has no frames.csv and summary.csv (a complete lodbench run?)", file=sys.stderr)

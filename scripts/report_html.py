@@ -178,7 +178,7 @@ def anchor(text: str) -> str:
 
 
 def table(columns, cells) -> str:
-    head = "".join(f"<th>{esc(c)}</th>" for c in columns)
+    head = "".join(f"<th>{esc(c).replace('_', '_<wbr>')}</th>" for c in columns)
     body = "\n".join("<tr>" + "".join(f'<td class="num">{esc(v)}</td>' if is_number(v) else f"<td>{esc(v)}</td>"
                                       for v in row) + "</tr>" for row in cells)
     return f'<div class="scroll"><table>\n<thead><tr>{head}</tr></thead>\n<tbody>\n{body}\n</tbody></table></div>'
@@ -256,6 +256,15 @@ def manifest_html(m) -> str:
     return "\n".join(out)
 
 
+def tune_manifest(meta) -> str:
+    """What a tune folder's tune.json says it was made with, as the manifest section."""
+    a = meta.get("adapter") or {}
+    rows = [("scene", meta.get("scene")), ("adapter", a.get("name")), ("driver", a.get("driver")),
+            ("lodbench", meta.get("lodbench_version")), ("git commit", meta.get("git_commit")),
+            ("size", f"{meta.get('width')}x{meta.get('height')}"), ("vertical field of view", meta.get("fov_y_deg"))]
+    return "<h3>tune.json</h3>" + key_values(rows) + details("settings", meta.get("settings"))
+
+
 def key_values(rows) -> str:
     return '<table class="kv">' + "".join(f"<tr><th>{esc(k)}</th><td>{esc(v)}</td></tr>" for k, v in rows
                                           if v not in (None, "")) + "</table>"
@@ -271,22 +280,62 @@ def script_json(value) -> str:
             .replace("&", "\\u0026"))
 
 
-def page(title: str, tables, figures, clips, runs) -> str:
-    """report.html. `tables`: [(heading, columns, rows of cell texts)], the first the summary; `figures`: [(file in
-    figures/, caption)]; `clips`: load_clips()'s or None; `runs`: manifest()'s."""
-    nav = [("summary", "Summary"), ("tables", "Per-transition tables"), ("players", "Transition players"),
-           ("figures", "Figures"), ("manifest", "Manifest")]
+def value_html(v) -> str:
+    """A str, or a scripts/answer.py Value as a span whose data- attributes say which CSV cells it shows."""
+    if not hasattr(v, "cols"):
+        return esc(v)
+    return (f'<span class="v" data-file="{esc(v.file)}" data-row="{esc(json.dumps(v.row))}" '
+            f'data-cols="{esc(",".join(v.cols))}" data-fmt="{esc(v.fmt)}" data-op="{esc(v.op)}">{esc(v.text)}</span>')
+
+
+def answer_html(a) -> str:
+    """One block's answer: its sentences, then its decision table."""
+    sentences = "".join(f'<p class="sentence">{"".join(value_html(part) for part in s)}</p>' for s in a["sentences"])
+    head = "".join(f"<th>{esc(c)}</th>" for c in a["columns"])
+    body = "\n".join("<tr>" + "".join(
+        f'<td class="num">{value_html(c)}</td>' if i else f"<th>{value_html(c)}</th>" for i, c in enumerate(row))
+        + "</tr>" for row in a["rows"])
+    return (f'<section class="answer"><h2>{esc(a["name"])}</h2>{sentences}'
+            f'<table class="decision"><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table></section>')
+
+
+def figure_html(name, cap) -> str:
+    src = esc(url(f"figures/{name}"))
+    return (f'<figure id="fig-{esc(anchor(name))}"><a href="{src}"><img src="{src}" alt="{esc(cap)}"></a>'
+            f"<figcaption>{esc(cap)}</figcaption></figure>")
+
+
+ANSWER_NOTE = ("Costs are paired round by round within the run and called different only where the 95 % interval "
+               "excludes 1; the budget is the run's <code>--budget-lodpop</code>, else half the hard switch's "
+               "largest lodpop; full precision in summary.csv and pairs.csv.")
+TUNE_NOTE = ("The worst popping is over tune's views from each switch to the end of its dense check; the engines' "
+             "values are those of engines/, for the model at the bounding sphere's centre; full precision in "
+             "tune.json and rules.csv.")
+
+
+def page(title: str, answers, headline, tables, figures, clips, runs, players=True, note=ANSWER_NOTE) -> str:
+    """report.html, the answer first. `answers`: [{name, sentences, columns, rows}] (scripts/answer.py: sentences
+    as lists of str and Value parts, rows of str and Value cells); `headline`: [(file in figures/, caption)], the
+    figures that follow the answer; `tables`: [(heading, columns, rows of cell texts)], folded (the
+    "cheapest at or below a popping" tables of an experiment open); `figures`: the other figures; `clips`:
+    load_clips()'s or None; `runs`: manifest()'s, or the manifest section's HTML; `players`: False leaves out the
+    players' section (a tune folder has no clips to play)."""
+    nav = [("answer", "Answer"), ("headline", "Cost and popping"), ("players", "Transition players"),
+           ("tables", "Tables"), ("figures", "More figures"), ("manifest", "Manifest")]
+    nav = [n for n in nav if (players or n[0] != "players") and (figures or n[0] != "figures")]
     body = [f"<h1>{esc(title)}</h1>",
-            '<nav>' + " ".join(f'<a href="#{a}">{esc(t)}</a>' for a, t in nav) + "</nav>"]
-    (summary_heading, columns, cells), rest = tables[0], tables[1:]
-    body += [f'<h2 id="summary">{esc(summary_heading)}</h2>', table(columns, cells)]
-    body.append('<h2 id="tables">Per-transition tables</h2>')
-    if not rest:
-        body.append('<p class="note">No transitions to tabulate.</p>')
-    for heading, columns, cells in rest:
-        body += [f'<h3 id="{esc(anchor(heading))}">{esc(heading)}</h3>', table(columns, cells)]
-    body.append('<h2 id="players">Transition players</h2>')
-    if not clips:
+            '<nav>' + " ".join(f'<a href="#{a}">{esc(t)}</a>' for a, t in nav) + "</nav>",
+            '<div id="answer">']
+    body += [answer_html(a) for a in answers] or ['<p class="note">summary.csv has no rows.</p>']
+    body.append(f'<p class="note">{note}</p></div>')
+    body.append('<h2 id="headline">Cost and popping</h2>')
+    body += [figure_html(name, cap) for name, cap in headline] or \
+        ['<p class="note">No popping measured (a run with <code>--quality off</code>?).</p>']
+    if players:
+        body.append('<h2 id="players">Transition players</h2>')
+    if not players:
+        pass  # a tune folder: nothing to play
+    elif not clips:
         body.append(f'<p class="note">{HOW_TO_GET_CLIPS}</p>' if clips is None else
                     '<p class="note">clips/index.json lists no clips (no transition on the path?).</p>')
     else:
@@ -300,12 +349,15 @@ def page(title: str, tables, figures, clips, runs) -> str:
                 scene = (clip["prefix"], clip["scene"])
                 body.append(f'<h3 class="scene">{esc(clip["prefix"] + clip["scene"])}</h3>')
             body.append(player(i, clip))
-    body.append('<h2 id="figures">Figures</h2>')
-    for name, cap in figures:
-        src = esc(url(f"figures/{name}"))
-        body.append(f'<figure id="fig-{esc(anchor(name))}"><a href="{src}"><img src="{src}" alt="{esc(cap)}"></a>'
-                    f"<figcaption>{esc(cap)}</figcaption></figure>")
-    body += ['<h2 id="manifest">Manifest</h2>', manifest_html(runs)]
+    body.append('<h2 id="tables">Tables</h2>')
+    for heading, columns, cells in tables:
+        opened = " open" if "cheapest at or below" in heading else ""
+        body.append(f'<details id="{esc(anchor(heading))}"{opened}><summary>{esc(heading)}</summary>'
+                    f"{table(columns, cells)}</details>")
+    if figures:
+        body.append('<h2 id="figures">More figures</h2>')
+        body += [figure_html(name, cap) for name, cap in figures]
+    body += ['<h2 id="manifest">Manifest</h2>', runs if isinstance(runs, str) else manifest_html(runs)]
     data = {"clips": [{k: c[k] for k in ("name", "fps", "frames", "k", "t_instances", "frame_images",
                                          "error_images")} for c in clips or []]}
     return f"""<!DOCTYPE html>
@@ -341,9 +393,19 @@ pre { background: #f0f0f0; padding: 8px; overflow: auto; max-height: 420px; }
 .scroll { overflow-x: auto; }
 table { border-collapse: collapse; background: #fff; font-size: 12.5px; }
 th, td { border: 1px solid #ddd; padding: 2px 7px; text-align: left; white-space: nowrap; }
+thead th { white-space: normal; vertical-align: bottom; }
+details { margin: 6px 0; }
+details > summary { cursor: pointer; font-weight: 600; }
+.answer { margin: 4px 0 14px; }
+.answer h2 { margin-top: 10px; }
+.sentence { font-size: 15px; margin: 4px 0; max-width: 1100px; }
+.sentence .v, table.decision .v { font-variant-numeric: tabular-nums; }
+table.decision { font-size: 13px; margin-top: 6px; }
+table.decision tbody th { font-weight: 600; background: #fafafa; }
 thead th { background: #f0f0f0; position: sticky; top: 0; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
 table.kv th { background: #f6f6f6; font-weight: 600; }
+table.kv td { white-space: normal; overflow-wrap: anywhere; }
 figure { margin: 12px 0 22px; }
 figure img { max-width: 100%; height: auto; border: 1px solid #e4e4e4; background: #fff; }
 figcaption { color: #555; }

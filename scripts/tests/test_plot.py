@@ -26,8 +26,8 @@ def test_sweep_folder(dump, tmp_path):
     r = plot(folder)
     assert r.returncode == 0, r.stderr
     assert figures(folder) == [
-        "contact_bunny-sweep.png", "cost_bunny-sweep.png", "fig6_bunny-sweep.png", "fsi_buffers_bunny-sweep.png",
-        "sweep_bunny-sweep.png", "transitions_bunny-sweep.png",
+        "contact_bunny-sweep.png", "cost_bunny-sweep.png", "decision_bunny-sweep.png", "fig6_bunny-sweep.png",
+        "fsi_buffers_bunny-sweep.png", "sweep_bunny-sweep.png", "transitions_bunny-sweep.png",
     ]
     report = (folder / "report.md").read_text()
     for name in figures(folder):
@@ -109,7 +109,7 @@ def test_pixel_error_experiment_gets_the_unified_figure(pixel_error_experiment, 
     assert r.returncode == 0, r.stderr
     assert "unified_terrain.png" in figures(folder)
     report = (folder / "report.md").read_text()
-    assert "| 1 | terrain | clusterlod |" in report and "| 4 | terrain | blocks |" in report
+    assert "| 1.0 | terrain | clusterlod |" in report and "| 4.0 | terrain | blocks |" in report
     assert "crack_px_mean" in report
     with Image.open(folder / "figures" / "unified_terrain.png") as im:
         assert im.width > 600

@@ -209,3 +209,90 @@ def test_lodbench_clips_in_chromium(clipped, browser, tmp_path):
     result = exercise(browser, clipped, screenshots_dir(tmp_path), "lodbench-clips")
     report_timing(browser, result, "lodbench clips")
     check(result)
+
+
+# The first screen a user sees (issue: the report answers first).
+FIRST_SCREEN = (1280, 800)
+FOX = Path(__file__).resolve().parents[2] / "tests" / "data" / "gltf" / "Fox.glb"
+
+
+@pytest.fixture(scope="module")
+def answer_reports(chromium, tmp_path_factory):
+    """Two reports as a user makes them: a textured, skinned and animated user asset (Khronos Fox, its texture
+    drawn) and bunny-sweep, every default method, a short flight at 160x120 (the page's layout does not depend on
+    the frame's size), plotted."""
+    base = tmp_path_factory.mktemp("answer-reports")
+    out = {}
+    for tag, scene in (("fox", str(FOX)), ("bunny-sweep", "bunny-sweep")):
+        folder = base / tag
+        r = subprocess.run([str(lodbench_binary()), "run", "--scene", scene, "--width", "160", "--height", "120",
+                            "--frames", "120", "--rounds", "6", "--out", str(folder)], capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        plot(folder)
+        out[tag] = folder
+    return out
+
+
+def first_screen_and_widths(b: Browser, folder: Path, shots: Path, tag: str) -> dict:
+    """Opens the report at 1280x800: where the first answer's heading, sentences and table lie, the window's
+    width, and every element wider than it (with every folded table opened); and every number span."""
+    b.js(f"window.resizeTo({FIRST_SCREEN[0]}, {FIRST_SCREEN[1]})")
+    b.call("Emulation.setDeviceMetricsOverride", width=FIRST_SCREEN[0], height=FIRST_SCREEN[1], deviceScaleFactor=1,
+           mobile=False)
+    b.open((folder / "report.html").resolve().as_uri())
+    b.painted()
+    b.screenshot().save(shots / f"answer-{tag}.png")
+    state = b.js("""(() => {
+        const box = el => { const r = el.getBoundingClientRect(); return [r.left, r.top, r.right, r.bottom]; };
+        const first = document.querySelector('.answer');
+        const parts = [first.querySelector('h2'), ...first.querySelectorAll('p.sentence'),
+                       first.querySelector('table.decision')];
+        document.querySelectorAll('details').forEach(d => d.open = true);
+        const w = document.documentElement.clientWidth;
+        const wide = [...document.querySelectorAll('body *')].filter(el => el.getBoundingClientRect().width > w + 0.5)
+            .map(el => el.tagName + (el.className ? '.' + el.className : '') + ' ' +
+                 Math.round(el.getBoundingClientRect().width));
+        const spans = [...document.querySelectorAll('span.v')].map(s => ({
+            'data-file': s.dataset.file, 'data-row': s.dataset.row, 'data-cols': s.dataset.cols,
+            'data-fmt': s.dataset.fmt, 'data-op': s.dataset.op, text: s.textContent,
+            in_sentence: !!s.closest('p.sentence')}));
+        return {boxes: parts.map(box), height: window.innerHeight, width: w,
+                scroll_width: document.documentElement.scrollWidth, wide, spans,
+                sentences: [...first.querySelectorAll('p.sentence')].map(p => p.textContent)};
+    })()""")
+    return state
+
+
+def check_answer(state, folder: Path):
+    from test_answer import expected
+    assert state["width"] == FIRST_SCREEN[0] and state["height"] == FIRST_SCREEN[1], state
+    for left, top, right, bottom in state["boxes"]:
+        assert 0 <= top and bottom <= FIRST_SCREEN[1], ("the answer is not in the first screen", state["boxes"])
+        assert 0 <= left and right <= FIRST_SCREEN[0], ("the answer is wider than the window", state["boxes"])
+    assert len(state["sentences"]) == 2, state["sentences"]
+    assert state["wide"] == [] and state["scroll_width"] <= FIRST_SCREEN[0], state["wide"]
+    in_sentences = [s for s in state["spans"] if s["in_sentence"]]
+    assert len(in_sentences) >= 3, state["spans"]
+    for span in state["spans"]:
+        assert span["text"] == expected(span, folder), span
+
+
+@pytest.mark.parametrize("tag", ["fox", "bunny-sweep"])
+def test_the_answer_is_in_the_first_screen(answer_reports, browser, tmp_path, tag):
+    folder = answer_reports[tag]
+    state = first_screen_and_widths(browser, folder, screenshots_dir(tmp_path), tag)
+    print(f"\n{tag}: answer boxes {state['boxes']}; sentences: {state['sentences']}")
+    check_answer(state, folder)
+    assert browser.errors() == [], browser.errors()
+
+
+def test_a_wide_table_is_caught(answer_reports, browser, tmp_path):
+    """The check can fail: the same report with its decision table made wider than the window."""
+    folder = tmp_path / "wide"
+    shutil.copytree(answer_reports["bunny-sweep"], folder)
+    page = (folder / "report.html").read_text()
+    (folder / "report.html").write_text(page.replace("</style>", "table.decision { min-width: 1400px; }</style>", 1))
+    state = first_screen_and_widths(browser, folder, screenshots_dir(tmp_path), "wide")
+    assert state["wide"], state
+    with pytest.raises(AssertionError):
+        check_answer(state, folder)

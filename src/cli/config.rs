@@ -144,6 +144,9 @@ pub struct RunConfig {
     pub rounds: u32,
     /// `--baseline` as given (None: each scene's default, [`RunConfig::baseline_for`]).
     pub baseline: Option<String>,
+    /// `--budget-lodpop`: the popping budget of the answer printed and in report.html (None: half of the hard
+    /// switch's largest lodpop, `results::answer`).
+    pub budget_lodpop: Option<f64>,
     /// Every method's flags (recorded whether or not the method runs).
     #[serde(flatten)]
     pub method_options: MethodOptions,
@@ -260,6 +263,14 @@ impl RunConfig {
             }
             None => None,
         };
+        if let Some(b) = a.budget_lodpop {
+            if !(b > 0.0 && b < 1.0) {
+                return Err(Error::Config(format!(
+                    "--budget-lodpop {b}: a lodpop budget is a change in (0, 1) (the RMS over the frame of a \
+                     switch's change, sRGB-encoded)"
+                )));
+            }
+        }
         if a.dump_every == 0 {
             return Err(Error::Config("--dump-every must be at least 1".into()));
         }
@@ -294,6 +305,7 @@ impl RunConfig {
             seed: a.seed,
             rounds: a.rounds,
             baseline,
+            budget_lodpop: a.budget_lodpop,
             method_options: a.method_options,
             metrics: a.metrics.clone(),
             metric_reduction: a.metric_reduction,

@@ -363,6 +363,11 @@ pub struct RunArgs {
     /// default `discrete` when it is run. A name repeated in --method is `NAME#2`, `NAME#3`, ...
     #[arg(long)]
     pub baseline: Option<String>,
+    /// The popping budget the answer under the summary table (and at the top of report.html) is stated within:
+    /// the largest lodpop a method may show to count (`lodbench tune --budget-lodpop`'s budget, say). Default:
+    /// half the hard switch's (discrete's) largest lodpop. Changes no measurement.
+    #[arg(long)]
+    pub budget_lodpop: Option<f64>,
     #[command(flatten)]
     #[serde(flatten)]
     pub method_options: MethodOptions,

@@ -48,7 +48,11 @@ pub fn stop_on_signal() {
 pub struct RunSummary {
     pub out_dir: PathBuf,
     pub summaries: Vec<SummaryRecord>,
+    /// pairs.csv's rows.
+    pub pairs: Vec<PairRecord>,
     pub blocks: Vec<BlockInfo>,
+    /// `--budget-lodpop`: the popping budget the answer under the table is stated within.
+    pub budget_lodpop: Option<f64>,
 }
 
 /// The default output folder: results/<scenes>-<UTC time>/.
@@ -127,11 +131,13 @@ pub fn run_with(cfg: &RunConfig, registry: &Registry) -> Result<RunSummary> {
         }
     }
     manifest.write(&out_dir)?;
-    let summaries = result?;
+    let (summaries, pairs) = result?;
     Ok(RunSummary {
         out_dir,
         summaries,
+        pairs,
         blocks: manifest.blocks.clone(),
+        budget_lodpop: cfg.budget_lodpop,
     })
 }
 
@@ -166,7 +172,7 @@ fn run_blocks(
     defs: &[SceneDef],
     out_dir: &Path,
     manifest: &mut RunManifest,
-) -> Result<Vec<SummaryRecord>> {
+) -> Result<(Vec<SummaryRecord>, Vec<PairRecord>)> {
     let ctx = GpuContext::new(cfg.adapter.as_deref())?;
     manifest.adapter = Some(ctx.info.clone());
     manifest.timing_source = Some(ctx.timing);
@@ -206,7 +212,7 @@ fn run_blocks(
     write_transitions(out_dir, &output.transitions)?;
     write_rounds(out_dir, &output.rounds)?;
     write_pairs(out_dir, &output.pairs)?;
-    Ok(output.summaries)
+    Ok((output.summaries, output.pairs))
 }
 
 /// The frames the progress bar counts: per block, every method's warm-up, timed and quality frames (with the
@@ -385,66 +391,76 @@ fn summarise(
     }
 }
 
-/// The table printed at the end of a run.
+/// The table printed at the end of a run: columns sized to their contents, numbers by unit (milliseconds to 3
+/// significant figures, triangles with thousands separators, ratios with their interval; full precision in the
+/// CSVs), then the answer (`results::answer`) and what the columns mean.
 pub fn summary_table(s: &RunSummary) -> String {
-    let mut out = format!(
-        "{:<12} {:<15} {:>5} {:>6} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>10} {:>5} {}\n",
+    use crate::results::answer::{aligned, answers, ratio, sig3, thousands};
+    let mut rows = vec![[
         "scene",
         "method",
         "count",
         "frames",
-        "gpu_ms",
-        "cpu_ms",
+        "gpu ms",
+        "cpu ms",
         "triangles",
         "rmse",
-        "rmse_max",
-        "pop_max",
-        "lodpop_max",
+        "rmse max",
+        "pop max",
+        "lodpop max",
         "q/r",
-        "ratio [95% CI]"
-    );
-    // A figure at `digits` decimals, or '-' where the run has none (no timestamps, `--quality off`).
-    let fig =
-        |v: Option<f64>, digits: usize| v.map_or("-".to_string(), |x| format!("{x:.digits$}"));
+        "time / baseline [95 % CI]",
+    ]
+    .map(String::from)
+    .to_vec()];
     for r in &s.summaries {
-        let ratio = s
+        let q = s
             .blocks
             .iter()
             .find(|b| b.scene == r.scene && b.method == r.method && b.count == r.count)
             .and_then(|b| b.quality_to_renders_ratio);
-        let paired = match (
-            r.ratio_to_baseline,
-            r.ratio_to_baseline_ci95_lo,
-            r.ratio_to_baseline_ci95_hi,
-        ) {
-            (Some(x), Some(lo), Some(hi)) => format!("{x:.3} [{lo:.3}, {hi:.3}]"),
-            (Some(x), _, _) => format!("{x:.3}"),
-            _ => "-".into(),
-        };
-        out.push_str(&format!(
-            "{:<12} {:<15} {:>5} {:>6} {:>9} {:>9.3} {:>10.0} {:>9} {:>9} {:>9} {:>10} {:>5} {}\n",
-            r.scene,
-            r.method,
-            r.count,
-            r.frames,
-            fig(r.gpu_ms_median, 3),
-            r.cpu_ms_median,
-            r.triangles_mean,
-            fig(r.rmse_mean, 5),
-            fig(r.rmse_max, 5),
-            fig(r.pop_max, 5),
-            fig(r.lodpop_max, 5),
-            fig(ratio, 2),
-            paired
-        ));
+        rows.push(vec![
+            r.scene.clone(),
+            r.method.clone(),
+            r.count.to_string(),
+            r.frames.to_string(),
+            sig3(r.gpu_ms_median),
+            sig3(Some(r.cpu_ms_median)),
+            thousands(Some(r.triangles_mean)),
+            sig3(r.rmse_mean),
+            sig3(r.rmse_max),
+            sig3(r.pop_max),
+            sig3(r.lodpop_max),
+            q.map_or("-".into(), |q| format!("{q:.2}")),
+            ratio(
+                r.ratio_to_baseline,
+                r.ratio_to_baseline_ci95_lo,
+                r.ratio_to_baseline_ci95_hi,
+            ),
+        ]);
+    }
+    let right = [
+        false, false, true, true, true, true, true, true, true, true, true, true, false,
+    ];
+    let mut out = aligned(&rows, &right);
+    let said = answers(&s.summaries, &s.pairs, s.budget_lodpop);
+    if said.iter().any(|a| !a.sentences.is_empty()) {
+        out.push('\n');
+        for a in &said {
+            for sentence in &a.sentences {
+                out.push_str(sentence);
+                out.push('\n');
+            }
+        }
+        out.push('\n');
     }
     let baseline = s.summaries.iter().find_map(|r| r.baseline.clone());
     out.push_str(&format!(
-        "gpu_ms and cpu_ms are medians; q/r = quality-pass time per frame / the timing-pass time of the \
+        "gpu ms and cpu ms are medians; q/r = quality-pass time per frame / the timing-pass time of the \
          renders it makes (method, reference where drawn, lodpop's counterfactual where drawn), paired by round \
-         (geometric mean; its interval in run.json); ratio = time over {}'s, paired by timing round, geometric mean and 95 % t interval over rounds \
-         (every other pair: pairs.csv, lodbench compare DIR A B); '-' = not measured (no timestamps; --quality off: \
-         no image figures)\n",
+         (geometric mean; its interval in run.json); time / baseline = time over {}'s, paired by timing round, \
+         geometric mean and 95 % t interval over rounds (every other pair: pairs.csv, lodbench compare DIR A B); \
+         '-' = not measured (no timestamps; --quality off: no image figures); full precision in summary.csv\n",
         baseline.as_deref().unwrap_or("the baseline (none run)")
     ));
     for b in &s.blocks {
@@ -453,4 +469,74 @@ pub fn summary_table(s: &RunSummary) -> String {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(scene: &str, method: &str, gpu_ms: f64, triangles: f64) -> SummaryRecord {
+        SummaryRecord {
+            scene: scene.into(),
+            method: method.into(),
+            count: 1,
+            frames: 600,
+            gpu_ms_median: Some(gpu_ms),
+            cpu_ms_median: gpu_ms * 1.1,
+            triangles_mean: triangles,
+            lodpop_max: Some(0.004 * gpu_ms),
+            baseline: Some("discrete".into()),
+            ratio_to_baseline: Some(gpu_ms),
+            ratio_to_baseline_ci95_lo: Some(gpu_ms * 0.9),
+            ratio_to_baseline_ci95_hi: Some(gpu_ms * 1.1),
+            ..SummaryRecord::default()
+        }
+    }
+
+    #[test]
+    fn the_table_stays_aligned_for_a_long_scene_name() {
+        let long = "a-forty-character-user-scene-name-01.glb";
+        assert_eq!(long.len(), 40);
+        let s = RunSummary {
+            out_dir: PathBuf::from("out"),
+            summaries: vec![
+                record("bunny-sweep", "discrete", 1.0, 1183.0),
+                record("bunny-sweep", "alpha-2pass", 1.234_567, 1556.4),
+                record(long, "discrete", 1.0, 557_500.0),
+                record(long, "fsi-noreproject", 12.345_67, 3674.0),
+            ],
+            pairs: Vec::new(),
+            blocks: Vec::new(),
+            budget_lodpop: None,
+        };
+        let text = summary_table(&s);
+        let lines: Vec<&str> = text.lines().take(5).collect();
+        // Each column's cells start (text) or end (numbers) at the same place on every line.
+        let method_at = lines[0].find("method").expect("the header");
+        for (line, method) in
+            lines[1..]
+                .iter()
+                .zip(["discrete", "alpha-2pass", "discrete", "fsi-noreproject"])
+        {
+            assert_eq!(line.find(method), Some(method_at), "{text}");
+        }
+        let gpu_end = lines[0].find("gpu ms").expect("the header") + "gpu ms".len();
+        for (line, ms) in lines[1..].iter().zip(["1.00", "1.23", "1.00", "12.3"]) {
+            assert!(line[..gpu_end].ends_with(ms), "{text}");
+        }
+        let ratio_at = lines[0].find("time / baseline").expect("the header");
+        for (line, r) in
+            lines[1..]
+                .iter()
+                .zip(["1.00 [0.90", "1.23 [1.11", "1.00 [0.90", "12.35 [11.11"])
+        {
+            assert_eq!(line.find(r), Some(ratio_at), "{text}");
+        }
+        assert!(text.contains("557,500"), "{text}");
+        // The answer follows the table, one per scene.
+        assert!(
+            text.contains(&format!("{long}: discrete pops least")),
+            "{text}"
+        );
+    }
 }

@@ -189,6 +189,13 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
         out.display(),
         out.display()
     );
+    if let Budget::Lodpop(x) = settings.budget {
+        outln!(
+            "every method with these switches, answered within the budget: lodbench run --scene {} \
+             --budget-lodpop {x}",
+            out.join("tuned.glb").display()
+        );
+    }
     Ok(())
 }
 

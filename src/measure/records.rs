@@ -76,7 +76,7 @@ pub struct FrameRecord {
 }
 
 /// One row of summary.csv: one method on one scene block.
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Default, Serialize, PartialEq)]
 pub struct SummaryRecord {
     pub scene: String,
     pub method: String,
@@ -292,9 +292,10 @@ impl FrameSet {
 /// has one, else `cpu_ms`. Decided once per block ([`Clock::of_block`]) and passed to every ratio of it
 /// (summary.csv's `ratio_to_baseline`, rounds.csv, pairs.csv), so one missing timestamp cannot switch some of
 /// a block's ratios to another clock than the others.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Clock {
+    #[default]
     GpuMs,
     CpuMs,
 }
