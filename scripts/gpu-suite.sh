@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The papers' experiments on this machine's GPU, in one command (docs/cluster.md, "The GPU suite"):
 #   scripts/gpu-suite.sh [FRAMES [EXPERIMENT ...]]
-# runs scenes/experiments/aa-gpu.toml (the A/A check the suite's ratios are read against, then
+# runs lodbench probe (the adapter's ceilings), then scenes/experiments/aa-gpu.toml (the A/A check the suite's ratios are read against, then
 # scripts/aa_check.py), then {fsi-fig8,sheliemietiev-fig5,sheliemietiev-fig6,trees-sorting,unified-lod,
 # terrain-equal-error,frontier}.toml, or only the EXPERIMENTs named (file names without .toml), at
 # the papers' scenes, instance counts and viewports, with FRAMES timed frames (default 150; the papers' 3,600
@@ -41,6 +41,11 @@ name=$(printf '%s' "${best%%[*}" | sed 's/^ *//; s/ *$//' | tr -c 'A-Za-z0-9._-'
 out=results/gpu/$name
 mkdir -p "$out"
 echo "adapter: $best" | tee -a "$out/times.txt"
+# The adapter's ceilings first (lodbench probe: triangle, vertex, fill, depth and read rates with their scaling
+# checks; seconds on a GPU, 15 s on lavapipe), so the experiments' costs can be read against them.
+start=$(date +%s)
+"$lodbench" probe --rounds 20 --out "$out/probe"
+echo "probe: $(($(date +%s) - start)) s" | tee -a "$out/times.txt"
 for exp in "${experiments[@]}"; do
     extra=()
     if [[ $exp == trees-sorting ]]; then

@@ -3,7 +3,7 @@
 use clap::Parser;
 use lodbench::cli::{Cli, Command};
 use lodbench::commands::{
-    clips, compare, describe, experiment, export, list, merge, perceptual, run, tune,
+    clips, compare, describe, experiment, export, list, merge, perceptual, probe, run, tune,
 };
 use lodbench::Error;
 use std::process::ExitCode;
@@ -22,6 +22,7 @@ fn main() -> ExitCode {
         Command::Perceptual(args) => perceptual::execute(&args),
         Command::Clips(args) => clips::execute(&args),
         Command::Tune(args) => tune::execute(&args),
+        Command::Probe(args) => probe::execute(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

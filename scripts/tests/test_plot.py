@@ -26,7 +26,8 @@ def test_sweep_folder(dump, tmp_path):
     r = plot(folder)
     assert r.returncode == 0, r.stderr
     assert figures(folder) == [
-        "contact_bunny-sweep.png", "cost_bunny-sweep.png", "decision_bunny-sweep.png", "fig6_bunny-sweep.png",
+        "ceilings_bunny-sweep.png", "contact_bunny-sweep.png", "cost_bunny-sweep.png", "decision_bunny-sweep.png",
+        "fig6_bunny-sweep.png",
         "fsi_buffers_bunny-sweep.png", "sweep_bunny-sweep.png", "transitions_bunny-sweep.png",
     ]
     report = (folder / "report.md").read_text()
@@ -47,7 +48,8 @@ def test_a_timing_only_run_gets_no_quality_figures(tmp_path):
              "--frames", "24", "--warmup", "0", "--rounds", "4", "--quality", "off", "--out", str(folder))
     r = plot(folder)
     assert r.returncode == 0, r.stderr
-    assert figures(folder) == []
+    # Only the timing's figure: the blocks' triangle rate against the adapter's ceiling.
+    assert figures(folder) == ["ceilings_bunny-sweep.png"]
     report = (folder / "report.md").read_text()
     row = next(line for line in report.splitlines() if line.startswith("| bunny-sweep | alpha |"))
     assert "|  |" in row and "| 0.0 |" not in row, row

@@ -147,6 +147,8 @@ pub struct RunConfig {
     /// `--budget-lodpop`: the popping budget of the answer printed and in report.html (None: half of the hard
     /// switch's largest lodpop, `results::answer`).
     pub budget_lodpop: Option<f64>,
+    /// `--ceilings`: measure the adapter's ceilings before the blocks.
+    pub ceilings: OnOff,
     /// Every method's flags (recorded whether or not the method runs).
     #[serde(flatten)]
     pub method_options: MethodOptions,
@@ -306,6 +308,7 @@ impl RunConfig {
             rounds: a.rounds,
             baseline,
             budget_lodpop: a.budget_lodpop,
+            ceilings: a.ceilings,
             method_options: a.method_options,
             metrics: a.metrics.clone(),
             metric_reduction: a.metric_reduction,

@@ -59,6 +59,33 @@ pub enum Command {
     /// alone from N directions at a range of distances; writes tune.csv, tune.json, the settings in each
     /// engine's units (engines/) and the scene rewritten with them (tuned.glb).
     Tune(TuneArgs),
+    /// Measure the adapter's ceilings: triangle, vertex, fill, depth and compute-read rates, each with a check
+    /// that doubling what it names doubles its time and changing anything else does not; writes probe.csv.
+    Probe(ProbeArgs),
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct ProbeArgs {
+    /// The target's width and height in pixels (the geometry probes' control draws into twice the width).
+    #[arg(long, default_value_t = 512)]
+    pub width: u32,
+    #[arg(long, default_value_t = 512)]
+    pub height: u32,
+    /// Timing rounds: each round times every variant of every probe once, in an order shuffled from --seed.
+    #[arg(long, default_value_t = 10)]
+    pub rounds: u32,
+    /// Seed of the rounds' order (recorded in probe.json).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// The amount of work of every probe, relative to the default (about a millisecond each on a GPU).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Output folder (default results/probe-<time>/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// GPU adapter, by index or name substring (`lodbench list`).
+    #[arg(long)]
+    pub adapter: Option<String>,
 }
 
 #[derive(Debug, Clone, Args)]
@@ -76,8 +103,9 @@ pub struct TuneArgs {
     /// may score.
     #[arg(long)]
     pub budget_jod: Option<f64>,
-    /// View directions per LOD pair: the scene's own (+z) and the rest from a seeded Fibonacci sphere.
-    #[arg(long, default_value_t = 8)]
+    /// View directions per LOD pair: the scene's own (+z) and the rest from a seeded Fibonacci sphere (32: with
+    /// 8, a direction between them broke the budget by 12 % on a scan, docs/findings/tune.md).
+    #[arg(long, default_value_t = 32)]
     pub views: u32,
     /// Distances per view, evenly spaced in log distance from where the model fits the view to where it is two
     /// pixels across.
@@ -368,6 +396,11 @@ pub struct RunArgs {
     /// half the hard switch's (discrete's) largest lodpop. Changes no measurement.
     #[arg(long)]
     pub budget_lodpop: Option<f64>,
+    /// Measure the adapter's ceilings before the blocks (`lodbench probe`'s rates, each probe's base alone, a
+    /// fraction of a second on a CPU adapter) into run.json, and fill summary.csv's triangles_per_s,
+    /// triangle_ceiling_share and bound.
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    pub ceilings: OnOff,
     #[command(flatten)]
     #[serde(flatten)]
     pub method_options: MethodOptions,

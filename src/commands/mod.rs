@@ -1,5 +1,5 @@
 //! One file per subcommand: what `lodbench run`, `experiment`, `merge`, `compare`, `clips`, `perceptual`, `list`,
-//! `describe`, `export` and `tune` do, from the parsed flags to a results folder or a printed report. Each file's `execute` is what
+//! `describe`, `export`, `tune` and `probe` do, from the parsed flags to a results folder or a printed report. Each file's `execute` is what
 //! the binary calls.
 
 /// `print!` / `println!` to stdout that give up quietly when stdout is gone (`lodbench describe ... | head`):
@@ -26,5 +26,6 @@ pub mod export;
 pub mod list;
 pub mod merge;
 pub mod perceptual;
+pub mod probe;
 pub mod run;
 pub mod tune;

@@ -177,6 +177,9 @@ fn run_blocks(
     manifest.adapter = Some(ctx.info.clone());
     manifest.timing_source = Some(ctx.timing);
     manifest.timestamp_period_ns = Some(ctx.timestamp_period_ns);
+    if cfg.ceilings == crate::effects::OnOff::On {
+        manifest.ceilings = Some(crate::measure::probe::ceilings(&ctx, cfg.seed)?);
+    }
     manifest.write(out_dir)?;
 
     let dumper = if cfg.dump_frames {
@@ -208,6 +211,13 @@ fn run_blocks(
     }
     job.progress.finish_and_clear();
     output.frames_csv.finish()?;
+    let ceiling = manifest
+        .ceilings
+        .as_deref()
+        .and_then(crate::measure::probe::triangle_ceiling);
+    for s in &mut output.summaries {
+        s.set_ceiling(ceiling);
+    }
     write_summary(out_dir, &output.summaries)?;
     write_transitions(out_dir, &output.transitions)?;
     write_rounds(out_dir, &output.rounds)?;

@@ -7,6 +7,7 @@ pub mod context;
 pub mod draw_list;
 pub mod instances;
 pub mod pipelines;
+pub mod probe;
 pub mod readback;
 pub mod scene_gpu;
 pub mod shadow_pass;

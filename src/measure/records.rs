@@ -141,9 +141,35 @@ pub struct SummaryRecord {
     pub ratio_to_baseline_steady: Option<f64>,
     pub ratio_to_baseline_steady_ci95_lo: Option<f64>,
     pub ratio_to_baseline_steady_ci95_hi: Option<f64>,
+    /// Mean triangles drawn over the median frame time (the block's clock), a second.
+    pub triangles_per_s: Option<f64>,
+    /// `triangles_per_s` over the adapter's triangle ceiling measured at the start of the run (run.json's
+    /// `ceilings`, `measure::probe::triangle_ceiling`).
+    pub triangle_ceiling_share: Option<f64>,
+    /// `triangles` where that share is 0.8 or more: the block draws near the adapter's triangle rate.
+    pub bound: Option<String>,
 }
 
 impl SummaryRecord {
+    /// Fills the ceiling columns from the run's triangle ceiling (triangles a second).
+    pub fn set_ceiling(&mut self, triangle_ceiling: Option<f64>) {
+        let ms = match self.clock {
+            Clock::GpuMs => self.gpu_ms_median,
+            Clock::CpuMs => Some(self.cpu_ms_median),
+        };
+        self.triangles_per_s = ms
+            .filter(|ms| *ms > 0.0)
+            .map(|ms| self.triangles_mean / (ms / 1e3));
+        self.triangle_ceiling_share = self
+            .triangles_per_s
+            .zip(triangle_ceiling.filter(|c| *c > 0.0))
+            .map(|(r, c)| r / c);
+        self.bound = self
+            .triangle_ceiling_share
+            .filter(|s| *s >= 0.8)
+            .map(|_| "triangles".to_string());
+    }
+
     /// Summarises one block's rows (all of the same scene, method and count); `seed` drives the bootstrap,
     /// `clock` is the block's ([`Clock::of_block`], over every method of the block).
     pub fn from_frames(
@@ -236,6 +262,9 @@ impl SummaryRecord {
             ratio_to_baseline_steady: None,
             ratio_to_baseline_steady_ci95_lo: None,
             ratio_to_baseline_steady_ci95_hi: None,
+            triangles_per_s: None,
+            triangle_ceiling_share: None,
+            bound: None,
         })
     }
 

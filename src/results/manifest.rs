@@ -50,6 +50,9 @@ pub struct RunManifest {
     /// The process's peak resident memory when the run ended, in bytes (`VmHWM` of /proc/self/status; null
     /// where the system does not say). On a CPU adapter such as lavapipe it includes what a GPU would hold.
     pub peak_resident_bytes: Option<u64>,
+    /// The adapter's ceilings measured before the blocks (`measure::probe::ceilings`; null with
+    /// `--ceilings off`): each probe's rate on its clock. summary.csv's ceiling columns divide by them.
+    pub ceilings: Option<Vec<crate::measure::probe::ProbeRecord>>,
 }
 
 /// This build's `git describe --always --dirty` (None when not built from a checkout).
@@ -104,6 +107,7 @@ impl RunManifest {
             blocks: Vec::new(),
             timing_rounds: Vec::new(),
             peak_resident_bytes: None,
+            ceilings: None,
         }
     }
 

@@ -1,0 +1,233 @@
+//! `lodbench probe`'s measurement: every probe of `gpu::probe` and its doubled and control variants, timed in
+//! rounds (each round times every variant of every probe once, in an order shuffled from the seed), on the GPU's
+//! timestamps where the adapter has them, else the CPU's clock around a submission and its wait.
+//!
+//! Each probe is read on the GPU's timestamps unless they hold less than half of the CPU's time from the
+//! submission to the device's idle (less an empty submission's): lavapipe's timestamps do not wait for a compute
+//! dispatch, and its bandwidth probe reads 1,000 times faster on them than the CPU waits. probe.csv's `clock`
+//! says which was read.
+//!
+//! Per probe: the rate (its quantity over the base's time) as the median over rounds and the geometric mean with
+//! its Student-t 95 % interval; the doubled variant's time over the base's and the control's time over the base's,
+//! paired round by round (geometric means with their intervals). A probe isolates what it names when doubling it
+//! about doubles the time and the control leaves it: `scales` (a ratio in one run, never a time).
+
+use crate::error::Result;
+use crate::gpu::context::GpuContext;
+use crate::gpu::probe::{Amounts, Probe, Probes, Variant, PROBES, VARIANTS};
+use crate::gpu::timing::GpuTimer;
+use crate::measure::stats::{paired_log_ratio, percentile};
+use crate::rng::SplitMix64;
+use serde::Serialize;
+use std::time::Instant;
+
+/// Where `scales` draws the line: doubling within [1.6, 2.5] times, the control within [0.8, 1.25].
+pub const DOUBLED_RANGE: (f64, f64) = (1.6, 2.5);
+pub const CONTROL_RANGE: (f64, f64) = (0.8, 1.25);
+
+/// One row of probe.csv.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ProbeRecord {
+    pub probe: &'static str,
+    pub unit: &'static str,
+    /// The base variant's amount of the unit.
+    pub quantity: f64,
+    /// `gpu_ms` (timestamps) or `cpu_ms` (submission to idle).
+    pub clock: &'static str,
+    pub rounds: u32,
+    /// The base variant's median time on `clock`; on the timestamps (None without them); and on the CPU's
+    /// clock from its submission to the device's idle, less an empty submission's time.
+    pub ms_median: f64,
+    pub gpu_ms_median: Option<f64>,
+    pub cpu_ms_median: f64,
+    /// The unit per second: the median over rounds, and the geometric mean's 95 % interval.
+    pub rate_median: f64,
+    pub rate_ci95_lo: Option<f64>,
+    pub rate_ci95_hi: Option<f64>,
+    /// The doubled variant's time over the base's, paired by round.
+    pub doubled_ratio: f64,
+    pub doubled_ci95_lo: Option<f64>,
+    pub doubled_ci95_hi: Option<f64>,
+    /// What the control changes, and its time over the base's.
+    pub control: &'static str,
+    pub control_ratio: f64,
+    pub control_ci95_lo: Option<f64>,
+    pub control_ci95_hi: Option<f64>,
+    /// Doubling within DOUBLED_RANGE and the control within CONTROL_RANGE.
+    pub scales: bool,
+}
+
+/// Times every probe's variants over `rounds` rounds, their order shuffled from `seed`; one untimed pass first.
+pub fn measure(
+    ctx: &GpuContext,
+    probes: &Probes,
+    rounds: u32,
+    seed: u64,
+) -> Result<Vec<ProbeRecord>> {
+    measure_variants(ctx, probes, rounds, seed, &VARIANTS)
+}
+
+/// The ceilings every run records in run.json before its blocks: each probe's base variant alone (no scaling
+/// check: that is `lodbench probe`'s), at a quarter of the default work on a 256 x 256 target, 3 rounds; a
+/// fraction of a second on lavapipe.
+pub fn ceilings(ctx: &GpuContext, seed: u64) -> Result<Vec<ProbeRecord>> {
+    let probes = Probes::new(ctx, (256, 256), Amounts::at(0.25))?;
+    measure_variants(ctx, &probes, 3, seed, &[Variant::Base])
+}
+
+/// The triangle ceiling of a run's ceilings: the larger of the two triangle probes' rates.
+pub fn triangle_ceiling(rows: &[ProbeRecord]) -> Option<f64> {
+    rows.iter()
+        .filter(|r| r.unit == "triangles" && r.rate_median.is_finite())
+        .map(|r| r.rate_median)
+        .reduce(f64::max)
+}
+
+fn measure_variants(
+    ctx: &GpuContext,
+    probes: &Probes,
+    rounds: u32,
+    seed: u64,
+    variants: &[Variant],
+) -> Result<Vec<ProbeRecord>> {
+    let items: Vec<(Probe, Variant)> = PROBES
+        .iter()
+        .flat_map(|&p| variants.iter().map(move |&v| (p, v)))
+        .collect();
+    let rounds = rounds.max(2);
+    let total = items.len() as u32 * rounds;
+    let timer = GpuTimer::new(ctx, total);
+    // Warm-up: every item once, untimed (pipelines compiled, buffers resident).
+    for &(p, v) in &items {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        probes.record(&mut encoder, p, v);
+        ctx.queue.submit([encoder.finish()]);
+        ctx.wait_idle()?;
+    }
+    // An empty submission's CPU time, per round: what the CPU clock adds to a probe's work.
+    let mut empty_ms = Vec::with_capacity(rounds as usize);
+    let mut rng = SplitMix64::new(seed ^ 0x0050_524F_4245);
+    // (round, item index) of each timed slot, and its CPU time.
+    let mut slots = Vec::with_capacity(total as usize);
+    let mut cpu_ms = Vec::with_capacity(total as usize);
+    for round in 0..rounds {
+        let t0 = Instant::now();
+        ctx.queue.submit([ctx
+            .device
+            .create_command_encoder(&Default::default())
+            .finish()]);
+        ctx.wait_idle()?;
+        empty_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+        let mut order: Vec<usize> = (0..items.len()).collect();
+        for i in (1..order.len()).rev() {
+            let j = (rng.next_u64() % (i as u64 + 1)) as usize;
+            order.swap(i, j);
+        }
+        for k in order {
+            let slot = slots.len() as u32;
+            let (p, v) = items[k];
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            if let Some(t) = &timer {
+                t.begin(&mut encoder, slot);
+            }
+            probes.record(&mut encoder, p, v);
+            if let Some(t) = &timer {
+                t.end(&mut encoder, slot);
+            }
+            let t0 = Instant::now();
+            ctx.queue.submit([encoder.finish()]);
+            ctx.wait_idle()?;
+            cpu_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+            slots.push((round, k));
+        }
+    }
+    let gpu_ms = match &timer {
+        Some(t) => t.read(ctx)?,
+        None => vec![None; slots.len()],
+    };
+    let stamped = gpu_ms.iter().all(|t| t.is_some_and(|t| t > 0.0));
+    let overhead = percentile(&empty_ms, 50.0).unwrap_or(0.0);
+    // time[item][round] on each clock; the CPU's less an empty submission's time.
+    let mut gpu = vec![vec![f64::NAN; rounds as usize]; items.len()];
+    let mut cpu = gpu.clone();
+    for ((&(round, k), g), &c) in slots.iter().zip(&gpu_ms).zip(&cpu_ms) {
+        gpu[k][round as usize] = g.unwrap_or(f64::NAN);
+        cpu[k][round as usize] = (c - overhead).max(1e-6);
+    }
+    let index = |p: Probe, v: Variant| items.iter().position(|&x| x == (p, v));
+    let none = vec![f64::NAN; rounds as usize];
+    Ok(PROBES
+        .iter()
+        .map(|&p| {
+            let k = index(p, Variant::Base).unwrap_or(0);
+            let gpu_median = percentile(&gpu[k], 50.0).unwrap_or(f64::NAN);
+            let cpu_median = percentile(&cpu[k], 50.0).unwrap_or(f64::NAN);
+            // The timestamps, unless they hold less than half of what the CPU waited for: then they missed the
+            // work (lavapipe's stamps do not wait for a compute dispatch), and the CPU's clock is read.
+            let use_gpu = stamped && gpu_median >= 0.5 * cpu_median;
+            let time = if use_gpu { &gpu } else { &cpu };
+            let base = &time[k];
+            let q = probes.quantity(p, Variant::Base);
+            let rates: Vec<f64> = base.iter().map(|t| q / (t / 1e3)).collect();
+            let (_, rate_ci) = geometric(&rates);
+            let of = |v| index(p, v).map_or(&none, |i| &time[i]);
+            let (doubled, doubled_ci) = paired(of(Variant::Doubled), base);
+            let (control, control_ci) = paired(of(Variant::Control), base);
+            ProbeRecord {
+                probe: p.name(),
+                unit: p.unit(),
+                quantity: q,
+                clock: if use_gpu { "gpu_ms" } else { "cpu_ms" },
+                rounds,
+                ms_median: percentile(base, 50.0).unwrap_or(f64::NAN),
+                gpu_ms_median: stamped.then_some(gpu_median),
+                cpu_ms_median: cpu_median,
+                rate_median: percentile(&rates, 50.0).unwrap_or(f64::NAN),
+                rate_ci95_lo: rate_ci.map(|c| c.0),
+                rate_ci95_hi: rate_ci.map(|c| c.1),
+                doubled_ratio: doubled,
+                doubled_ci95_lo: doubled_ci.map(|c| c.0),
+                doubled_ci95_hi: doubled_ci.map(|c| c.1),
+                control: p.control(),
+                control_ratio: control,
+                control_ci95_lo: control_ci.map(|c| c.0),
+                control_ci95_hi: control_ci.map(|c| c.1),
+                scales: (DOUBLED_RANGE.0..=DOUBLED_RANGE.1).contains(&doubled)
+                    && (CONTROL_RANGE.0..=CONTROL_RANGE.1).contains(&control),
+            }
+        })
+        .collect())
+}
+
+/// Geometric mean of positive values and its 95 % interval.
+fn geometric(values: &[f64]) -> (f64, Option<(f64, f64)>) {
+    if values.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        return (f64::NAN, None);
+    }
+    let logs: Vec<f64> = values.iter().map(|v| v.ln()).collect();
+    match paired_log_ratio(&logs) {
+        Some((m, ci)) => (m.exp(), ci.map(|(lo, hi)| (lo.exp(), hi.exp()))),
+        None => (f64::NAN, None),
+    }
+}
+
+/// `a`'s time over `b`'s, paired by round: geometric mean and its 95 % interval.
+fn paired(a: &[f64], b: &[f64]) -> (f64, Option<(f64, f64)>) {
+    let ratios: Vec<f64> = a.iter().zip(b).map(|(x, y)| x / y).collect();
+    geometric(&ratios)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paired_ratio_of_doubled_times_is_two() {
+        let b = [1.0, 1.2, 0.9, 1.1];
+        let a: Vec<f64> = b.iter().map(|x| x * 2.0).collect();
+        let (r, ci) = paired(&a, &b);
+        assert!((r - 2.0).abs() < 1e-12);
+        let (lo, hi) = ci.expect("an interval of 4 rounds");
+        assert!((lo - 2.0).abs() < 1e-9 && (hi - 2.0).abs() < 1e-9);
+    }
+}
