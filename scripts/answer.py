@@ -70,7 +70,7 @@ def summary_value(r, variables, col, fmt="sig3", op=""):
     row = {k: r[k] for k in (*variables, *KEY)}
     if fmt == "ratio":
         cols = (col, f"{col}_ci95_lo", f"{col}_ci95_hi")
-        return Value(ratio_text(num(r[cols[0]]), num(r.get(cols[1])), num(r.get(cols[2]))), "summary.csv", row,
+        return Value(ratio_text(num(r.get(cols[0])), num(r.get(cols[1])), num(r.get(cols[2]))), "summary.csv", row,
                      cols, fmt)
     x = num(r.get(col))
     if op == "half":
