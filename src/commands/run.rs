@@ -202,13 +202,31 @@ fn run_blocks(
         progress: progress_bar(total_frames(cfg, defs)),
         out_dir,
     };
+    let clock = match cfg.ceilings {
+        crate::effects::OnOff::On => Some(crate::measure::probe::ClockCheck::new(&job.ctx)?),
+        crate::effects::OnOff::Off => None,
+    };
     let mut block_index = 0u64;
     for def in defs {
         for &count in &def.counts {
             block_index += 1;
+            let first = manifest.blocks.len();
+            let before = clock
+                .as_ref()
+                .map(|c| c.triangle_rate(&job.ctx))
+                .transpose()?;
             job.run_block(def, count, block_index, manifest, &mut output)?;
+            let after = clock
+                .as_ref()
+                .map(|c| c.triangle_rate(&job.ctx))
+                .transpose()?;
+            for b in &mut manifest.blocks[first..] {
+                b.triangle_rate_before = before;
+                b.triangle_rate_after = after;
+            }
         }
     }
+    manifest.write(out_dir)?;
     job.progress.finish_and_clear();
     output.frames_csv.finish()?;
     let ceiling = manifest
@@ -473,6 +491,22 @@ pub fn summary_table(s: &RunSummary) -> String {
          '-' = not measured (no timestamps; --quality off: no image figures); full precision in summary.csv\n",
         baseline.as_deref().unwrap_or("the baseline (none run)")
     ));
+    let mut said = Vec::new();
+    for b in &s.blocks {
+        if let (Some(x), Some(y)) = (b.triangle_rate_before, b.triangle_rate_after) {
+            if crate::measure::probe::clock_changed(x, y) && !said.contains(&(&b.scene, b.count)) {
+                said.push((&b.scene, b.count));
+                out.push_str(&format!(
+                    "note: {} n={}: the adapter's triangle rate was {:.3} M/s before the block and {:.3} M/s \
+                     after it: the adapter changed speed during the block, and its times are suspect\n",
+                    b.scene,
+                    b.count,
+                    x / 1e6,
+                    y / 1e6
+                ));
+            }
+        }
+    }
     for b in &s.blocks {
         if let Some(limit) = &b.material_limits {
             out.push_str(&format!("note: {} {}: {limit}\n", b.scene, b.method));
@@ -501,6 +535,39 @@ mod tests {
             ratio_to_baseline_ci95_hi: Some(gpu_ms * 1.1),
             ..SummaryRecord::default()
         }
+    }
+
+    #[test]
+    fn a_block_the_adapter_slowed_in_is_noted_once() {
+        let block = |method: &str, before: f64, after: f64| BlockInfo {
+            scene: "terrain".into(),
+            method: method.into(),
+            count: 1,
+            triangle_rate_before: Some(before),
+            triangle_rate_after: Some(after),
+            ..BlockInfo::default()
+        };
+        let s = RunSummary {
+            out_dir: PathBuf::from("out"),
+            summaries: vec![record("terrain", "blocks", 1.0, 1000.0)],
+            pairs: Vec::new(),
+            blocks: vec![block("blocks", 10e6, 2.5e6), block("roam", 10e6, 2.5e6)],
+            budget_lodpop: None,
+        };
+        let text = summary_table(&s);
+        assert_eq!(
+            text.matches("changed speed during the block").count(),
+            1,
+            "{text}"
+        );
+        assert!(
+            text.contains("note: terrain n=1: the adapter's triangle rate was 10.000 M/s before")
+        );
+        let steady = RunSummary {
+            blocks: vec![block("blocks", 10e6, 9e6)],
+            ..s
+        };
+        assert!(!summary_table(&steady).contains("changed speed"));
     }
 
     #[test]

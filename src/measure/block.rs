@@ -360,6 +360,8 @@ impl<'a> BlockRunner<'a> {
             extra_target_bytes: timed.method.extra_target_bytes(),
             instance_bytes_listed_per_frame: timed.uploads.listed as f64 / frames,
             instance_bytes_written_per_frame: timed.uploads.written as f64 / frames,
+            triangle_rate_before: None,
+            triangle_rate_after: None,
         }
     }
 }

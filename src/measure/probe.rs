@@ -75,6 +75,56 @@ pub fn ceilings(ctx: &GpuContext, seed: u64) -> Result<Vec<ProbeRecord>> {
     measure_variants(ctx, &probes, 3, seed, &[Variant::Base])
 }
 
+/// The adapter's speed read around each block of a run: the triangle probe's base variant, 3 times, at a
+/// tenth of the default work on a 256 x 256 target (a few milliseconds on lavapipe, well under one on a GPU).
+/// A block whose rate after differs from its rate before by more than a fifth ran while the adapter changed
+/// speed (the H200's GPU clock dropping while ROAM's selection kept it idle): detected and said, not prevented.
+pub struct ClockCheck {
+    probes: Probes,
+}
+
+impl ClockCheck {
+    pub fn new(ctx: &GpuContext) -> Result<ClockCheck> {
+        Ok(ClockCheck {
+            probes: Probes::new(ctx, (256, 256), Amounts::at(0.1))?,
+        })
+    }
+
+    /// Triangles a second now: the median of 3 timings (timestamps where the adapter has them).
+    pub fn triangle_rate(&self, ctx: &GpuContext) -> Result<f64> {
+        let timer = GpuTimer::new(ctx, 3);
+        let mut cpu = Vec::new();
+        for slot in 0..3 {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            if let Some(t) = &timer {
+                t.begin(&mut encoder, slot);
+            }
+            self.probes
+                .record(&mut encoder, Probe::Triangles, Variant::Base);
+            if let Some(t) = &timer {
+                t.end(&mut encoder, slot);
+            }
+            let t0 = Instant::now();
+            ctx.queue.submit([encoder.finish()]);
+            ctx.wait_idle()?;
+            cpu.push(t0.elapsed().as_secs_f64() * 1e3);
+        }
+        let gpu: Vec<f64> = match &timer {
+            Some(t) => t.read(ctx)?.into_iter().flatten().collect(),
+            None => Vec::new(),
+        };
+        let ms = if gpu.len() == 3 { gpu } else { cpu };
+        let q = self.probes.quantity(Probe::Triangles, Variant::Base);
+        Ok(q / (percentile(&ms, 50.0).unwrap_or(f64::NAN) / 1e3))
+    }
+}
+
+/// Whether a block's rates before and after differ by more than a fifth.
+pub fn clock_changed(before: f64, after: f64) -> bool {
+    let (lo, hi) = (before.min(after), before.max(after));
+    lo.is_finite() && hi > 0.0 && lo / hi < 0.8
+}
+
 /// The triangle ceiling of a run's ceilings: the larger of the two triangle probes' rates.
 pub fn triangle_ceiling(rows: &[ProbeRecord]) -> Option<f64> {
     rows.iter()
@@ -220,6 +270,15 @@ fn paired(a: &[f64], b: &[f64]) -> (f64, Option<(f64, f64)>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_fifth_either_way_is_a_clock_change() {
+        assert!(!clock_changed(10.0, 8.5));
+        assert!(!clock_changed(8.5, 10.0));
+        assert!(clock_changed(10.0, 7.9));
+        assert!(clock_changed(2.0, 10.0));
+        assert!(!clock_changed(f64::NAN, 10.0));
+    }
 
     #[test]
     fn paired_ratio_of_doubled_times_is_two() {

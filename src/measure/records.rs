@@ -616,7 +616,7 @@ pub fn transitions(rows: &[FrameRecord], pairs: &[TransitionPair]) -> Vec<Transi
 }
 
 /// Per (scene, count, method) block: sizes and the cost of the two passes.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct BlockInfo {
     pub scene: String,
     pub method: String,
@@ -677,6 +677,11 @@ pub struct BlockInfo {
     /// GPU (only the entries that changed since the previous upload into the same buffer range).
     pub instance_bytes_listed_per_frame: f64,
     pub instance_bytes_written_per_frame: f64,
+    /// The adapter's triangle rate (a second) just before and just after the block
+    /// (`measure::probe::ClockCheck`; null with `--ceilings off`): where the two differ by more than a fifth,
+    /// the adapter changed speed during the block (a GPU's clock), and its times are suspect.
+    pub triangle_rate_before: Option<f64>,
+    pub triangle_rate_after: Option<f64>,
 }
 
 /// The timing rounds of one scene block, as run.json records them (`timing_rounds`).

@@ -91,3 +91,37 @@ fn bad_probe_flags_are_one_error() {
         &["--width 0"],
     );
 }
+
+/// Every run records the ceilings before its blocks and the triangle rate around each block in run.json, and
+/// summary.csv's rate against the ceiling; `--ceilings off` leaves all of them null.
+#[test]
+fn runs_record_the_ceilings_and_the_rate_around_each_block() {
+    let dir = tempfile::tempdir().unwrap();
+    for (flag, on) in [("on", true), ("off", false)] {
+        let out = dir.path().join(flag);
+        #[rustfmt::skip]
+        let r = lodbench(&[
+            "run", "--scene", "bunny-sweep", "--method", "discrete", "--width", "64", "--height", "48",
+            "--frames", "8", "--warmup", "0", "--rounds", "2", "--quality", "off", "--ceilings", flag,
+            "--out", out.to_str().unwrap(),
+        ], &[]);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let run: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+        let block = &run["blocks"][0];
+        assert_eq!(run["ceilings"].is_array(), on, "{}", run["ceilings"]);
+        for key in ["triangle_rate_before", "triangle_rate_after"] {
+            assert_eq!(
+                block[key].as_f64().is_some_and(|x| x > 0.0),
+                on,
+                "{key}: {}",
+                block[key]
+            );
+        }
+        let mut summary = csv::Reader::from_path(out.join("summary.csv")).unwrap();
+        let header = summary.headers().unwrap().clone();
+        let row = summary.records().next().unwrap().unwrap();
+        let share = &row[column(&header, "triangle_ceiling_share")];
+        assert_eq!(share.parse::<f64>().is_ok_and(|x| x > 0.0), on, "{share:?}");
+    }
+}
