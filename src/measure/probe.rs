@@ -44,13 +44,16 @@ pub struct ProbeRecord {
     pub rate_median: f64,
     pub rate_ci95_lo: Option<f64>,
     pub rate_ci95_hi: Option<f64>,
-    /// The doubled variant's time over the base's, paired by round.
+    /// The doubled variant's time over the base's, paired by round: the geometric mean with its interval, and
+    /// the median over rounds (what a round disturbed by other work moves least).
     pub doubled_ratio: f64,
+    pub doubled_ratio_median: f64,
     pub doubled_ci95_lo: Option<f64>,
     pub doubled_ci95_hi: Option<f64>,
     /// What the control changes, and its time over the base's.
     pub control: &'static str,
     pub control_ratio: f64,
+    pub control_ratio_median: f64,
     pub control_ci95_lo: Option<f64>,
     pub control_ci95_hi: Option<f64>,
     /// Doubling within DOUBLED_RANGE and the control within CONTROL_RANGE.
@@ -223,6 +226,10 @@ fn measure_variants(
             let of = |v| index(p, v).map_or(&none, |i| &time[i]);
             let (doubled, doubled_ci) = paired(of(Variant::Doubled), base);
             let (control, control_ci) = paired(of(Variant::Control), base);
+            let median_ratio = |a: &[f64]| {
+                let r: Vec<f64> = a.iter().zip(base).map(|(x, y)| x / y).collect();
+                percentile(&r, 50.0).unwrap_or(f64::NAN)
+            };
             ProbeRecord {
                 probe: p.name(),
                 unit: p.unit(),
@@ -236,10 +243,12 @@ fn measure_variants(
                 rate_ci95_lo: rate_ci.map(|c| c.0),
                 rate_ci95_hi: rate_ci.map(|c| c.1),
                 doubled_ratio: doubled,
+                doubled_ratio_median: median_ratio(of(Variant::Doubled)),
                 doubled_ci95_lo: doubled_ci.map(|c| c.0),
                 doubled_ci95_hi: doubled_ci.map(|c| c.1),
                 control: p.control(),
                 control_ratio: control,
+                control_ratio_median: median_ratio(of(Variant::Control)),
                 control_ci95_lo: control_ci.map(|c| c.0),
                 control_ci95_hi: control_ci.map(|c| c.1),
                 scales: (DOUBLED_RANGE.0..=DOUBLED_RANGE.1).contains(&doubled)
