@@ -170,6 +170,14 @@ def sentences(name, rows, pairs, budget, variables):
     # Least lodpop as the sentence shows it (3 figures), the cheaper of a tie.
     least = min(cands, key=lambda r: (float(sig3(num(r["lodpop_max"]))), cost(r), num(r["lodpop_max"])))
     out = []
+    if len(cands) == 1:
+        # Nothing to compare its popping with: say what it is, and a budget's verdict only where one was given.
+        out.append([f"{name}: {least['method']} is the only method with LOD transitions in the run, a largest "
+                    "lodpop of ", summary_value(least, variables, "lodpop_max"), "; "]
+                   + cost_clause(least, baseline, variables) + ["."])
+        if budget is None:
+            return out
+        return out + within_budget(cands, least, budget, None, pairs, baseline, variables)
     s = [f"{name}: {least['method']} pops least, a largest lodpop of ",
          summary_value(least, variables, "lodpop_max")]
     # Methods whose largest lodpop reads the same to 3 figures pop as little as far as the sentence can say.
@@ -180,6 +188,15 @@ def sentences(name, rows, pairs, budget, variables):
     if hard is not None and hard["method"] != least["method"]:
         s += [f" against {hard['method']}'s ", summary_value(hard, variables, "lodpop_max")]
     out.append(s + ["; "] + cost_clause(least, baseline, variables) + ["."])
+    return out + within_budget(cands, least, budget, hard, pairs, baseline, variables)
+
+
+def within_budget(cands, least, budget, hard, pairs, baseline, variables):
+    """The cheapest-within-the-budget sentence (none without a budget or a hard switch to halve)."""
+    def cost(r):
+        x = num(r.get("ratio_to_baseline"))
+        return x if x == x else float("inf")
+
     if budget is not None:
         b, source = Value(sig3(budget), "run.json", {}, ("budget_lodpop",), "sig3"), "--budget-lodpop"
         level = budget
@@ -187,18 +204,16 @@ def sentences(name, rows, pairs, budget, variables):
         b = summary_value(hard, variables, "lodpop_max", op="half")
         source, level = f"half of {hard['method']}'s", num(hard["lodpop_max"]) / 2
     else:
-        return out
+        return []
     within = sorted((r for r in cands if num(r["lodpop_max"]) <= level and
                      num(r.get("ratio_to_baseline")) == num(r.get("ratio_to_baseline"))), key=cost)
     if not within:
-        out.append(["No method keeps its largest lodpop within ", b, f" ({source}); {least['method']} comes nearest."])
-        return out
+        return [["No method keeps its largest lodpop within ", b, f" ({source}); {least['method']} comes nearest."]]
     best = within[0]
     s = ["Within a largest lodpop of ", b, f" ({source}), {best['method']} is the cheapest: "] + \
         cost_clause(best, baseline, variables) + ["."]
     s += [" No other method is within it."] if len(within) == 1 else versus(best, within[1], pairs, variables)
-    out.append(s)
-    return out
+    return [s]
 
 
 def text(parts) -> str:

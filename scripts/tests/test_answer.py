@@ -161,3 +161,14 @@ def test_a_wrong_number_is_caught(answered, tmp_path):
         w.writerows(rows)
     with pytest.raises(AssertionError):
         check_numbers(copy)
+
+
+def test_a_lone_method_is_not_said_to_pop_least():
+    """The case of answer.rs's a_lone_method_is_not_said_to_pop_least, word for word."""
+    rows = [row("reference", 0.0, 2.0, 1.8, 2.2), row("discrete", 0.004, 1.0, 1.0, 1.0)]
+    (_, _, _, said), = answer.answers(rows, [], None)
+    assert [answer.text(s) for s in said] == [
+        "s: discrete is the only method with LOD transitions in the run, a largest lodpop of 0.00400; it is the "
+        "baseline (discrete)."]
+    (_, _, _, said), = answer.answers(rows, [], 0.005)
+    assert len(said) == 2

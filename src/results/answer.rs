@@ -168,12 +168,25 @@ fn block_sentences(
     } else {
         format!(" ({} too, to 3 figures)", and_list(&ties))
     };
-    out.push(format!(
-        "{name}: {} pops least, a largest lodpop of {}{ties}{against}; {}.",
-        least.method,
-        sig3(least.lodpop_max),
-        cost_clause(least, &baseline)
-    ));
+    if candidates.len() == 1 {
+        // Nothing to compare its popping with: say what it is, and a budget's verdict only where one was given.
+        out.push(format!(
+            "{name}: {} is the only method with LOD transitions in the run, a largest lodpop of {}; {}.",
+            least.method,
+            sig3(least.lodpop_max),
+            cost_clause(least, &baseline)
+        ));
+        if budget.is_none() {
+            return out;
+        }
+    } else {
+        out.push(format!(
+            "{name}: {} pops least, a largest lodpop of {}{ties}{against}; {}.",
+            least.method,
+            sig3(least.lodpop_max),
+            cost_clause(least, &baseline)
+        ));
+    }
     let budget = match (budget, hard) {
         (Some(b), _) => Some((b, "--budget-lodpop".to_string())),
         (None, Some(h)) => h
@@ -471,6 +484,21 @@ mod tests {
             ),
             "{a:?}"
         );
+    }
+
+    #[test]
+    fn a_lone_method_is_not_said_to_pop_least() {
+        let rows = vec![
+            row("s", "reference", 0.0, (2.0, 1.8, 2.2)),
+            row("s", "discrete", 0.004, (1.0, 1.0, 1.0)),
+        ];
+        let a = &answers(&rows, &[], None)[0].sentences;
+        assert_eq!(
+            a,
+            &["s: discrete is the only method with LOD transitions in the run, a largest lodpop of 0.00400; it \
+               is the baseline (discrete)."]
+        );
+        assert_eq!(answers(&rows, &[], Some(0.005))[0].sentences.len(), 2);
     }
 
     #[test]
