@@ -71,15 +71,15 @@ pub fn measure(
 }
 
 /// The ceilings every run records in run.json before its blocks: each probe's base variant alone (no scaling
-/// check: that is `lodbench probe`'s), at a quarter of the default work on a 256 x 256 target, 3 rounds; a
-/// fraction of a second on lavapipe.
-pub fn ceilings(ctx: &GpuContext, seed: u64) -> Result<Vec<ProbeRecord>> {
-    let probes = Probes::new(ctx, (256, 256), Amounts::at(0.25))?;
-    measure_variants(ctx, &probes, 3, seed, &[Variant::Base])
+/// check: that is `lodbench probe`'s), on `clock`'s probes (a tenth of the default work on a 256 x 256 target),
+/// 3 rounds; a tenth of a second on lavapipe.
+pub fn ceilings(ctx: &GpuContext, clock: &ClockCheck, seed: u64) -> Result<Vec<ProbeRecord>> {
+    measure_variants(ctx, &clock.probes, 3, seed, &[Variant::Base])
 }
 
-/// The adapter's speed read around each block of a run: the triangle probe's base variant, 3 times, at a
-/// tenth of the default work on a 256 x 256 target (a few milliseconds on lavapipe, well under one on a GPU).
+/// The probes a run reads the adapter with: its ceilings before the blocks ([`ceilings`]) and its speed around
+/// each block, the triangle probe's base variant 3 times, at a tenth of the default work on a 256 x 256 target (a
+/// few milliseconds on lavapipe, well under one on a GPU).
 /// A block whose rate after differs from its rate before by more than a fifth ran while the adapter changed
 /// speed (the H200's GPU clock dropping while ROAM's selection kept it idle): detected and said, not prevented.
 pub struct ClockCheck {
@@ -93,11 +93,18 @@ impl ClockCheck {
         })
     }
 
-    /// Triangles a second now: the median of 3 timings (timestamps where the adapter has them).
+    /// Triangles a second now: one untimed submission (after a block, the probe's first reading was slower
+    /// by up to 44 % on lavapipe with nothing else changed: caches, not clocks), then the median of 5 timings
+    /// (timestamps where the adapter has them).
     pub fn triangle_rate(&self, ctx: &GpuContext) -> Result<f64> {
-        let timer = GpuTimer::new(ctx, 3);
+        let mut warm = ctx.device.create_command_encoder(&Default::default());
+        self.probes
+            .record(&mut warm, Probe::Triangles, Variant::Base);
+        ctx.queue.submit([warm.finish()]);
+        ctx.wait_idle()?;
+        let timer = GpuTimer::new(ctx, 5);
         let mut cpu = Vec::new();
-        for slot in 0..3 {
+        for slot in 0..5 {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             if let Some(t) = &timer {
                 t.begin(&mut encoder, slot);
@@ -116,7 +123,7 @@ impl ClockCheck {
             Some(t) => t.read(ctx)?.into_iter().flatten().collect(),
             None => Vec::new(),
         };
-        let ms = if gpu.len() == 3 { gpu } else { cpu };
+        let ms = if gpu.len() == 5 { gpu } else { cpu };
         let q = self.probes.quantity(Probe::Triangles, Variant::Base);
         Ok(q / (percentile(&ms, 50.0).unwrap_or(f64::NAN) / 1e3))
     }
