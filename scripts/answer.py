@@ -83,6 +83,19 @@ def is_candidate(method: str) -> bool:
     return not re.sub(r"#\d+$", "", method).startswith("reference")
 
 
+def cost(r):
+    """A row's time over the baseline's, all frames (infinite where not measured, so it sorts last)."""
+    x = num(r.get("ratio_to_baseline"))
+    return x if x == x else float("inf")
+
+
+def hard_switch(rows, baseline):
+    """The hard switch the least popping is set against and the default budget halves: discrete where it ran,
+    else the baseline; None where neither is among `rows`."""
+    return next((r for r in rows if r["method"] == "discrete"), None) or \
+        next((r for r in rows if r["method"] == baseline), None)
+
+
 def blocks(summary, variables):
     """[(key, rows)]: summary rows grouped by run (swept values), scene and count, in their order."""
     out = {}
@@ -161,12 +174,7 @@ def sentences(name, rows, pairs, budget, variables):
     if not cands:
         return [[f"{name}: no popping measured (--quality off, or no method with LOD transitions ran)."]]
 
-    def cost(r):
-        x = num(r.get("ratio_to_baseline"))
-        return x if x == x else float("inf")
-
-    hard = next((r for r in cands if r["method"] == "discrete"), None) or \
-        next((r for r in cands if r["method"] == baseline), None)
+    hard = hard_switch(cands, baseline)
     # Least lodpop as the sentence shows it (3 figures), the cheaper of a tie.
     least = min(cands, key=lambda r: (float(sig3(num(r["lodpop_max"]))), cost(r), num(r["lodpop_max"])))
     out = []
@@ -193,10 +201,6 @@ def sentences(name, rows, pairs, budget, variables):
 
 def within_budget(cands, least, budget, hard, pairs, baseline, variables):
     """The cheapest-within-the-budget sentence (none without a budget or a hard switch to halve)."""
-    def cost(r):
-        x = num(r.get("ratio_to_baseline"))
-        return x if x == x else float("inf")
-
     if budget is not None:
         b, source = Value(sig3(budget), "run.json", {}, ("budget_lodpop",), "sig3"), "--budget-lodpop"
         level = budget

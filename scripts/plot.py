@@ -726,8 +726,7 @@ def decision_figure(scene, rows, budget, path):
     """Each method's cost (time over the baseline's, all frames, with its 95 % interval) against its largest
     lodpop, the budget of the answer drawn across: the answer's two sentences at a glance."""
     fig, ax = plt.subplots(figsize=(9, 4.4))
-    hard = next((r for r in rows if r["method"] == "discrete"), None) or \
-        next((r for r in rows if r["method"] == r.get("baseline")), None)
+    hard = answer.hard_switch(rows, next((r["baseline"] for r in rows if r.get("baseline")), None))
     level = budget if budget is not None else (num(hard["lodpop_max"]) / 2 if hard else None)
     for i, r in enumerate(rows):
         x, lo, hi, y = (num(r.get(c)) for c in ("ratio_to_baseline", "ratio_to_baseline_ci95_lo",

@@ -8,8 +8,8 @@ use crate::gpu::probe::{Amounts, Probes};
 use crate::gpu::GpuContext;
 use crate::measure::probe::{measure, ProbeRecord, CONTROL_RANGE, DOUBLED_RANGE};
 use crate::results::answer::{aligned, ratio, sig3};
+use crate::results::csv::write_whole;
 use serde::Serialize;
-use std::path::Path;
 
 /// What probe.json holds.
 #[derive(Serialize)]
@@ -54,7 +54,7 @@ pub fn execute(args: &ProbeArgs) -> Result<()> {
     let ctx = GpuContext::new(args.adapter.as_deref())?;
     let probes = Probes::new(&ctx, (args.width, args.height), Amounts::at(args.scale))?;
     let rows = measure(&ctx, &probes, args.rounds, args.seed)?;
-    write_csv(&out.join("probe.csv"), &rows)?;
+    write_whole(&out, "probe.csv", &rows)?;
     let manifest = ProbeManifest {
         lodbench_version: env!("CARGO_PKG_VERSION"),
         git_commit: env!("LODBENCH_GIT_COMMIT"),
@@ -137,16 +137,4 @@ fn giga(x: f64) -> String {
         (x, "")
     };
     format!("{} {p}", sig3(Some(v))).trim_end().to_string()
-}
-
-fn write_csv<T: Serialize>(path: &Path, rows: &[T]) -> Result<()> {
-    let err = |e: String| Error::Output {
-        path: path.to_path_buf(),
-        problem: e,
-    };
-    let mut w = ::csv::Writer::from_path(path).map_err(|e| err(e.to_string()))?;
-    for r in rows {
-        w.serialize(r).map_err(|e| err(e.to_string()))?;
-    }
-    w.flush().map_err(|e| err(e.to_string()))
 }

@@ -12,6 +12,7 @@ use crate::measure::engine_rules::RULES;
 use crate::measure::tune::{
     tune_model, view_directions, Budget, ModelCamera, ModelSwitches, Sample, TuneSettings,
 };
+use crate::results::csv::write_whole;
 use crate::results::engines::{self, EngineModel};
 use crate::scene::{SceneConfig, SceneDef, SceneKind};
 use glam::Quat;
@@ -237,22 +238,7 @@ fn write(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 fn write_samples(out: &Path, samples: &[Sample]) -> Result<()> {
-    write_csv(&out.join("tune.csv"), samples)
-}
-
-/// A CSV of `rows`, whole or an error naming the file.
-fn write_csv<T: Serialize>(path: &Path, rows: &[T]) -> Result<()> {
-    let mut w = ::csv::Writer::from_path(path).map_err(|e| Error::Output {
-        path: path.to_path_buf(),
-        problem: e.to_string(),
-    })?;
-    for r in rows {
-        w.serialize(r).map_err(|e| Error::Output {
-            path: path.to_path_buf(),
-            problem: e.to_string(),
-        })?;
-    }
-    w.flush().map_err(|e| Error::io(path, e))
+    write_whole(out, "tune.csv", samples).map(|_| ())
 }
 
 /// One row of rules.csv.
@@ -298,7 +284,7 @@ fn write_rules(out: &Path, models: &[ModelSwitches]) -> Result<()> {
             }
         }
     }
-    write_csv(&out.join("rules.csv"), &rows)
+    write_whole(out, "rules.csv", &rows).map(|_| ())
 }
 
 /// The cross-fading engines' files with blending methods' bands: `dithered` for Unity and Bevy, `blended` for

@@ -97,28 +97,12 @@ impl ClockCheck {
     /// by up to 44 % on lavapipe with nothing else changed: caches, not clocks), then the median of 5 timings
     /// (timestamps where the adapter has them).
     pub fn triangle_rate(&self, ctx: &GpuContext) -> Result<f64> {
-        let mut warm = ctx.device.create_command_encoder(&Default::default());
-        self.probes
-            .record(&mut warm, Probe::Triangles, Variant::Base);
-        ctx.queue.submit([warm.finish()]);
-        ctx.wait_idle()?;
+        let item = (Probe::Triangles, Variant::Base);
+        submit(ctx, &self.probes, item, None)?;
         let timer = GpuTimer::new(ctx, 5);
-        let mut cpu = Vec::new();
-        for slot in 0..5 {
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            if let Some(t) = &timer {
-                t.begin(&mut encoder, slot);
-            }
-            self.probes
-                .record(&mut encoder, Probe::Triangles, Variant::Base);
-            if let Some(t) = &timer {
-                t.end(&mut encoder, slot);
-            }
-            let t0 = Instant::now();
-            ctx.queue.submit([encoder.finish()]);
-            ctx.wait_idle()?;
-            cpu.push(t0.elapsed().as_secs_f64() * 1e3);
-        }
+        let cpu = (0..5)
+            .map(|slot| submit(ctx, &self.probes, item, timer.as_ref().map(|t| (t, slot))))
+            .collect::<Result<Vec<f64>>>()?;
         let gpu: Vec<f64> = match &timer {
             Some(t) => t.read(ctx)?.into_iter().flatten().collect(),
             None => Vec::new(),
@@ -158,11 +142,8 @@ fn measure_variants(
     let total = items.len() as u32 * rounds;
     let timer = GpuTimer::new(ctx, total);
     // Warm-up: every item once, untimed (pipelines compiled, buffers resident).
-    for &(p, v) in &items {
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        probes.record(&mut encoder, p, v);
-        ctx.queue.submit([encoder.finish()]);
-        ctx.wait_idle()?;
+    for &item in &items {
+        submit(ctx, probes, item, None)?;
     }
     // An empty submission's CPU time, per round: what the CPU clock adds to a probe's work.
     let mut empty_ms = Vec::with_capacity(rounds as usize);
@@ -185,19 +166,12 @@ fn measure_variants(
         }
         for k in order {
             let slot = slots.len() as u32;
-            let (p, v) = items[k];
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            if let Some(t) = &timer {
-                t.begin(&mut encoder, slot);
-            }
-            probes.record(&mut encoder, p, v);
-            if let Some(t) = &timer {
-                t.end(&mut encoder, slot);
-            }
-            let t0 = Instant::now();
-            ctx.queue.submit([encoder.finish()]);
-            ctx.wait_idle()?;
-            cpu_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+            cpu_ms.push(submit(
+                ctx,
+                probes,
+                items[k],
+                timer.as_ref().map(|t| (t, slot)),
+            )?);
             slots.push((round, k));
         }
     }
@@ -263,6 +237,28 @@ fn measure_variants(
             }
         })
         .collect())
+}
+
+/// Records `item` in an encoder of its own (bracketed by `timed`'s timestamps at its slot, where given),
+/// submits it and waits for the device: the CPU's milliseconds from the submission to idle.
+fn submit(
+    ctx: &GpuContext,
+    probes: &Probes,
+    (probe, variant): (Probe, Variant),
+    timed: Option<(&GpuTimer, u32)>,
+) -> Result<f64> {
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    if let Some((t, slot)) = timed {
+        t.begin(&mut encoder, slot);
+    }
+    probes.record(&mut encoder, probe, variant);
+    if let Some((t, slot)) = timed {
+        t.end(&mut encoder, slot);
+    }
+    let t0 = Instant::now();
+    ctx.queue.submit([encoder.finish()]);
+    ctx.wait_idle()?;
+    Ok(t0.elapsed().as_secs_f64() * 1e3)
 }
 
 /// Geometric mean of positive values and its 95 % interval.

@@ -51,7 +51,7 @@ impl FramesWriter {
 }
 
 /// Writes `rows` to `name` in `dir` through a temporary file, so it appears whole or not at all.
-fn write_whole<T: serde::Serialize>(dir: &Path, name: &str, rows: &[T]) -> Result<PathBuf> {
+pub fn write_whole<T: serde::Serialize>(dir: &Path, name: &str, rows: &[T]) -> Result<PathBuf> {
     let path = dir.join(name);
     let tmp = dir.join(partial(name));
     {
