@@ -18,13 +18,14 @@ Usage:
     python3 scripts/aa_check.py DIR [DIR ...] [--resamples 2000] [--seed 1]
 """
 import argparse
-import csv
 import math
 import sys
 from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
+
+from lodbench_results import FRAMES_CSV, ROUNDS_CSV, SUMMARY_CSV, read_csv
 
 # Student's t quantile 0.975 (as src/measure/stats.rs).
 T975 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145, 2.131,
@@ -59,11 +60,6 @@ def median_interval(values, rng, resamples):
     return np.percentile(medians, 2.5), np.percentile(medians, 97.5)
 
 
-def read(path: Path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
-
-
 def block_key(row):
     return tuple(row.get(k, "") for k in ("seed", "viewport", "scene", "count"))
 
@@ -72,10 +68,10 @@ def check(folder: Path, resamples: int, seed: int):
     """Per A/A block of `folder`: (key, method, ratio, t interval, bootstrap interval, frame-rule different).
     Raises ValueError when summary.csv's interval is not the one rounds.csv gives."""
     rng = np.random.default_rng(seed)
-    summary = read(folder / "summary.csv")
-    rounds = read(folder / "rounds.csv")
+    summary = read_csv(folder / SUMMARY_CSV)
+    rounds = read_csv(folder / ROUNDS_CSV)
     # frames.csv is optional (committed results leave it out for size): without it the frame rule is not computed.
-    frames = read(folder / "frames.csv") if (folder / "frames.csv").is_file() else []
+    frames = read_csv(folder / FRAMES_CSV) if (folder / FRAMES_CSV).is_file() else []
     per_round = defaultdict(list)
     for r in rounds:
         if r["ratio_to_baseline"]:
@@ -121,7 +117,7 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|---|---|")
     pooled = []
     for folder in args.dirs:
-        for name in ("summary.csv", "rounds.csv"):
+        for name in (SUMMARY_CSV, ROUNDS_CSV):
             if not (folder / name).is_file():
                 print(f"error: {folder / name} is missing", file=sys.stderr)
                 return 2

@@ -19,15 +19,10 @@ data- attributes for the browser test to check against the CSVs.
 import math
 import re
 
+from lodbench_results import PAIRS_CSV, RUN_JSON, SUMMARY_CSV, num
+
 # summary.csv's columns that name a row besides the swept variables (and a merged folder's adapter).
 KEY = ("scene", "method", "count")
-
-
-def num(v):
-    try:
-        return float(v)
-    except (TypeError, ValueError):
-        return float("nan")
 
 
 def sig3(x) -> str:
@@ -70,13 +65,13 @@ def summary_value(r, variables, col, fmt="sig3", op=""):
     row = {k: r[k] for k in (*variables, *KEY)}
     if fmt == "ratio":
         cols = (col, f"{col}_ci95_lo", f"{col}_ci95_hi")
-        return Value(ratio_text(num(r.get(cols[0])), num(r.get(cols[1])), num(r.get(cols[2]))), "summary.csv", row,
+        return Value(ratio_text(num(r.get(cols[0])), num(r.get(cols[1])), num(r.get(cols[2]))), SUMMARY_CSV, row,
                      cols, fmt)
     x = num(r.get(col))
     if op == "half":
         x = x / 2
     text = thousands(x) if fmt == "thousands" else sig3(x)
-    return Value(text, "summary.csv", row, (col,), fmt, op)
+    return Value(text, SUMMARY_CSV, row, (col,), fmt, op)
 
 
 def is_candidate(method: str) -> bool:
@@ -156,9 +151,9 @@ def versus(best, nxt, pairs, variables):
     r, lo, hi, row, cols, op = found
     # best's time over next's; "faster" in hyperfine's words is its inverse.
     if hi < 1:
-        v = Value(ratio_text(1 / r, 1 / hi, 1 / lo), "pairs.csv", row, cols, "ratio", "" if op else "inv")
+        v = Value(ratio_text(1 / r, 1 / hi, 1 / lo), PAIRS_CSV, row, cols, "ratio", "" if op else "inv")
         return [f" {best['method']} ran ", v, f" times faster than {nxt['method']}, the next within it."]
-    v = Value(ratio_text(r, lo, hi), "pairs.csv", row, cols, "ratio", op)
+    v = Value(ratio_text(r, lo, hi), PAIRS_CSV, row, cols, "ratio", op)
     if lo > 1:
         return [f" Paired directly, {nxt['method']} ran ", v, f" times faster than {best['method']}."]
     return [f" It is not measurably different from {nxt['method']}, the next within it (", v,
@@ -202,7 +197,7 @@ def sentences(name, rows, pairs, budget, variables):
 def within_budget(cands, least, budget, hard, pairs, baseline, variables):
     """The cheapest-within-the-budget sentence (none without a budget or a hard switch to halve)."""
     if budget is not None:
-        b, source = Value(sig3(budget), "run.json", {}, ("budget_lodpop",), "sig3"), "--budget-lodpop"
+        b, source = Value(sig3(budget), RUN_JSON, {}, ("budget_lodpop",), "sig3"), "--budget-lodpop"
         level = budget
     elif hard is not None:
         b = summary_value(hard, variables, "lodpop_max", op="half")

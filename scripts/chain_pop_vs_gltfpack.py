@@ -28,6 +28,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from lodbench_results import TRANSITIONS_CSV, read_csv
+
 METHODS = "discrete,dither"
 FRAMES = "600"
 
@@ -95,8 +97,7 @@ def chain_file(tools: Path, src: Path, fractions, work: Path) -> Path:
 def transitions(lodbench, scene: Path, switches, out: Path):
     run([lodbench, "run", "--scene", scene, "--method", METHODS, "--frames", FRAMES, "--animation", "none",
          "--switch-distances", ",".join(f"{d:.6g}" for d in switches), "--out", out])
-    with open(out / "transitions.csv") as fh:
-        return list(csv.DictReader(fh))
+    return read_csv(out / TRANSITIONS_CSV)
 
 
 def main() -> int:

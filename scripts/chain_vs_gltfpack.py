@@ -20,7 +20,6 @@ import base64
 import csv
 import json
 import shlex
-import struct
 import subprocess
 import sys
 import tempfile

@@ -13,7 +13,6 @@ frame; 2 when the folder cannot be checked.
     python3 scripts/check_colour.py RESULTS_DIR [--rmse-tol 1e-4] [--de2000-tol 1e-3]
 """
 import argparse
-import csv
 import sys
 import warnings
 from pathlib import Path
@@ -21,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from dumps import load_rgb, parse_stem
+from lodbench_results import FRAMES_CSV, frames_by_key
 
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")  # colour-science warns about optional packages it does not need here
@@ -47,12 +47,11 @@ def main() -> int:
     ap.add_argument("--de2000-tol", type=float, default=1e-3)
     args = ap.parse_args()
 
-    frames_csv = args.results / "frames.csv"
+    frames_csv = args.results / FRAMES_CSV
     if not frames_csv.is_file():
         print(f"error: {frames_csv} not found (is this a complete lodbench run?)", file=sys.stderr)
         return 2
-    with open(frames_csv, newline="") as f:
-        rows = {(r["scene"], r["method"], r["count"], r["frame"]): r for r in csv.DictReader(f)}
+    rows = frames_by_key(frames_csv)
     dumps = sorted((args.results / "frames").glob("*_method.png"))
     if not dumps:
         print(f"error: no *_method.png under {args.results / 'frames'} (run with --dump-frames)", file=sys.stderr)

@@ -28,6 +28,8 @@ import sys
 from collections import OrderedDict
 from pathlib import Path
 
+from lodbench_results import FRAMES_CSV, SUMMARY_CSV, num, read_csv, run_folder_of
+
 COLUMNS = (
     ("triangles", "triangles_mean"),
     ("cost", "ratio_to_baseline"),
@@ -36,13 +38,6 @@ COLUMNS = (
     ("crack_px_max", "crack_px_max"),
     ("variable", None),
 )
-
-
-def num(v):
-    try:
-        return float(v)
-    except (TypeError, ValueError):
-        return float("nan")
 
 
 def cpu_ratios(frames_csv: Path):
@@ -54,13 +49,11 @@ def cpu_ratios(frames_csv: Path):
         return {}
     from aa_check import t_interval
 
-    with open(frames_csv.parent / "summary.csv", newline="") as f:
-        baseline = {(r["scene"], r["count"]): r.get("baseline") for r in csv.DictReader(f)}
+    baseline = {(r["scene"], r["count"]): r.get("baseline") for r in read_csv(frames_csv.parent / SUMMARY_CSV)}
     times = {}
-    with open(frames_csv, newline="") as f:
-        for r in csv.DictReader(f):
-            key = (r["scene"], r["count"], r["method"], r["round"])
-            times.setdefault(key, []).append(float(r["cpu_ms"]))
+    for r in read_csv(frames_csv):
+        key = (r["scene"], r["count"], r["method"], r["round"])
+        times.setdefault(key, []).append(float(r["cpu_ms"]))
     med = {k: sorted(v)[len(v) // 2] if len(v) % 2 else sum(sorted(v)[len(v) // 2 - 1: len(v) // 2 + 1]) / 2
            for k, v in times.items()}
     logs = {}
@@ -82,7 +75,7 @@ def curves(rows, variable, folder=None):
             continue
         run = r[variable]
         if folder is not None and run not in cpu:
-            cpu[run] = cpu_ratios(folder / "runs" / f"{variable}={run}" / "frames.csv")
+            cpu[run] = cpu_ratios(run_folder_of(folder, [variable], [run]) / FRAMES_CSV)
         p = {"rmse": num(r["rmse_mean"]), "variable": num(r[variable])}
         p["cpu_cost"] = cpu.get(run, {}).get((r["scene"], r["method"]), float("nan"))
         for name, col in COLUMNS:
@@ -138,8 +131,8 @@ def table(scene, methods, levels, variable):
                 lines.append(f"| {level:.5f} | {m} | - | - | - | - | - | - |")
             else:
                 lines.append(
-                    f"| {level:.5f} | {m} | {v['variable']:.2f} | {v['triangles']:,.0f} | {v['cost']:.3f} | {v['cpu_cost']:.3f} | "
-                    f"{v['lodpop_max']:.5f} | {v['crack_px_max']:.0f} |"
+                    f"| {level:.5f} | {m} | {v['variable']:.2f} | {v['triangles']:,.0f} | {v['cost']:.3f} | "
+                    f"{v['cpu_cost']:.3f} | {v['lodpop_max']:.5f} | {v['crack_px_max']:.0f} |"
                 )
     return lines, rows
 
@@ -179,11 +172,10 @@ def main(argv=None):
     ap.add_argument("--out", help="folder for equal_error.csv and .png (default: RESULTS)")
     a = ap.parse_args(argv)
     folder = Path(a.results)
-    summary = folder / "summary.csv"
+    summary = folder / SUMMARY_CSV
     if not summary.is_file():
         sys.exit(f"error: {summary} not found: give the folder `lodbench experiment` wrote")
-    with open(summary, newline="") as f:
-        rows = list(csv.DictReader(f))
+    rows = read_csv(summary)
     # The swept variables are the columns before `scene` (lodbench experiment writes them first).
     header = list(rows[0].keys()) if rows else []
     variables = header[: header.index("scene")] if "scene" in header else []
@@ -211,7 +203,8 @@ def main(argv=None):
             else:
                 w.writerow(
                     [scene, f"{level:.6g}", m]
-                    + [f"{v[k]:.6g}" for k in ("variable", "triangles", "cost", "cpu_cost", "lodpop_max", "crack_px_max")]
+                    + [f"{v[k]:.6g}"
+                       for k in ("variable", "triangles", "cost", "cpu_cost", "lodpop_max", "crack_px_max")]
                 )
     figure(scene_curves, out_dir / "equal_error.png")
     print(f"wrote {out_dir / 'equal_error.csv'} and {out_dir / 'equal_error.png'}")

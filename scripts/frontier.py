@@ -14,21 +14,15 @@ cheapest other method that meets the level in the same run, by that run's pairs.
 transition frames and its 95 % interval): "cheaper" or "dearer" only where the interval excludes 1, else "no
 difference". Points of different runs are never ranked against each other (their rounds are not paired).
 """
-import csv
 from collections import OrderedDict
 from pathlib import Path
 
 import matplotlib.pyplot as plt
 from matplotlib.lines import Line2D
 
+from lodbench_results import PERCEPTUAL_CSV, num, read_csv, run_folder_of
+
 LEVELS = (1.0, 0.5, 0.25, 0.125)
-
-
-def num(v):
-    try:
-        return float(v)
-    except (TypeError, ValueError):
-        return float("nan")
 
 
 def setting_key(v):
@@ -37,23 +31,15 @@ def setting_key(v):
     return (0, x, "") if x == x else (1, 0.0, str(v))
 
 
-def run_folder(folder: Path, variables, values) -> Path:
-    """The run folder of `values` (results::files::run_folder_of: `runs/<var>=<value>+...`, a comma as x)."""
-    if not variables:
-        return folder
-    return folder / "runs" / "+".join(f"{k}={str(v).replace(',', 'x')}" for k, v in zip(variables, values))
-
-
 def perceptual_popping(folder: Path, variables, values):
     """{(scene, method, count): lowest jod_popping over transitions} of the run's perceptual.csv, or {}."""
-    path = run_folder(folder, variables, values) / "perceptual.csv"
+    path = run_folder_of(folder, variables, values) / PERCEPTUAL_CSV
     if not path.is_file():
         return {}
     out = {}
-    with open(path, newline="") as f:
-        for r in csv.DictReader(f):
-            key = (r["scene"], r["method"], r["count"])
-            out[key] = min(out.get(key, float("inf")), num(r["jod_popping"]))
+    for r in read_csv(path):
+        key = (r["scene"], r["method"], r["count"])
+        out[key] = min(out.get(key, float("inf")), num(r["jod_popping"]))
     return out
 
 

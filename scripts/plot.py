@@ -9,21 +9,22 @@ wrote `clips/`, a player per transition stepping through the methods' frames sid
 nothing but the folder's own files, see scripts/report_html.py):
   - sweep_<scene>.png       rmse, pop and lodpop along the path per method, and FSI's lag_rmse, discrete LOD switch
                             frames marked;
-  - fig6_<scene>.png        Sheliemietiev et al. 2023 Fig. 6: popping per method (mean rmse, max pop, max lodpop; bunny-sweep or any
-                            moving scene);
+  - fig6_<scene>.png        Sheliemietiev et al. 2023 Fig. 6: popping per method (mean rmse, max pop, max lodpop;
+                            bunny-sweep or any moving scene);
   - transitions_<scene>.png per transition of the path (up to 16), the largest lodpop and pop of each method (from
                             transitions.csv: the transition's frames and the 2 after; older folders without it: the
                             largest pop within 5 frames), also as tables in report.md;
-  - fig5_<scene>.png        Sheliemietiev et al. 2023 Fig. 5: median frame time against instance count per method (scenes run with
-                            several --count values, e.g. bunny-grid), with bootstrap 95 % intervals;
+  - fig5_<scene>.png        Sheliemietiev et al. 2023 Fig. 5: median frame time against instance count per method
+                            (scenes run with several --count values, e.g. bunny-grid), with bootstrap 95 % intervals;
   - cost_<scene>.png        error against cost: mean rmse and max pop against median GPU time, per method;
   - contact_<scene>.png     three dumped frames around one transition per method with their error heat-maps, cropped
                             to where the scene is (runs with --dump-frames); `--transition worst` (default: the
                             frame where the methods' rmse differ most), `first`, or N (the N-th along the path).
   - fsi_buffers_<scene>.png FSI's two LOD buffers and the combined frame, at the dumped frame with the most instances
                             in transition (ties: the largest rmse), cropped (an fsi method run with --dump-frames).
-  - fig8_<scene>.png        Scherzer & Wimmer 2008 Fig. 8: median frame time against viewport size per method (experiment folders
-                            sweeping `viewport`, e.g. `lodbench experiment` with [sweep] variable = "viewport").
+  - fig8_<scene>.png        Scherzer & Wimmer 2008 Fig. 8: median frame time against viewport size per method
+                            (experiment folders sweeping `viewport`, e.g. `lodbench experiment` with [sweep] variable =
+                            "viewport").
   - unified_<scene>.png     unified LOD (experiment folders sweeping `pixel-error`, e.g.
                             scenes/experiments/unified-lod.toml): mean triangles, largest lodpop and mean crack pixels
                             against the pixel error, per method.
@@ -44,7 +45,6 @@ with more than one adapter (`merge --allow-adapters`) each (method, adapter) pai
 `method [adapter]`, so no curve mixes two GPUs.
 """
 import argparse
-import csv
 import sys
 from collections import OrderedDict
 from pathlib import Path
@@ -53,25 +53,33 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 from PIL import Image  # noqa: E402
 
 import answer  # noqa: E402  (scripts/answer.py, beside this file)
 import frontier  # noqa: E402  (scripts/frontier.py, beside this file)
 import report_html  # noqa: E402  (scripts/report_html.py, beside this file)
+from lodbench_results import (  # noqa: E402  (scripts/lodbench_results.py, beside this file)
+    FRAMES_CSV,
+    PAIRS_CSV,
+    RULES_CSV,
+    RUN_JSON,
+    SUMMARY_CSV,
+    TRANSITIONS_CSV,
+    TUNE_CSV,
+    TUNE_JSON,
+    read_csv,
+    run_folder_of,
+)
 
 # Eleven methods and more: matplotlib's ten default colours would give two methods one colour.
 plt.rcParams["axes.prop_cycle"] = matplotlib.cycler(
     color=list(plt.get_cmap("tab10").colors) + ["black", "gold", "navy", "lime"])
 
 
-def read_csv(path: Path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
-
-
 def num(v):
+    """A cell as a float, nan where empty; unlike lodbench_results.num, a cell that is not a number is an error."""
     return float(v) if v not in ("", None) else float("nan")
 
 
@@ -539,9 +547,9 @@ def report(folder: Path, transition: str = "worst") -> list:
     before anything is written."""
     clips = report_html.load_clips(folder)
     runs = report_html.manifest(folder)
-    frames = read_csv(folder / "frames.csv")
-    summary = read_csv(folder / "summary.csv")
-    transitions_csv = read_csv(folder / "transitions.csv") if (folder / "transitions.csv").is_file() else None
+    frames = read_csv(folder / FRAMES_CSV)
+    summary = read_csv(folder / SUMMARY_CSV)
+    transitions_csv = read_csv(folder / TRANSITIONS_CSV) if (folder / TRANSITIONS_CSV).is_file() else None
     figs = folder / "figures"
     figs.mkdir(exist_ok=True)
     made = []
@@ -556,7 +564,7 @@ def report(folder: Path, transition: str = "worst") -> list:
     frontier_tables = []
     if variables and variable != "viewport" and any(r.get("lodpop_max") for r in summary):
         # Before the methods are relabelled below: pairs.csv names them as the runs do.
-        pairs = read_csv(folder / "pairs.csv") if (folder / "pairs.csv").is_file() else []
+        pairs = read_csv(folder / PAIRS_CSV) if (folder / PAIRS_CSV).is_file() else []
         pts = frontier.points(folder, summary, variables)
         for (scene,), scene_pts in group(pts, "scene").items():
             first_count = scene_pts[0]["count"]
@@ -568,7 +576,7 @@ def report(folder: Path, transition: str = "worst") -> list:
                 frontier_tables.append((f"{scene}: cheapest at or below a popping (paired within a run)", rows,
                                         frontier.COLUMNS))
     # The answer first (scripts/answer.py), from the rows as the runs name their methods.
-    pairs_all = read_csv(folder / "pairs.csv") if (folder / "pairs.csv").is_file() else []
+    pairs_all = read_csv(folder / PAIRS_CSV) if (folder / PAIRS_CSV).is_file() else []
     answers = []
     for name, key, rows, said in answer.answers(summary, pairs_all, lambda values: budget_of(folder, variables,
                                                                                            values), variables):
@@ -612,7 +620,8 @@ def report(folder: Path, transition: str = "worst") -> list:
             by_method = group([r for r in scene_frames if r["count"] == first_count], "method")
             sweep_figure(scene, OrderedDict((m, rs) for (m,), rs in by_method.items()),
                          figs / f"sweep_{scene}.png")
-            made.append((f"sweep_{scene}.png", f"{scene}: rmse, pop" + (" and lodpop" if "lodpop" in scene_frames[0] else "") + " per frame"))
+            made.append((f"sweep_{scene}.png", f"{scene}: rmse, pop"
+                         + (" and lodpop" if "lodpop" in scene_frames[0] else "") + " per frame"))
             fig6(scene, [r for r in scene_summary if r["count"] == first_count], figs / f"fig6_{scene}.png")
             made.append((f"fig6_{scene}.png", f"{scene}: popping per method"))
             if transitions_csv is not None:
@@ -648,8 +657,8 @@ def report(folder: Path, transition: str = "worst") -> list:
                             (3, "max lodpop's shading part"), (1, "max pop (motion included)")):
                 if all(p[m][k] != p[m][k] for *_, p in per_transition for m in p):
                     continue
-                rows = [{"transition": f"frames {a}-{b} ({lods})", **{m: answer.sig3(p[m][k]) for m in methods if m in p}}
-                        for a, b, lods, p in per_transition]
+                rows = [{"transition": f"frames {a}-{b} ({lods})",
+                         **{m: answer.sig3(p[m][k]) for m in methods if m in p}} for a, b, lods, p in per_transition]
                 sections.append((f"{scene}: {what} of each transition (its frames and the 2 after)", rows,
                                  ["transition"] + methods))
         else:
@@ -713,7 +722,7 @@ def summary_groups(header, lead):
 def budget_of(folder: Path, variables, values):
     """The run's --budget-lodpop (its run.json's config), or None."""
     import json
-    path = frontier.run_folder(folder, variables, values) / "run.json"
+    path = run_folder_of(folder, variables, values) / RUN_JSON
     try:
         cfg = json.loads(path.read_text()).get("config") or {}
     except (OSError, ValueError, AttributeError):
@@ -782,9 +791,9 @@ def tune_figure(model, samples, rules, budget, path):
 def tune_report(folder: Path) -> list:
     """A tune folder's figures and report.md; returns [(file name, caption)]."""
     import json
-    meta = json.loads((folder / "tune.json").read_text())
-    samples = read_csv(folder / "tune.csv")
-    rules = read_csv(folder / "rules.csv") if (folder / "rules.csv").is_file() else []
+    meta = json.loads((folder / TUNE_JSON).read_text())
+    samples = read_csv(folder / TUNE_CSV)
+    rules = read_csv(folder / RULES_CSV) if (folder / RULES_CSV).is_file() else []
     figs = folder / "figures"
     figs.mkdir(exist_ok=True)
     made = []
@@ -906,11 +915,11 @@ def main() -> int:
         print(f"error: --transition {args.transition!r}: expected worst, first or a number", file=sys.stderr)
         return 2
     for folder in args.results:
-        if (folder / "tune.csv").is_file() and (folder / "tune.json").is_file():
+        if (folder / TUNE_CSV).is_file() and (folder / TUNE_JSON).is_file():
             made = tune_report(folder)
             print(f"{folder}: report.md, report.html and {len(made)} figures in {folder / 'figures'}")
             continue
-        if not (folder / "frames.csv").is_file() or not (folder / "summary.csv").is_file():
+        if not (folder / FRAMES_CSV).is_file() or not (folder / SUMMARY_CSV).is_file():
             print(f"error: {folder} has no frames.csv and summary.csv (a complete lodbench run?)", file=sys.stderr)
             return 2
         try:

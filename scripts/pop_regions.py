@@ -21,7 +21,6 @@ default, with or without `--dump-transitions`). For each dumped frame t of each 
 reference's border (override with --background R,G,B as bytes). Exit 2 with a message on a folder without dumps.
 """
 import argparse
-import csv
 import sys
 from collections import Counter
 from pathlib import Path
@@ -29,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from dumps import load_rgb, parse_stem
+from lodbench_results import FRAMES_CSV, frames_by_key
 
 
 def dilate(mask: np.ndarray, steps: int) -> np.ndarray:
@@ -123,10 +123,8 @@ def main() -> int:
         return 2
     methods = args.method.split(",") if args.method else sorted({method for _, method, _, _ in keys})
     csv_pop = {}
-    if (args.run / "frames.csv").is_file():
-        with open(args.run / "frames.csv", newline="") as f:
-            for r in csv.DictReader(f):
-                csv_pop[(r["scene"], r["method"], r["count"], r["frame"])] = r["pop"]
+    if (args.run / FRAMES_CSV).is_file():
+        csv_pop = {key: r["pop"] for key, r in frames_by_key(args.run / FRAMES_CSV).items()}
     print("scene,method,count,frame,pop,pop_csv,silhouette,interior,extra,missing,border,border_pop")
     reported = 0
     for key in keys:

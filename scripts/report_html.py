@@ -19,6 +19,8 @@ from urllib.parse import quote
 
 from PIL import Image
 
+from lodbench_results import EXPERIMENT_JSON, INDEX_JSON, RUN_JSON, RUNS_DIR
+
 # The animations `lodbench clips` may write beside a clip's frames (index.json's key, what the link says); any may
 # be null (no MP4 without ffmpeg).
 MEDIA = (("apng", "animated PNG"), ("gif", "GIF"), ("mp4", "MP4"))
@@ -43,9 +45,9 @@ def url(rel: str) -> str:
 def index_locations(folder: Path):
     """(prefix, clips folder) of a results folder: its own clips/ and, in an experiment folder, each run's."""
     out = [("", folder / "clips")]
-    if (folder / "runs").is_dir():
-        out += [(f"runs/{d.name}/", d / "clips") for d in sorted((folder / "runs").iterdir()) if d.is_dir()]
-    return [(prefix, d) for prefix, d in out if (d / "index.json").exists()]
+    if (folder / RUNS_DIR).is_dir():
+        out += [(f"runs/{d.name}/", d / "clips") for d in sorted((folder / RUNS_DIR).iterdir()) if d.is_dir()]
+    return [(prefix, d) for prefix, d in out if (d / INDEX_JSON).exists()]
 
 
 def load_clips(folder: Path):
@@ -59,7 +61,7 @@ def load_clips(folder: Path):
     for prefix, d in found:
         where = f"{prefix}clips/index.json"
         try:
-            index = json.loads((d / "index.json").read_text())
+            index = json.loads((d / INDEX_JSON).read_text())
         except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
             raise ValueError(f"{where}: not readable JSON ({e}); rerun `lodbench clips`") from None
         if not isinstance(index, dict) or not isinstance(index.get("clips"), list):
@@ -144,14 +146,14 @@ def manifest(folder: Path):
     run.json)]}, the folder's own run.json and each run folder's of an experiment (runs/*/run.json). Raises
     ValueError on a run.json that is not JSON."""
     runs = []
-    paths = [folder / "run.json"]
-    if (folder / "runs").is_dir():
-        paths += sorted((folder / "runs").glob("*/run.json"))
+    paths = [folder / RUN_JSON]
+    if (folder / RUNS_DIR).is_dir():
+        paths += sorted((folder / RUNS_DIR).glob(f"*/{RUN_JSON}"))
     for p in paths:
         if p.is_file():
             runs.append((p.parent.relative_to(folder).as_posix() if p.parent != folder else folder.name,
                          read_json(p, folder)))
-    experiment = read_json(folder / "experiment.json", folder) if (folder / "experiment.json").is_file() else None
+    experiment = read_json(folder / EXPERIMENT_JSON, folder) if (folder / EXPERIMENT_JSON).is_file() else None
     return {"experiment": experiment, "runs": runs}
 
 

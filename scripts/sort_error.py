@@ -11,8 +11,8 @@ over R, G, B of |a - b| on the stored sRGB bytes / 255, then the root mean squar
 channel's difference first lowered by --tolerance levels: `alpha` blends layer by layer in the hardware,
 rounding to 8 bits after each, `alpha-sorted` accumulates in floats and rounds once, so where the order is the
 same the two frames still differ by one level on some pixels (measured: every differing pixel of a frame with one
-translucent layer differs by exactly 1). Compared with each method's own rmse to the reference from frames.csv. Writes sort_error.csv into RUN_DIR and prints a summary per
-scene and instance count.
+translucent layer differs by exactly 1). Compared with each method's own rmse to the reference from frames.csv.
+Writes sort_error.csv into RUN_DIR and prints a summary per scene and instance count.
 """
 import argparse
 import csv
@@ -24,6 +24,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from dumps import load_rgb, parse_stem  # noqa: E402
+from lodbench_results import FRAMES_CSV, frames_by_key  # noqa: E402
 
 
 def rmse(a: np.ndarray, b: np.ndarray, tolerance: int = 0) -> float:
@@ -32,6 +33,11 @@ def rmse(a: np.ndarray, b: np.ndarray, tolerance: int = 0) -> float:
     levels = np.abs(np.rint(a * 255.0).astype(np.int64) - np.rint(b * 255.0).astype(np.int64))
     d = np.maximum(levels - tolerance, 0) / 255.0
     return float(np.sqrt(np.mean(np.mean(d, axis=2) ** 2)))
+
+
+def mean_of(rows, k):
+    """The mean of column `k` over the rows where it is not empty; nan where it is empty in every row."""
+    return np.mean([float(r[k]) for r in rows if r[k] != ""]) if any(r[k] != "" for r in rows) else float("nan")
 
 
 def main(argv=None):
@@ -44,11 +50,10 @@ def main(argv=None):
                          "composites round differently)")
     a = ap.parse_args(argv)
     run = Path(a.run)
-    frames_dir, frames_csv = run / "frames", run / "frames.csv"
+    frames_dir, frames_csv = run / "frames", run / FRAMES_CSV
     if not frames_dir.is_dir() or not frames_csv.is_file():
         sys.exit(f"error: {run}: no frames/ or frames.csv (run lodbench with --dump-frames into it)")
-    with open(frames_csv, newline="") as f:
-        rows = {(r["scene"], r["method"], r["count"], r["frame"]): r for r in csv.DictReader(f)}
+    rows = frames_by_key(frames_csv)
     out = []
     for path in sorted(frames_dir.glob(f"*_{a.method}_c*_method.png")):
         key = parse_stem(path.name)
@@ -75,14 +80,14 @@ def main(argv=None):
     groups = defaultdict(list)
     for r in out:
         groups[(r["scene"], r["count"])].append(r)
-    print("| scene | count | frames | in transition | sort_rmse mean | sort_rmse max | rmse mean (method) | rmse mean (sorted) |")
+    print("| scene | count | frames | in transition | sort_rmse mean | sort_rmse max | rmse mean (method) | "
+          "rmse mean (sorted) |")
     print("|---|---|---|---|---|---|---|---|")
     for (scene, count), rs in groups.items():
         sort = np.array([r["sort_rmse"] for r in rs])
-        num = lambda k: np.mean([float(r[k]) for r in rs if r[k] != ""]) if any(r[k] != "" for r in rs) else float("nan")
         moving = sum(1 for r in rs if r["t_instances"] not in ("", "0"))
-        print(f"| {scene} | {count} | {len(rs)} | {moving} | {sort.mean():.5f} | {sort.max():.5f} | {num('rmse'):.5f} | "
-              f"{num('rmse_sorted'):.5f} |")
+        print(f"| {scene} | {count} | {len(rs)} | {moving} | {sort.mean():.5f} | {sort.max():.5f} | "
+              f"{mean_of(rs, 'rmse'):.5f} | {mean_of(rs, 'rmse_sorted'):.5f} |")
     print(f"wrote {run / 'sort_error.csv'}")
 
 

@@ -30,13 +30,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+from lodbench_results import RULES_CSV, SUMMARY_CSV, TRANSITIONS_CSV, TUNE_JSON, read_csv
+
 DIAGONAL = (0.55, 0.45, 0.70)
 RULES = ["tune", "unreal", "godot", "meshopt"]
-
-
-def read_csv(path: Path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def run(binary, args, quiet=True):
@@ -68,8 +65,8 @@ def summarise(folder: Path, budget: float):
     """Per method: (largest transition lodpop, [lodpop of each transition], mean triangles, paired ratio to the
     baseline with its interval)."""
     out = {}
-    transitions = read_csv(folder / "transitions.csv")
-    for row in read_csv(folder / "summary.csv"):
+    transitions = read_csv(folder / TRANSITIONS_CSV)
+    for row in read_csv(folder / SUMMARY_CSV):
         m = row["method"]
         pops = [float(t["lodpop_max"]) for t in transitions if t["method"] == m and t["lodpop_max"] != ""]
         out[m] = {
@@ -100,8 +97,8 @@ def main() -> int:
     ap.add_argument("--frames", type=int, default=120, help="frames of each path (default 120)")
     ap.add_argument("--binary", type=Path, default=Path("target/release/lodbench"))
     args = ap.parse_args()
-    meta_path = args.tune_dir / "tune.json"
-    if not meta_path.is_file() or not (args.tune_dir / "rules.csv").is_file():
+    meta_path = args.tune_dir / TUNE_JSON
+    if not meta_path.is_file() or not (args.tune_dir / RULES_CSV).is_file():
         print(f"error: {args.tune_dir} has no tune.json and rules.csv (a lodbench tune folder?)", file=sys.stderr)
         return 2
     meta = json.loads(meta_path.read_text())
@@ -117,7 +114,7 @@ def main() -> int:
               "model's switches, so this checks scenes of one model", file=sys.stderr)
         return 2
     model = models[0]
-    rules = read_csv(args.tune_dir / "rules.csv")
+    rules = read_csv(args.tune_dir / RULES_CSV)
     switches = {r: [float(x["distance"]) for x in sorted((x for x in rules if x["rule"] == r),
                                                            key=lambda x: int(x["lod_from"]))] for r in RULES}
     out = args.out or args.tune_dir / "paths"

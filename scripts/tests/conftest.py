@@ -35,8 +35,8 @@ def dump(tmp_path_factory) -> Path:
     5th frame dumped."""
     out = tmp_path_factory.mktemp("dump") / "run"
     lodbench("run", "--scene", "bunny-sweep", "--method", "discrete,dither,fsi", "--width", "160", "--height", "120",
-             "--frames", "60", "--warmup", "0", "--switch-distances", "14,16,18", "--metrics", "rmse,pop,de2000", "--dump-frames",
-             "--dump-every", "5", "--out", str(out))
+             "--frames", "60", "--warmup", "0", "--switch-distances", "14,16,18", "--metrics", "rmse,pop,de2000",
+             "--dump-frames", "--dump-every", "5", "--out", str(out))
     return out
 
 
@@ -104,8 +104,9 @@ def write_clips(folder: Path, clips=2, frames=8, tile=(160, 120), methods=("refe
     """A synthetic `clips/` in `folder`, laid out as `lodbench clips` writes it (index.json, per clip a frame and an
     error image per frame, an animated PNG and a GIF, no MP4): each tile a method's colour with a white bar that
     moves with the frame, so every frame differs from every other. Returns the index."""
-    from PIL import Image, ImageDraw
     import json
+
+    from PIL import Image, ImageDraw
 
     colours = [(70, 110, 200), (200, 90, 60), (60, 160, 90), (170, 150, 40)]
     width, height = tile[0] * len(methods), tile[1]

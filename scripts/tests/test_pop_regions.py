@@ -65,8 +65,8 @@ def test_lag_is_all_silhouette(tmp_path):
 
 
 def test_colour_change_inside_is_all_interior(tmp_path):
-    # A static square; at frame 1 the method's square is 20 levels brighter, 3 or more pixels (4-neighbour steps) from the background,
-    # so the change lies outside a 2-pixel silhouette band.
+    # A static square; at frame 1 the method's square is 20 levels brighter, 3 or more pixels (4-neighbour steps)
+    # from the background, so the change lies outside a 2-pixel silhouette band.
     reference = [square(8), square(8)]
     brighter = square(8)
     brighter[13:15, 11:13] = [c + 20 for c in FG]

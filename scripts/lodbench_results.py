@@ -1,0 +1,101 @@
+"""What the scripts share about lodbench's results folders: the file names, the columns the scripts read from each
+CSV, and the small readers they all use.
+
+The names mirror src/results/files.rs (and, for the files it does not list, the commands that write them). READS
+says which columns of each CSV the scripts read; scripts/tests/test_columns.py checks that each is a field of the
+Rust record the file is written from, and that every column a script reads by name is declared here, so a column
+renamed or removed in lodbench fails a test rather than a script (or, read with `.get`, quietly reads nothing).
+
+(Not called `results`: run from the repository root, Python would also find the top-level results/ folder under
+that name.)
+"""
+import csv
+from pathlib import Path
+
+# A run folder's files (src/results/files.rs), and those of `lodbench perceptual`, `tune`, `probe` and `overhead`.
+FRAMES_CSV = "frames.csv"
+SUMMARY_CSV = "summary.csv"
+TRANSITIONS_CSV = "transitions.csv"
+ROUNDS_CSV = "rounds.csv"
+PAIRS_CSV = "pairs.csv"
+PERCEPTUAL_CSV = "perceptual.csv"
+TUNE_CSV = "tune.csv"
+RULES_CSV = "rules.csv"
+PROBE_CSV = "probe.csv"
+OVERHEAD_CSV = "overhead.csv"
+RUN_JSON = "run.json"
+EXPERIMENT_JSON = "experiment.json"
+TUNE_JSON = "tune.json"
+# The clips of a run folder: clips/index.json.
+INDEX_JSON = "index.json"
+# The run folders of an experiment folder.
+RUNS_DIR = "runs"
+
+# The columns the scripts read from each CSV, by name (a column of the Rust record it is written from; checked by
+# scripts/tests/test_columns.py). A script that reads another column declares it here.
+READS = {
+    FRAMES_CSV: (
+        "scene", "method", "count", "frame", "round", "gpu_ms", "cpu_ms", "t_instances", "lod_mean", "rmse", "pop",
+        "lodpop", "de2000_mean", "lag_rmse",
+    ),
+    SUMMARY_CSV: (
+        "scene", "method", "count", "frames", "baseline", "rounds",
+        "gpu_ms_median", "gpu_ms_median_transition", "gpu_ms_median_steady", "gpu_ms_p5", "gpu_ms_p95",
+        "cpu_ms_median", "combine_gpu_ms_median",
+        "ratio_to_baseline", "ratio_to_baseline_ci95_lo", "ratio_to_baseline_ci95_hi",
+        "ratio_to_baseline_transition", "ratio_to_baseline_transition_ci95_lo", "ratio_to_baseline_transition_ci95_hi",
+        "ratio_to_baseline_steady", "ratio_to_baseline_steady_ci95_lo", "ratio_to_baseline_steady_ci95_hi",
+        "rmse_mean", "rmse_max", "de2000_mean", "de2000_max", "flip_mean", "lag_rmse_mean", "lag_rmse_max",
+        "shadow_rmse_mean",
+        "pop_max", "pop_p95", "lodpop_max", "lodpop_p95", "lodpop_sum", "shadow_lodpop_max",
+        "triangles_mean", "draw_calls_mean", "t_instances_mean", "units_drawn_mean", "uncovered_px_mean",
+        "crack_px_mean", "crack_px_max", "extra_target_bytes", "tri_alternation_max",
+        "triangles_per_s", "triangle_ceiling_share", "bound",
+    ),
+    TRANSITIONS_CSV: (
+        "scene", "method", "count", "transition", "first_frame", "last_frame", "lods", "lodpop_max",
+        "lodpop_coverage", "lodpop_shading", "pop_max",
+    ),
+    ROUNDS_CSV: ("scene", "method", "count", "ratio_to_baseline"),
+    PAIRS_CSV: (
+        "scene", "count", "method_a", "method_b", "ratio", "ratio_ci95_lo", "ratio_ci95_hi", "ratio_transition",
+        "ratio_transition_ci95_lo", "ratio_transition_ci95_hi",
+    ),
+    PERCEPTUAL_CSV: ("scene", "method", "count", "jod_popping"),
+    TUNE_CSV: ("model", "lod_from", "lod_to", "view", "distance", "lodpop", "jod", "refined"),
+    RULES_CSV: ("model", "lod_from", "lod_to", "rule", "distance", "screen_size", "value", "within_budget"),
+}
+
+# The columns an experiment's or a merged folder's CSVs lead with, before the record's own: one per swept variable
+# (a `lodbench run` flag, or `viewport` for the width and height together), then, in a merged folder, `adapter`.
+# The scripts take the swept variables from the header; these are the ones they name.
+LEAD_COLUMNS = ("seed", "viewport", "pixel-error", "adapter")
+
+
+def num(v):
+    """A cell as a float; nan where it is empty, missing or not a number."""
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return float("nan")
+
+
+def read_csv(path: Path):
+    """The rows of a CSV as dicts keyed by its header."""
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def frames_by_key(path: Path):
+    """The rows of a frames.csv by (scene, method, count, frame), as strings (the names of the dumped PNGs give the
+    same key: dumps.parse_stem)."""
+    with open(path, newline="") as f:
+        return {(r["scene"], r["method"], r["count"], r["frame"]): r for r in csv.DictReader(f)}
+
+
+def run_folder_of(folder: Path, variables, values) -> Path:
+    """The run folder of `values` in an experiment folder (results::files::run_folder_of:
+    `runs/<var>=<value>+...`, a comma in a value as x); the folder itself without swept variables."""
+    if not variables:
+        return folder
+    return folder / RUNS_DIR / "+".join(f"{k}={str(v).replace(',', 'x')}" for k, v in zip(variables, values))
