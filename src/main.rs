@@ -3,7 +3,8 @@
 use clap::Parser;
 use lodbench::cli::{Cli, Command};
 use lodbench::commands::{
-    clips, compare, describe, experiment, export, list, merge, perceptual, probe, run, tune,
+    clips, compare, describe, experiment, export, list, merge, overhead, perceptual, probe, run,
+    tune,
 };
 use lodbench::Error;
 use std::process::ExitCode;
@@ -23,6 +24,7 @@ fn main() -> ExitCode {
         Command::Clips(args) => clips::execute(&args),
         Command::Tune(args) => tune::execute(&args),
         Command::Probe(args) => probe::execute(&args),
+        Command::Overhead(args) => overhead::execute(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

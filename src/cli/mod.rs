@@ -62,6 +62,38 @@ pub enum Command {
     /// Measure the adapter's ceilings: triangle, vertex, fill, depth and compute-read rates, each with a check
     /// that doubling what it names doubles its time and changing anything else does not; writes probe.csv.
     Probe(ProbeArgs),
+    /// The harness's own overhead: methods as the timing rounds draw them against a bare instanced draw of the
+    /// same meshes and instances, paired round by round; writes overhead.csv and overhead.json.
+    Overhead(OverheadArgs),
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct OverheadArgs {
+    /// Scenes to measure (comma-separated): built-in scenes of instanced models in one colour.
+    #[arg(long, value_delimiter = ',', default_value = "bunny-grid,trees")]
+    pub scene: Vec<String>,
+    /// Methods drawn by the harness (comma-separated); the bare draw draws every instance at LOD0, as
+    /// `reference` does.
+    #[arg(long, value_delimiter = ',', default_value = "reference")]
+    pub method: Vec<String>,
+    #[command(flatten)]
+    pub scene_args: SceneArgs,
+    /// Untimed frames rendered before the timed ones (default: the profile's).
+    #[arg(long)]
+    pub warmup: Option<u32>,
+    /// Timing rounds: each round times every method and bare draw over the round's frames, in an order shuffled
+    /// from --seed.
+    #[arg(long, default_value_t = 20)]
+    pub rounds: u32,
+    /// Seed of the rounds' order (recorded in overhead.json).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output folder (default results/overhead-<time>/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// GPU adapter, by index or name substring (`lodbench list`).
+    #[arg(long)]
+    pub adapter: Option<String>,
 }
 
 #[derive(Debug, Clone, Args)]

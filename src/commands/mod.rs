@@ -25,6 +25,7 @@ pub mod experiment;
 pub mod export;
 pub mod list;
 pub mod merge;
+pub mod overhead;
 pub mod perceptual;
 pub mod probe;
 pub mod run;

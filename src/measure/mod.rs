@@ -20,6 +20,7 @@ pub mod effects;
 pub mod engine_rules;
 pub mod metric_kernel;
 pub mod metrics;
+pub mod overhead;
 pub mod probe;
 pub mod quality;
 pub mod records;

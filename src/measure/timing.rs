@@ -303,7 +303,7 @@ impl<'a> BlockGpu<'a> {
 
     /// Times `m` over `frames` (the next frames of its walk) in round `round`: each frame submitted and waited
     /// for, bracketed by the method's own timestamps, nothing else in its command buffer.
-    fn time_segment(
+    pub(super) fn time_segment(
         &self,
         m: &mut TimedMethod<'_>,
         round: u32,

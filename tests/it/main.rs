@@ -21,6 +21,7 @@ mod cli_input;
 mod commands_clips;
 mod commands_compare;
 mod commands_experiment;
+mod commands_overhead;
 mod commands_probe;
 mod commands_tune;
 // src/gpu: what the GPU draws of a scene's materials.
