@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The papers' experiments on this machine's GPU, in one command (docs/cluster.md, "The GPU suite"):
 #   scripts/gpu-suite.sh [FRAMES [EXPERIMENT ...]]
-# runs lodbench probe (the adapter's ceilings), then scenes/experiments/aa-gpu.toml (the A/A check the suite's ratios are read against, then
+# runs lodbench probe (the adapter's ceilings) and lodbench overhead (the harness against a bare draw), then scenes/experiments/aa-gpu.toml (the A/A check the suite's ratios are read against, then
 # scripts/aa_check.py), then {fsi-fig8,sheliemietiev-fig5,sheliemietiev-fig6,trees-sorting,unified-lod,
 # terrain-equal-error,frontier}.toml, or only the EXPERIMENTs named (file names without .toml), at
 # the papers' scenes, instance counts and viewports, with FRAMES timed frames (default 150; the papers' 3,600
@@ -46,6 +46,13 @@ echo "adapter: $best" | tee -a "$out/times.txt"
 start=$(date +%s)
 "$lodbench" probe --rounds 20 --out "$out/probe"
 echo "probe: $(($(date +%s) - start)) s" | tee -a "$out/times.txt"
+# The harness's overhead against a bare instanced draw of the same meshes (lodbench overhead), at the paper's
+# bunny-grid counts and trees; FRAMES timed frames each, 20 rounds (seconds on a GPU; 15 minutes on lavapipe at ci).
+start=$(date +%s)
+"$lodbench" overhead --scene bunny-grid --profile paper --count 50,500,2000 --frames "$frames" --rounds 20 \
+    --out "$out/overhead/bunny-grid"
+"$lodbench" overhead --scene trees --profile paper --frames "$frames" --rounds 20 --out "$out/overhead/trees"
+echo "overhead: $(($(date +%s) - start)) s ($frames frames)" | tee -a "$out/times.txt"
 for exp in "${experiments[@]}"; do
     extra=()
     if [[ $exp == trees-sorting ]]; then
