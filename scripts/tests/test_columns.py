@@ -25,10 +25,10 @@ RECORDS = {
     results.ROUNDS_CSV: ("src/measure/records.rs", "RoundRecord"),
     results.PAIRS_CSV: ("src/measure/records.rs", "PairRecord"),
     results.PERCEPTUAL_CSV: ("src/commands/perceptual.rs", "PerceptualRecord"),
-    results.TUNE_CSV: ("src/measure/tune.rs", "Sample"),
+    results.TUNE_CSV: ("src/measure/switch_tuning.rs", "Sample"),
     results.RULES_CSV: ("src/commands/tune.rs", "RuleRow"),
-    results.PROBE_CSV: ("src/measure/probe.rs", "ProbeRecord"),
-    results.OVERHEAD_CSV: ("src/measure/overhead.rs", "OverheadRecord"),
+    results.PROBE_CSV: ("src/measure/probe_rounds.rs", "ProbeRecord"),
+    results.OVERHEAD_CSV: ("src/measure/overhead_rounds.rs", "OverheadRecord"),
 }
 
 # Keys the scripts read that are not CSV columns: from lodbench's JSON (tune.json, run.json, `describe --json`, the

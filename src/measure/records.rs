@@ -144,7 +144,7 @@ pub struct SummaryRecord {
     /// Mean triangles drawn over the median frame time (the block's clock), a second.
     pub triangles_per_s: Option<f64>,
     /// `triangles_per_s` over the adapter's triangle ceiling measured at the start of the run (run.json's
-    /// `ceilings`, `measure::probe::triangle_ceiling`).
+    /// `ceilings`, `measure::probe_rounds::triangle_ceiling`).
     pub triangle_ceiling_share: Option<f64>,
     /// `triangles` where that share is 0.8 or more: the block draws near the adapter's triangle rate.
     pub bound: Option<String>,
@@ -678,7 +678,7 @@ pub struct BlockInfo {
     pub instance_bytes_listed_per_frame: f64,
     pub instance_bytes_written_per_frame: f64,
     /// The adapter's triangle rate (a second) just before and just after the block
-    /// (`measure::probe::ClockCheck`; null with `--ceilings off`): where the two differ by more than a fifth,
+    /// (`measure::probe_rounds::ClockCheck`; null with `--ceilings off`): where the two differ by more than a fifth,
     /// the adapter changed speed during the block (a GPU's clock), and its times are suspect.
     pub triangle_rate_before: Option<f64>,
     pub triangle_rate_after: Option<f64>,
