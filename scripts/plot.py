@@ -346,7 +346,8 @@ def ceilings_figure(scene, summary, path):
 CLIP_LEAD = 2
 CLIP_TAIL = 2
 # crop_box: pixels kept around what the pictures draw, and the share of the frame above which the whole frame is
-# shown. Mirror CROP_MARGIN and CROP_MAX_SHARE of src/results/clips/compose.rs (its crop_box), also checked by test_plot.py.
+# shown. Mirror CROP_MARGIN and CROP_MAX_SHARE of src/results/clips/compose.rs (its crop_box), also checked by
+# test_plot.py.
 CROP_MARGIN = 8
 CROP_MAX_SHARE = 0.5
 
