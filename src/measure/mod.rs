@@ -9,7 +9,7 @@
 //! - `reference_cache.rs`: the reference's frames kept for the block's next methods;
 //! - `block_gpu.rs`: what both passes over a block share; `block.rs`: the block and the records built from both
 //!   passes;
-//! - `records.rs`, `stats.rs`: the records and their statistics; `metrics.rs`: the CPU definitions of every
+//! - `records/` (rows, summaries, transitions), `stats.rs`: the records and their statistics; `metrics.rs`: the CPU definitions of every
 //!   image figure (the GPU kernels' oracle); `metric_kernel.rs`, `diff_kernel.rs`: the GPU reductions.
 
 pub mod block;
