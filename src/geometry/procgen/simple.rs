@@ -1,7 +1,7 @@
 //! SIMPLE: a red UV sphere and a blue box (the module docs of `procgen` give the table).
 
 use super::mesh_builder::{flat_box, uv_sphere, Builder};
-use super::{measure_errors, ModelChain};
+use super::model_chain::{measure_errors, ModelChain};
 use crate::error::Result;
 use crate::geometry::lod::LodChain;
 use glam::Vec3;

@@ -2,7 +2,7 @@
 //! billboard-cloud cards (the module docs of `procgen` give the table), and the cards' alpha masks.
 
 use super::mesh_builder::{tube, AuxKind, Builder, Caps};
-use super::{measure_errors, ModelChain};
+use super::model_chain::{measure_errors, ModelChain};
 use crate::error::Result;
 use crate::geometry::lod::LodChain;
 use crate::geometry::mesh::{Mesh, AUX_LEAF, AUX_LEAF_CLUSTER, AUX_SOLID};

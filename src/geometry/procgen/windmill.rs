@@ -2,7 +2,7 @@
 //! module docs of `procgen` give the table).
 
 use super::mesh_builder::{loft, tube, AuxKind, Builder, Caps};
-use super::{measure_errors, ModelChain};
+use super::model_chain::{measure_errors, ModelChain};
 use crate::error::Result;
 use crate::geometry::lod::LodChain;
 use crate::geometry::mesh::{Mesh, AUX_BLADE, AUX_SOLID};
