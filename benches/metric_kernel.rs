@@ -35,8 +35,8 @@ use lodbench::gpu::targets::RenderTarget;
 use lodbench::measure::coverage::TILE;
 use lodbench::measure::metric_kernel::MetricKernel;
 use lodbench::measure::metrics::MetricReduction;
+use lodbench::measure::rounds::shuffled_order;
 use lodbench::measure::stats::{paired_log_ratio, percentile};
-use lodbench::measure::timing::shuffled_order;
 use lodbench::rng::SplitMix64;
 use std::time::Instant;
 

@@ -346,7 +346,8 @@ def ceilings_figure(scene, summary, path):
 CLIP_LEAD = 2
 CLIP_TAIL = 2
 # crop_box: pixels kept around what the pictures draw, and the share of the frame above which the whole frame is
-# shown. Mirror CROP_MARGIN and CROP_MAX_SHARE of src/commands/clips.rs (its crop_box), also checked by test_plot.py.
+# shown. Mirror CROP_MARGIN and CROP_MAX_SHARE of src/results/clips/compose.rs (its crop_box), also checked by
+# test_plot.py.
 CROP_MARGIN = 8
 CROP_MAX_SHARE = 0.5
 
@@ -403,7 +404,7 @@ def pick_transition(by_method, dumped, which):
 
 def crop_box(images, margin=CROP_MARGIN):
     """The box holding everything that is not background (the first image's top-left colour) in any of the
-    images, with a margin; None when it covers more than CROP_MAX_SHARE of the frame (as clips.rs's crop_box)."""
+    images, with a margin; None when it covers more than CROP_MAX_SHARE of the frame (as compose.rs's crop_box)."""
     arrays = [np.asarray(im.convert("RGB"), dtype=np.int16) for im in images]
     h, w = arrays[0].shape[:2]
     bg = arrays[0][0, 0]

@@ -19,16 +19,16 @@ import lodbench_results as results  # noqa: E402
 
 # The Rust record each CSV is written from (one row per value, serde's field order): (source file, struct).
 RECORDS = {
-    results.FRAMES_CSV: ("src/measure/records.rs", "FrameRecord"),
-    results.SUMMARY_CSV: ("src/measure/records.rs", "SummaryRecord"),
-    results.TRANSITIONS_CSV: ("src/measure/records.rs", "TransitionRecord"),
-    results.ROUNDS_CSV: ("src/measure/records.rs", "RoundRecord"),
-    results.PAIRS_CSV: ("src/measure/records.rs", "PairRecord"),
+    results.FRAMES_CSV: ("src/measure/records/rows.rs", "FrameRecord"),
+    results.SUMMARY_CSV: ("src/measure/records/summaries.rs", "SummaryRecord"),
+    results.TRANSITIONS_CSV: ("src/measure/records/transitions.rs", "TransitionRecord"),
+    results.ROUNDS_CSV: ("src/measure/records/summaries.rs", "RoundRecord"),
+    results.PAIRS_CSV: ("src/measure/records/summaries.rs", "PairRecord"),
     results.PERCEPTUAL_CSV: ("src/commands/perceptual.rs", "PerceptualRecord"),
-    results.TUNE_CSV: ("src/measure/tune.rs", "Sample"),
+    results.TUNE_CSV: ("src/measure/switch_tuning.rs", "Sample"),
     results.RULES_CSV: ("src/commands/tune.rs", "RuleRow"),
-    results.PROBE_CSV: ("src/measure/probe.rs", "ProbeRecord"),
-    results.OVERHEAD_CSV: ("src/measure/overhead.rs", "OverheadRecord"),
+    results.PROBE_CSV: ("src/measure/probe_rounds.rs", "ProbeRecord"),
+    results.OVERHEAD_CSV: ("src/measure/overhead_rounds.rs", "OverheadRecord"),
 }
 
 # Keys the scripts read that are not CSV columns: from lodbench's JSON (tune.json, run.json, `describe --json`, the

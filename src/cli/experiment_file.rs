@@ -18,7 +18,7 @@
 //! validated by `RunConfig::from_args` as on the command line. An unknown key, or a value of the wrong type, is
 //! an error naming the key and its line.
 
-use crate::cli::config::RunConfig;
+use crate::cli::run_config::RunConfig;
 use crate::cli::RunArgs;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};

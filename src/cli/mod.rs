@@ -4,8 +4,8 @@
 //! keys, the flags' names without dashes); a key it leaves out takes the flag's default
 //! (`crate::defaults::clap_defaults`), so a file and a command line with the same settings are the same run.
 
-pub mod config;
 pub mod experiment_file;
+pub mod run_config;
 
 use crate::effects::OnOff;
 use crate::geometry::blocks::PartitionMode;

@@ -1,7 +1,7 @@
 //! `lodbench experiment FILE.toml`: runs the planned runs of an experiment file (`cli::experiment_file` reads
 //! and validates it) into one results folder, with a column per swept variable.
 
-use crate::cli::config::RunConfig;
+use crate::cli::run_config::RunConfig;
 use crate::cli::ExperimentArgs;
 use crate::error::{Error, Result};
 use crate::results::files::{FRAMES_CSV, RUN_JSON, SUMMARY_CSV};

@@ -1,4 +1,4 @@
-//! `lodbench export --scene NAME --out FILE.glb|FILE.obj`: a scene as glTF 2.0 (`scene/export.rs`: a built-in
+//! `lodbench export --scene NAME --out FILE.glb|FILE.obj`: a scene as glTF 2.0 (`scene/export_glb.rs`: a built-in
 //! scene, or a glTF scene as lodbench draws it, its LOD chains and materials, at frame 0), or any non-unified
 //! scene's geometry on one frame as OBJ (`scene/export_obj.rs`).
 
@@ -38,7 +38,7 @@ pub fn execute(args: &ExportArgs) -> Result<()> {
     let scene = def.instantiate(count);
     let bytes = match obj {
         true => crate::scene::export_obj::obj(&def, &scene, args.frame).into_bytes(),
-        false => crate::scene::export::glb(&scene)?,
+        false => crate::scene::export_glb::glb(&scene)?,
     };
     std::fs::write(&args.out, &bytes).map_err(|e| Error::Output {
         path: args.out.clone(),

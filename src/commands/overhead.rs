@@ -1,12 +1,12 @@
-//! `lodbench overhead`: the harness's own overhead (`measure::overhead`) per scene and count, written as
+//! `lodbench overhead`: the harness's own overhead (`measure::overhead_rounds`) per scene and count, written as
 //! overhead.csv (a row per method and bare draw) and overhead.json (the adapter, the flags, each round's order),
 //! and printed as a table.
 
-use crate::cli::config::resolve_methods;
+use crate::cli::run_config::resolve_methods;
 use crate::cli::OverheadArgs;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
-use crate::measure::overhead::{check_same_image, measure, OverheadRecord};
+use crate::measure::overhead_rounds::{check_same_image, measure, OverheadRecord};
 use crate::measure::{BlockGpu, MethodSetup};
 use crate::methods::Registry;
 use crate::results::answer::{aligned, ratio, sig3};

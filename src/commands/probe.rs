@@ -1,12 +1,12 @@
-//! `lodbench probe`: the adapter's ceilings (`gpu::probe`, measured by `measure::probe`), written as probe.csv
+//! `lodbench probe`: the adapter's ceilings (`gpu::probe_kernels`, measured by `measure::probe_rounds`), written as probe.csv
 //! (a row per probe) and probe.json (the adapter, the target's size, the amounts, the settings and the rows), and
 //! printed as a table whose last column says whether each probe isolated what it names.
 
 use crate::cli::ProbeArgs;
 use crate::error::{Error, Result};
-use crate::gpu::probe::{Amounts, Probes};
+use crate::gpu::probe_kernels::{Amounts, Probes};
 use crate::gpu::GpuContext;
-use crate::measure::probe::{measure, ProbeRecord, CONTROL_RANGE, DOUBLED_RANGE};
+use crate::measure::probe_rounds::{measure, ProbeRecord, CONTROL_RANGE, DOUBLED_RANGE};
 use crate::results::answer::{aligned, ratio, sig3};
 use crate::results::csv::write_whole;
 use serde::Serialize;

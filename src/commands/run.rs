@@ -1,7 +1,7 @@
 //! A run: validates the output folder, writes run.json, opens the GPU, and measures every scene block x method
 //! (`crate::measure`), writing frames.csv as blocks finish and summary.csv at the end.
 
-use crate::cli::config::RunConfig;
+use crate::cli::run_config::RunConfig;
 use crate::cli::RunArgs;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
@@ -186,11 +186,11 @@ fn run_blocks(
     manifest.timing_source = Some(ctx.timing);
     manifest.timestamp_period_ns = Some(ctx.timestamp_period_ns);
     let clock = match cfg.ceilings {
-        crate::effects::OnOff::On => Some(crate::measure::probe::ClockCheck::new(&ctx)?),
+        crate::effects::OnOff::On => Some(crate::measure::probe_rounds::ClockCheck::new(&ctx)?),
         crate::effects::OnOff::Off => None,
     };
     if let Some(c) = &clock {
-        manifest.ceilings = Some(crate::measure::probe::ceilings(&ctx, c, cfg.seed)?);
+        manifest.ceilings = Some(crate::measure::probe_rounds::ceilings(&ctx, c, cfg.seed)?);
     }
     manifest.write(out_dir)?;
 
@@ -240,7 +240,7 @@ fn run_blocks(
     let ceiling = manifest
         .ceilings
         .as_deref()
-        .and_then(crate::measure::probe::triangle_ceiling);
+        .and_then(crate::measure::probe_rounds::triangle_ceiling);
     for s in &mut output.summaries {
         s.set_ceiling(ceiling);
     }
@@ -505,7 +505,9 @@ pub fn summary_table(s: &RunSummary) -> String {
             break;
         }
         if let (Some(x), Some(y)) = (b.triangle_rate_before, b.triangle_rate_after) {
-            if crate::measure::probe::clock_changed(x, y) && !said.contains(&(&b.scene, b.count)) {
+            if crate::measure::probe_rounds::clock_changed(x, y)
+                && !said.contains(&(&b.scene, b.count))
+            {
                 said.push((&b.scene, b.count));
                 out.push_str(&format!(
                     "note: {} n={}: the adapter's triangle rate was {:.3} M/s before the block and {:.3} M/s \

@@ -1,5 +1,5 @@
 //! `lodbench tune --scene FILE|NAME --budget-lodpop X | --budget-jod J`: each model's LOD switch distances chosen
-//! from a popping budget by measurement (`measure/tune.rs`), written as tune.csv (every curve), tune.json (the
+//! from a popping budget by measurement (`measure/switch_tuning.rs`), written as tune.csv (every curve), tune.json (the
 //! settings, views and switches), engines/ (the switches in Unity's, Unreal's, Godot's, Bevy's and three.js's
 //! units, `results/engines.rs`) and tuned.glb (the scene with its chains and the chosen switches, MSFT_lod with
 //! MSFT_screencoverage and lodbench's exact distances, no camera: `lodbench run --scene tuned.glb` flies its
@@ -9,7 +9,7 @@ use crate::cli::TuneArgs;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::measure::engine_rules::RULES;
-use crate::measure::tune::{
+use crate::measure::switch_tuning::{
     tune_model, view_directions, Budget, ModelCamera, ModelSwitches, Sample, TuneSettings,
 };
 use crate::results::csv::write_whole;
@@ -86,12 +86,12 @@ fn settings_of(args: &TuneArgs, band: f32) -> Result<TuneSettings> {
 /// The chosen switches of `m` as the engines take them: the LODs up to the first switch no distance allows; the
 /// hard switches, or `blend`'s switches and bands (with `--speed`).
 fn engine_model(m: &ModelSwitches, blend: Option<&str>) -> EngineModel {
-    let usable: Vec<&crate::measure::tune::PairSwitch> = m
+    let usable: Vec<&crate::measure::switch_tuning::PairSwitch> = m
         .pairs
         .iter()
         .take_while(|p| p.switch_distance.is_some())
         .collect();
-    let of = |p: &crate::measure::tune::PairSwitch| -> (f32, f32) {
+    let of = |p: &crate::measure::switch_tuning::PairSwitch| -> (f32, f32) {
         match blend.and_then(|b| p.bands.iter().find(|x| x.method == b)) {
             Some(x) => (x.switch_distance, x.band),
             None => (p.switch_distance.unwrap_or(0.0), 0.0),
@@ -162,7 +162,7 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
         write_fading(&out, &with("dither"), &with("alpha"), scene.fov_y)?;
     }
     let tuned = tuned_scene(&scene, &models);
-    let glb = crate::scene::export::glb_with(&tuned, false)?;
+    let glb = crate::scene::export_glb::glb_with(&tuned, false)?;
     write(&out.join("tuned.glb"), &glb)?;
     let manifest = TuneManifest {
         lodbench_version: env!("CARGO_PKG_VERSION"),

@@ -12,6 +12,6 @@ pub mod material;
 pub mod mesh;
 pub mod morph;
 pub mod procgen;
-pub mod roam;
+pub mod roam_mesh;
 pub mod tangents;
 pub mod terrain;

@@ -7,14 +7,14 @@ pub mod context;
 pub mod draw_list;
 pub mod instances;
 pub mod pipelines;
-pub mod probe;
+pub mod probe_kernels;
 pub mod readback;
 pub mod scene_gpu;
 pub mod shadow_pass;
 pub mod surface;
 pub mod taa_resolve;
 pub mod targets;
-pub mod timing;
+pub mod timestamps;
 
 pub use context::{AdapterSummary, GpuContext, TimingSource};
 pub use draw_list::{Draw, DrawList, DrawStats, InstanceRaw, PipelineIndex, Selection};

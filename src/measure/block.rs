@@ -3,19 +3,19 @@
 //! (without the quality pass, from the timing rounds alone, its figures empty).
 //!
 //! A block is measured in rounds ([`BlockRunner::measure_block`]): round r times every method over the r-th
-//! segment of the path in a shuffled order (src/measure/timing.rs), then makes every reported method's quality
+//! segment of the path in a shuffled order (src/measure/rounds.rs), then makes every reported method's quality
 //! pass over the same segment, in the same order, each by its own instance of the method and its own
 //! [`QualityStage`]. A quality segment is thus seconds, not minutes, from the timing segments of its own round,
 //! and `quality_to_renders_ratio` is paired round by round as the timing ratios are.
 
-use super::context::{BlockGpu, MethodSetup};
+use super::block_gpu::{BlockGpu, MethodSetup};
 use super::driver::FrameDriver;
 use super::quality::{
     FrameImages, QualityOptions, QualityPass, QualitySchedule, QualityStage, SegmentCost, Walk,
 };
 use super::reference_cache::ReferenceCache;
+use super::rounds::{round_frames, Prepared, TimedMethod};
 use super::stats::paired_log_ratio;
-use super::timing::{round_frames, Prepared, TimedMethod};
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::measure::metrics::Metric;

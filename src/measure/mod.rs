@@ -2,17 +2,18 @@
 //! frames, then one frame record per frame, built once every figure of the frame is known.
 //!
 //! - `driver.rs`: the walk along the path (the LOD schedule, shared by every method);
-//! - `timing.rs`: the warm-up and the interleaved timing rounds;
+//! - `rounds.rs`: the warm-up and the interleaved timing rounds;
 //! - `quality.rs`: the quality pass in stages (render, shadow maps, effects, metrics, read-back requests,
 //!   counterfactuals, collect);
 //! - `effects.rs`: which shadow map stands for what, the shadow's share, the lights, the TAA streams;
 //! - `reference_cache.rs`: the reference's frames kept for the block's next methods;
-//! - `block.rs`: the block's GPU objects and the records built from both passes;
-//! - `records.rs`, `stats.rs`: the records and their statistics; `metrics.rs`: the CPU definitions of every
+//! - `block_gpu.rs`: what both passes over a block share; `block.rs`: the block and the records built from both
+//!   passes;
+//! - `records/` (rows, summaries, transitions), `stats.rs`: the records and their statistics; `metrics.rs`: the CPU definitions of every
 //!   image figure (the GPU kernels' oracle); `metric_kernel.rs`, `diff_kernel.rs`: the GPU reductions.
 
 pub mod block;
-pub mod context;
+pub mod block_gpu;
 pub mod coverage;
 pub mod diff_kernel;
 pub mod driver;
@@ -20,21 +21,21 @@ pub mod effects;
 pub mod engine_rules;
 pub mod metric_kernel;
 pub mod metrics;
-pub mod overhead;
-pub mod probe;
+pub mod overhead_rounds;
+pub mod probe_rounds;
 pub mod quality;
 pub mod records;
 pub mod reference_cache;
+pub mod rounds;
 pub mod stats;
-pub mod timing;
-pub mod tune;
+pub mod switch_tuning;
 
 pub use block::{BlockOutput, BlockRunner, DumpPolicy};
-pub use context::{BlockGpu, MethodSetup};
+pub use block_gpu::{BlockGpu, MethodSetup};
 pub use driver::{FrameDriver, FrameFacts};
 pub use quality::{FrameImages, QualityOptions, QualitySchedule, QualityStage};
 pub use records::{BlockRounds, Round};
-pub use timing::{round_frames, shuffled_order, Prepared, TimedMethod, Uploads, WarmUpPlan};
+pub use rounds::{round_frames, shuffled_order, Prepared, TimedMethod, Uploads, WarmUpPlan};
 
 pub use crate::methods::is_reference;
 pub use driver::INTERRUPTED;

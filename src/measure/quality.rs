@@ -16,7 +16,7 @@
 //! timed one: so its frames are the timed frames, and each segment's time is paired with the round's timing
 //! segments for `quality_to_renders_ratio`.
 
-use super::context::BlockGpu;
+use super::block_gpu::BlockGpu;
 use super::coverage::{Coverage, PixelRect};
 use super::diff_kernel::DiffKernel;
 use super::driver::check_interrupt;
@@ -25,7 +25,7 @@ use super::effects::{Casters, ShadowRole, ShadowShare, Stream, TaaStreams};
 use super::metric_kernel::MetricKernel;
 use super::reference_cache::ReferenceCache;
 use crate::error::{Error, Result};
-use crate::gpu::timing::GpuTimer;
+use crate::gpu::timestamps::GpuTimer;
 use crate::gpu::{GpuContext, RenderTarget, SceneGpu, TextureReadback};
 use crate::measure::metrics::{FrameMetrics, Metric, MetricReduction, MetricRegion};
 use crate::methods::common::DumpKind;

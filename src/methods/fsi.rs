@@ -49,7 +49,7 @@
 use super::common::{instance_raw_with, DumpKind, FrameInput, Method};
 use crate::effects::shadow::Caster;
 use crate::error::Result;
-use crate::gpu::timing::GpuTimer;
+use crate::gpu::timestamps::GpuTimer;
 use crate::gpu::GpuContext;
 use crate::gpu::{
     read_texture, texture_2d, DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget,

@@ -1,5 +1,5 @@
 //! `roam` and `roam-morph`: ROAM (Duchaineau et al. 1997; seed 002's terrain algorithm) on the `terrain`
-//! scene's height field ([`crate::geometry::roam`]): the bintree triangulation carried from frame to frame,
+//! scene's height field ([`crate::geometry::roam_mesh`]): the bintree triangulation carried from frame to frame,
 //! split and merged each frame so that every triangle's projected wedgie thickness is at or under
 //! `--pixel-error`, the triangulation's indices uploaded and drawn opaque in one draw. `roam-morph` moves each
 //! vertex a split adds from the height of its edge's midpoint to its own over `--roam-morph-frames` frames
@@ -15,7 +15,7 @@
 use super::common::{identity_instance, FrameInput, Method};
 use crate::error::{Error, Result};
 use crate::geometry::cluster_dag::CutBound;
-use crate::geometry::roam::{Bintree, HeightField};
+use crate::geometry::roam_mesh::{Bintree, HeightField};
 use crate::geometry::terrain::{height, TERRAIN_SIZE};
 use crate::gpu::{DrawStats, InstanceBuffer, RenderTarget, SceneGpu, Selection, Vertex};
 use crate::scene::schedule::InstanceState;

@@ -3,8 +3,8 @@
 //! [`RunManifestRecord`] and [`ExperimentRecord`].
 
 use super::files::{partial, EXPERIMENT_JSON};
-use crate::cli::config::RunConfig;
 use crate::cli::experiment_file::{Experiment, PlannedRun, Shard};
+use crate::cli::run_config::RunConfig;
 use crate::error::{Error, Result};
 use crate::gpu::{AdapterSummary, TimingSource};
 use crate::measure::records::{BlockInfo, BlockRounds};
@@ -50,9 +50,9 @@ pub struct RunManifest {
     /// The process's peak resident memory when the run ended, in bytes (`VmHWM` of /proc/self/status; null
     /// where the system does not say). On a CPU adapter such as lavapipe it includes what a GPU would hold.
     pub peak_resident_bytes: Option<u64>,
-    /// The adapter's ceilings measured before the blocks (`measure::probe::ceilings`; null with
+    /// The adapter's ceilings measured before the blocks (`measure::probe_rounds::ceilings`; null with
     /// `--ceilings off`): each probe's rate on its clock. summary.csv's ceiling columns divide by them.
-    pub ceilings: Option<Vec<crate::measure::probe::ProbeRecord>>,
+    pub ceilings: Option<Vec<crate::measure::probe_rounds::ProbeRecord>>,
 }
 
 /// This build's `git describe --always --dirty` (None when not built from a checkout).

@@ -2,6 +2,7 @@
 //! here measures anything.
 
 pub mod answer;
+pub mod clips;
 pub mod csv;
 pub mod engines;
 pub mod files;

@@ -367,7 +367,7 @@ mod tests {
     use super::*;
     use crate::cli::{Cli, Command};
     use crate::scene::def::SceneDef;
-    use crate::scene::describe::NOT_REACHED;
+    use crate::scene::description::NOT_REACHED;
     use clap::Parser;
 
     fn cfg(extra: &[&str]) -> SceneConfig {

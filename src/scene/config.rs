@@ -5,7 +5,7 @@ use crate::scene::kind::{CameraMode, Profile, ProfileValues, SceneKind, SweepSta
 use crate::scene::schedule::ScheduleParams;
 use serde::Serialize;
 
-/// Scene-defining settings after the profile is applied (built from the flags by `crate::cli::config`).
+/// Scene-defining settings after the profile is applied (built from the flags by `crate::cli::run_config`).
 #[derive(Debug, Clone, Serialize)]
 pub struct SceneConfig {
     pub profile: Profile,

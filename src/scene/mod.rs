@@ -7,15 +7,15 @@
 //!   `bunny.rs` (bunny-sweep, bunny-grid) and `unified.rs` (bunny-halves, terrain).
 //!   A glTF file's path is a user scene (`user.rs`).
 //! - `model.rs`: the data model (models, instances, motion, the camera, the unified scenes' seams and DAG).
-//! - `describe.rs`: what `lodbench describe` prints; `schedule.rs`: the LOD schedule every method shares.
+//! - `description.rs`: what `lodbench describe` prints; `schedule.rs`: the LOD schedule every method shares.
 
 pub mod animated;
 pub mod bunny;
 pub mod camera_path;
 pub mod config;
 pub mod def;
-pub mod describe;
-pub mod export;
+pub mod description;
+pub mod export_glb;
 pub mod export_obj;
 pub mod kind;
 pub mod model;
@@ -27,7 +27,7 @@ pub mod user;
 pub use bunny::{BunnyPath, BUNNY_OBJ, BUNNY_YAW};
 pub use config::{SceneConfig, PAPER_HEIGHT};
 pub use def::{Family, SceneDef};
-pub use describe::{LodDescription, ModelDescription, SceneDescription, NOT_REACHED};
+pub use description::{LodDescription, ModelDescription, SceneDescription, NOT_REACHED};
 pub use kind::{CameraMode, Profile, ProfileValues, SceneKind, SweepStart, PAPER_COUNTS};
 pub use model::{
     sweep_distance, Camera, CameraTrack, Instance, Model, Motion, Scene, BACKGROUND,

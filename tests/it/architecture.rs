@@ -362,3 +362,186 @@ fn a_circle_is_found() {
         ]
     );
 }
+
+/// The most lines a function of src/ may span (its signature to its closing brace, doc comments not counted),
+/// and the stricter limit of the folders whose functions are steps of a command or a measurement.
+const FN_LINES: usize = 100;
+const FN_LINES_STRICT: usize = 80;
+const STRICT_FOLDERS: &[&str] = &["/measure/", "/commands/"];
+
+/// The functions over the limits today, each at most as long as listed: (file under src/, function, lines).
+/// Split one and remove it here; the test fails on any function over its limit that is not listed, on a listed
+/// one that grew, and on a listed one that is now within the limit (so the list only shrinks).
+const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
+    ("gpu/scene_gpu.rs", "with_shadow_maps", 267),
+    ("measure/switch_tuning.rs", "tune_model", 233),
+    ("methods/fsi.rs", "new", 185),
+    ("methods/alpha_sorted.rs", "new", 165),
+    ("gpu/probe_kernels.rs", "new", 163),
+    ("scene/user/mod.rs", "def", 141),
+    ("scene/camera_path.rs", "parse", 141),
+    ("geometry/gltf/primitives.rs", "primitive", 132),
+    ("gpu/pipelines.rs", "mesh_pipeline_from", 128),
+    ("cli/run_config.rs", "from_args_in", 124),
+    ("scene/export_glb.rs", "glb_with", 120),
+    ("gpu/surface.rs", "new", 120),
+    ("results/answer.rs", "block_sentences", 115),
+    ("commands/compare.rs", "compare", 115),
+    ("scene/user/chains.rs", "build", 112),
+    ("measure/probe_rounds.rs", "measure_variants", 111),
+    ("geometry/gltf/camera.rs", "animated_camera", 111),
+    ("cli/run_config.rs", "from_args", 110),
+    ("scene/user/models.rs", "chain", 104),
+    ("geometry/procgen/tree.rs", "generate", 102),
+    ("geometry/block_tree.rs", "build", 102),
+    ("commands/run.rs", "summary_table", 97),
+    ("measure/quality.rs", "counterfactuals", 96),
+    ("measure/records/summaries.rs", "from_frames", 95),
+    ("commands/tune.rs", "execute", 92),
+    ("commands/overhead.rs", "execute", 87),
+    ("commands/run.rs", "run_block", 86),
+    ("commands/describe.rs", "print_blocks", 86),
+];
+
+/// The name of the function a line declares (`[pub[(..)]] [const] [async] [unsafe] fn NAME`), and the
+/// line's indentation.
+fn fn_declared(line: &str) -> Option<(usize, &str)> {
+    let rest = line.trim_start();
+    let indent = line.len() - rest.len();
+    // One keyword followed by whitespace, or None.
+    let word = |s: &'static str, r: &str| -> Option<usize> {
+        let after = r.strip_prefix(s)?;
+        let ws = after.len() - after.trim_start().len();
+        (ws > 0).then_some(r.len() - after.trim_start().len())
+    };
+    let mut r = rest;
+    if let Some(after) = r.strip_prefix("pub") {
+        let after = match after.strip_prefix('(') {
+            Some(inner) => inner.find(')').map_or(after, |close| &inner[close + 1..]),
+            None => after,
+        };
+        if after.len() > after.trim_start().len() {
+            r = after.trim_start();
+        }
+    }
+    for kw in ["const", "async", "unsafe"] {
+        if let Some(n) = word(kw, r) {
+            r = &r[n..];
+        }
+    }
+    let n = word("fn", r)?;
+    let r = &r[n..];
+    let end = r
+        .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+        .unwrap_or(r.len());
+    (end > 0).then(|| (indent, &r[..end]))
+}
+
+/// Every function of `text` with a body: (name, lines from its `fn` line to the closing brace at its
+/// indentation).
+fn function_lengths(text: &str) -> Vec<(String, usize)> {
+    let lines: Vec<&str> = text.split('\n').collect();
+    let mut out = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let Some((indent, name)) = fn_declared(line) else {
+            continue;
+        };
+        let Some(j) = (i..lines.len()).find(|&j| {
+            let l = lines[j].trim_end();
+            l.ends_with('{') || l.ends_with(';')
+        }) else {
+            // As /tmp/fnlen.py counts it: to one past the end.
+            out.push((name.to_string(), lines.len() - i + 2));
+            continue;
+        };
+        if lines[j].trim_end().ends_with(';') {
+            continue;
+        }
+        let close = " ".repeat(indent) + "}";
+        let k = (j + 1..lines.len())
+            .find(|&k| {
+                lines[k].starts_with(&close)
+                    && lines[k].len() - lines[k].trim_start().len() == indent
+            })
+            .unwrap_or(lines.len());
+        out.push((name.to_string(), k - i + 1));
+    }
+    out
+}
+
+/// (file under src/, function, lines) of every function over its limit.
+fn over_the_limit(src: &Path) -> Vec<(String, String, usize)> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    files.sort();
+    let mut out = Vec::new();
+    for p in files {
+        let rel = p
+            .strip_prefix(src)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
+        let limit = if STRICT_FOLDERS.iter().any(|f| format!("/{rel}").contains(f)) {
+            FN_LINES_STRICT
+        } else {
+            FN_LINES
+        };
+        for (name, n) in function_lengths(&std::fs::read_to_string(&p).unwrap()) {
+            if n > limit {
+                out.push((rel.clone(), name, n));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn functions_stay_within_their_length_limits() {
+    let found = over_the_limit(&src_dir());
+    let mut problems = Vec::new();
+    for (file, name, n) in &found {
+        match OVER_THE_LIMIT
+            .iter()
+            .find(|(f, fun, _)| f == file && fun == name)
+        {
+            None => problems.push(format!(
+                "src/{file}: fn {name} is {n} lines, over the limit ({FN_LINES}, {FN_LINES_STRICT} in \
+                 measure/ and commands/): split it into named steps"
+            )),
+            Some((_, _, max)) if n > max => problems.push(format!(
+                "src/{file}: fn {name} grew to {n} lines (listed at {max} in OVER_THE_LIMIT): split it"
+            )),
+            Some(_) => {}
+        }
+    }
+    for (file, name, max) in OVER_THE_LIMIT {
+        if !found.iter().any(|(f, fun, _)| f == file && fun == name) {
+            problems.push(format!(
+                "src/{file}: fn {name} (listed at {max}) is within the limit now or gone: remove it from \
+                 OVER_THE_LIMIT"
+            ));
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+#[test]
+fn a_long_function_is_found() {
+    // The checker itself: bodies measured from the `fn` line to the closing brace at its indentation,
+    // declarations without a body skipped, methods found at their indentation.
+    let text = "pub(crate) fn a() {\n    x();\n}\ntrait T {\n    fn b(&self);\n    fn c(&self)\n    where\n        \
+                Self: Sized,\n    {\n        y();\n    }\n}\npub const unsafe fn d() {\n    z();\n}\n";
+    assert_eq!(
+        function_lengths(text),
+        vec![
+            ("a".to_string(), 3),
+            ("c".to_string(), 6),
+            ("d".to_string(), 3)
+        ]
+    );
+    assert_eq!(
+        fn_declared("    pub(super) async fn e_2() {"),
+        Some((4, "e_2"))
+    );
+    assert_eq!(fn_declared("let f = fn_pointer;"), None);
+}

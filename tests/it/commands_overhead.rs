@@ -4,7 +4,7 @@
 //! No time is compared with a threshold: the ratios are the command's output, not the test's.
 
 use crate::common::{fails_with, gpu, lodbench, scene_config};
-use lodbench::measure::overhead::check_same_image;
+use lodbench::measure::overhead_rounds::check_same_image;
 use lodbench::measure::{BlockGpu, MethodSetup};
 use lodbench::scene::{SceneDef, SceneKind};
 

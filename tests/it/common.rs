@@ -4,7 +4,7 @@
 
 use clap::Parser;
 use glam::Vec3;
-use lodbench::cli::config::RunConfig;
+use lodbench::cli::run_config::RunConfig;
 use lodbench::cli::{Cli, Command, RunArgs};
 use lodbench::scene::{Motion, Scene, SceneConfig, SceneDef, SceneKind};
 use std::collections::HashMap;

@@ -239,7 +239,7 @@ fn bad_shadow_flags_are_refused() {
         let Command::Run(a) = Cli::try_parse_from(argv).unwrap().command else {
             unreachable!()
         };
-        let err = lodbench::cli::config::RunConfig::from_args(&a)
+        let err = lodbench::cli::run_config::RunConfig::from_args(&a)
             .unwrap_err()
             .to_string();
         assert!(err.contains(needle), "{err}");

@@ -187,7 +187,7 @@ fn bad_taa_flags_are_refused() {
         let Command::Run(args) = cli.command else {
             unreachable!()
         };
-        let err = lodbench::cli::config::RunConfig::from_args(&args)
+        let err = lodbench::cli::run_config::RunConfig::from_args(&args)
             .unwrap_err()
             .to_string();
         assert!(err.contains(flag), "{err}");

@@ -1,8 +1,8 @@
-//! The warm-up before the timing rounds (src/measure/timing.rs): it ends on the frame before the first timed
+//! The warm-up before the timing rounds (src/measure/rounds.rs): it ends on the frame before the first timed
 //! frame, and it uses every pipeline a timed frame will use.
 
 use crate::common::{col, read_csv, run_into, sweep_scene};
-use lodbench::measure::timing::WarmUpPlan;
+use lodbench::measure::rounds::WarmUpPlan;
 use lodbench::measure::FrameDriver;
 
 /// FSI's first timed frame follows a frame like every other: on a static bunny out of transition its triangle

@@ -5,7 +5,7 @@
 
 use crate::common::read_csv;
 
-use lodbench::cli::config::RunConfig;
+use lodbench::cli::run_config::RunConfig;
 use lodbench::gpu::{DrawStats, RenderTarget, SceneGpu};
 use lodbench::methods::{FrameInput, Method, MethodEntry, OpaqueInstances, Registry};
 use lodbench::scene::Scene;

@@ -3,7 +3,7 @@
 
 use super::accessors::Doc;
 use super::animation::{animation_names, Animation, Rig};
-use super::chains::{chains, AuthoredChain};
+use super::authored_chains::{chains, AuthoredChain};
 use super::container::{check_required, container};
 use super::json::{array, floats, uint};
 use super::nodes::{Nodes, Placement};
@@ -57,7 +57,7 @@ pub fn read<'a>(bytes: &'a [u8], dir: &'a Path) -> Result<Content<'a>, String> {
         // node's parent (the spec's LOD nodes replace the LOD0 node where it stands), its descendants with it.
         for c in chains
             .iter()
-            .filter(|c| c.source == super::chains::ChainSource::MsftLod)
+            .filter(|c| c.source == super::authored_chains::ChainSource::MsftLod)
         {
             let parent = nodes.parent[c.nodes[0]].map_or(Mat4::IDENTITY, |p| rest_worlds[p]);
             for &level in &c.nodes[1..] {

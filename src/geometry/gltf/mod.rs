@@ -18,15 +18,15 @@
 //! remedy (for Draco: the glTF-Transform command that rewrites the file with meshopt compression).
 //!
 //! The files: `container.rs` (GLB, JSON, buffer URIs, required extensions), `json.rs` (properties), `accessors.rs`
-//! (buffer views and accessors), `nodes.rs` (hierarchy, placements), `chains.rs` (authored LOD chains),
+//! (buffer views and accessors), `nodes.rs` (hierarchy, placements), `authored_chains.rs` (authored LOD chains),
 //! `materials.rs` (materials, textures, samplers, images),
 //! `primitives.rs` (triangles and their attributes, merging), `skins.rs`, `animation.rs`, `camera.rs` (the
 //! animated camera) and `content.rs` ([`read`] and what it gives).
 
 mod accessors;
 pub mod animation;
+mod authored_chains;
 mod camera;
-mod chains;
 pub mod container;
 mod content;
 mod json;
@@ -36,8 +36,8 @@ pub mod primitives;
 mod skins;
 
 pub use animation::{Animation, Rig};
+pub use authored_chains::{AuthoredChain, ChainSource};
 pub use camera::AnimatedCamera;
-pub use chains::{AuthoredChain, ChainSource};
 pub use container::{decode_base64, percent_decode};
 pub use content::{read, Content};
 pub use materials::MaterialTable;

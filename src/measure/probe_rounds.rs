@@ -1,4 +1,4 @@
-//! `lodbench probe`'s measurement: every probe of `gpu::probe` and its doubled and control variants, timed in
+//! `lodbench probe`'s measurement: every probe of `gpu::probe_kernels` and its doubled and control variants, timed in
 //! rounds (each round times every variant of every probe once, in an order shuffled from the seed), on the GPU's
 //! timestamps where the adapter has them, else the CPU's clock around a submission and its wait.
 //!
@@ -14,8 +14,8 @@
 
 use crate::error::Result;
 use crate::gpu::context::GpuContext;
-use crate::gpu::probe::{Amounts, Probe, Probes, Variant, PROBES, VARIANTS};
-use crate::gpu::timing::GpuTimer;
+use crate::gpu::probe_kernels::{Amounts, Probe, Probes, Variant, PROBES, VARIANTS};
+use crate::gpu::timestamps::GpuTimer;
 use crate::measure::stats::{paired_log_ratio, percentile};
 use crate::rng::SplitMix64;
 use serde::Serialize;

@@ -20,15 +20,15 @@
 //! is triangles per second over the bare draw's, paired round by round; for `reference` it is the bare
 //! draw's time over the method's.
 
-use super::context::BlockGpu;
+use super::block_gpu::BlockGpu;
 use super::driver::FrameDriver;
+use super::rounds::{round_frames, shuffled_order, Prepared};
 use super::stats::{paired_log_ratio, percentile};
-use super::timing::{round_frames, shuffled_order, Prepared};
 use crate::error::{Error, Result};
 use crate::gpu::draw_list::DrawList;
 use crate::gpu::instances::InstanceBuffer;
 use crate::gpu::readback::TextureReadback;
-use crate::gpu::timing::GpuTimer;
+use crate::gpu::timestamps::GpuTimer;
 use crate::methods::common::instance_raw;
 use crate::rng::SplitMix64;
 use indicatif::ProgressBar;

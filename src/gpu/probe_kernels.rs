@@ -1,5 +1,5 @@
 //! The adapter's ceilings: microbenchmarks that each load one stage of the pipeline (`shaders/probe.wgsl`,
-//! `shaders/probe_read.wgsl`; timed and summarised by `measure::probe`, `lodbench probe`).
+//! `shaders/probe_read.wgsl`; timed and summarised by `measure::probe_rounds`, `lodbench probe`).
 //!
 //! Each probe has a quantity it names (triangles, vertices, fragments, bytes) and three variants: the base, the
 //! same with that quantity doubled (its time should double), and a control that changes something else and

@@ -11,12 +11,12 @@
 //!   frame is submitted and waited for, so `cpu_ms` is a true encode-to-completion time and frames never
 //!   overlap; GPU timestamps are resolved into one buffer per method and read once after the rounds.
 
-use super::context::BlockGpu;
+use super::block_gpu::BlockGpu;
 use super::driver::check_interrupt;
 use super::driver::{FrameDriver, FrameFacts};
 use super::effects::{Casters, ShadowRole};
 use crate::error::Result;
-use crate::gpu::timing::GpuTimer;
+use crate::gpu::timestamps::GpuTimer;
 use crate::gpu::DrawStats;
 use crate::measure::records::{BlockRounds, Round, TransitionPair};
 use crate::methods::is_reference;
