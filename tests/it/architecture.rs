@@ -325,9 +325,8 @@ fn an_import_against_the_layers_is_found() {
 #[test]
 fn module_imports_form_no_circle() {
     let edges = imports(&src_dir());
-    for (file, deps) in &edges {
-        let deps: Vec<&str> = deps.iter().map(String::as_str).collect();
-        println!("{file:<24} -> {}", deps.join(", "));
+    for line in listing(&edges) {
+        println!("{line}");
     }
     let found = circles(&edges);
     assert!(found.is_empty(), "import circles: {found:?}");
@@ -544,4 +543,43 @@ fn a_long_function_is_found() {
         Some((4, "e_2"))
     );
     assert_eq!(fn_declared("let f = fn_pointer;"), None);
+}
+
+/// The listing as docs/ARCHITECTURE.md shows it: a line per file of src/, `FILE -> IMPORTS`.
+fn listing(edges: &BTreeMap<String, BTreeSet<String>>) -> Vec<String> {
+    edges
+        .iter()
+        .map(|(file, deps)| {
+            let deps: Vec<&str> = deps.iter().map(String::as_str).collect();
+            format!("{file:<24} -> {}", deps.join(", "))
+                .trim_end()
+                .to_string()
+        })
+        .collect()
+}
+
+/// docs/ARCHITECTURE.md's import listing is the code's: a file added, moved or importing something new without
+/// the listing regenerated (`cargo test --release --test it architecture:: -- --nocapture`) fails here.
+#[test]
+fn the_documented_listing_is_the_code_s() {
+    let doc =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/ARCHITECTURE.md"))
+            .unwrap();
+    let documented: Vec<String> = doc
+        .lines()
+        .skip_while(|l| !l.starts_with("## The import listing"))
+        .skip_while(|l| !l.starts_with("```"))
+        .skip(1)
+        .take_while(|l| !l.starts_with("```"))
+        .map(|l| l.trim_end().to_string())
+        .collect();
+    let actual = listing(&imports(&src_dir()));
+    let missing: Vec<&String> = actual.iter().filter(|l| !documented.contains(l)).collect();
+    let stale: Vec<&String> = documented.iter().filter(|l| !actual.contains(l)).collect();
+    assert!(
+        missing.is_empty() && stale.is_empty(),
+        "docs/ARCHITECTURE.md's listing differs from the code (regenerate it):\nmissing:\n{}\nstale:\n{}",
+        missing.iter().map(|s| s.as_str()).collect::<Vec<_>>().join("\n"),
+        stale.iter().map(|s| s.as_str()).collect::<Vec<_>>().join("\n")
+    );
 }
