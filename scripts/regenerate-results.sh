@@ -62,7 +62,7 @@ folders=(
 "sheliemietiev-fig6-cpu|5||\$LB experiment $E/sheliemietiev-fig6-cpu.toml --out \$D && $PLOT \$D"
 "trees-sorting-cpu|9||\$LB experiment $E/trees-sorting-cpu.toml --out \$D && $PLOT \$D"
 "unified-lod-cpu|2||\$LB experiment $E/unified-lod-cpu.toml --out \$D && $PLOT \$D"
-"unified-terrain-ci|1||\$LB run --scene terrain --profile ci --method reference,blocks,blocks-noseams,blocks-discrete,clusterlod --out \$D && $PLOT \$D"
+"unified-terrain-ci|1||\$LB run --scene terrain --profile ci --method reference,blocks,blocks-noseams,blocks-discrete,clusterlod,blocks-discrete --out \$D && $PLOT \$D"
 "unified-bunny-halves-ci|1||\$LB run --scene bunny-halves --profile ci --out \$D && $PLOT \$D"
 "timing-aa-bunny-sweep-ci|10||\$LB experiment $E/aa-bunny-sweep-ci.toml --out \$D"
 "timing-aa-bunny-grid-ci|17||\$LB experiment $E/aa-bunny-grid-ci.toml --out \$D"
