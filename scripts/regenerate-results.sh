@@ -14,7 +14,7 @@
 #   GSA    a copy of the Khronos glTF sample assets (github DRx3D/glTF-Sample-Assets-OLD: the folder holding Models/)
 #   AG     the glTF Asset-Generator's output (github YuuuZhang/glTF-Asset-Generator: the folder holding Output/)
 #   SCAN   the Stanford scan as OBJ (alecjacobson/common-3d-test-models, data/stanford-bunny.obj)
-#   TOOLS  a folder where `npm install gltfpack@1.3.0 @gltf-transform/cli@4.5.1 three@0.187.0` was run
+#   TOOLS  a folder where `npm install gltfpack@1.3.0 @gltf-transform/cli@4.5.1 three@0.187.0` was run (npx runs there)
 # LODBENCH names a lodbench binary to use instead of building one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -44,6 +44,8 @@ if [[ -z $LB && $list == 0 ]]; then
     cargo build --release --quiet
     LB=target/release/lodbench
 fi
+# Absolute, for commands that run elsewhere (npx finds gltfpack from the tools' folder only).
+[[ -z $LB || $LB == /* ]] || LB=$PWD/$LB
 build=$(git describe --always --dirty --abbrev=12)
 mkdir -p "$work" ${into:+"$into"}
 E=scenes/experiments/cpu
@@ -111,7 +113,7 @@ folders=(
 "tune-damagedhelmet|2|GSA|\$LB tune --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --budget-lodpop 0.004 --speed 2 --views 8 --out \$D && $PLOT \$D && python3 scripts/tune_rules.py \$D --frames 240"
 "tune-stanford-scan|9|SCAN|\$LB tune --scene bunny-sweep --mesh \$SCAN --budget-lodpop 0.004 --speed 2 --views 8 --out \$D && $PLOT \$D && python3 scripts/tune_rules.py \$D --frames 240"
 "three-fidelity|2|GSA TOOLS|scifi_available && PATH=\$TOOLS/node_modules/.bin:\$PATH python3 scripts/three_fidelity.py --lodbench \$LB --out \$D \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb \$GSA/Models/BoomBoxWithAxes/glTF/BoomBoxWithAxes.gltf \$GSA/Models/Avocado/glTF/Avocado.gltf \$GSA/Models/WaterBottle/glTF/WaterBottle.gltf \$GSA/Models/AlphaBlendModeTest/glTF/AlphaBlendModeTest.gltf \$GSA/Models/VertexColorTest/glTF/VertexColorTest.gltf \$GSA/Models/TextureCoordinateTest/glTF/TextureCoordinateTest.gltf \$GSA/Models/NormalTangentMirrorTest/glTF/NormalTangentMirrorTest.gltf \$GSA/Models/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf \$GSA/Models/TextureSettingsTest/glTF/TextureSettingsTest.gltf \$GSA/Models/MultiUVTest/glTF/MultiUVTest.gltf \$GSA/Models/TextureTransformMultiTest/glTF/TextureTransformMultiTest.gltf \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet-available.gltf"
-"chain-vs-gltfpack|1|GSA TOOLS|scifi_available && PATH=\$TOOLS/node_modules/.bin:\$PATH python3 scripts/chain_vs_gltfpack.py --lodbench \$LB --out \$D/chains.csv \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet-available.gltf \$GSA/Models/Fox/glTF-Binary/Fox.glb \$GSA/Models/Suzanne/glTF/Suzanne.gltf tests/data/gltf/faceted-sphere.gltf"
+"chain-vs-gltfpack|1|GSA TOOLS|scifi_available && here=\$PWD && cd \$TOOLS && python3 \$here/scripts/chain_vs_gltfpack.py --lodbench \$LB --out \$here/\$D/chains.csv \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet-available.gltf \$GSA/Models/Fox/glTF-Binary/Fox.glb \$GSA/Models/Suzanne/glTF/Suzanne.gltf \$here/tests/data/gltf/faceted-sphere.gltf"
 "chain-pop-vs-gltfpack|2|GSA TOOLS|scifi_available && python3 scripts/chain_pop_vs_gltfpack.py --lodbench \$LB --tools \$TOOLS --out \$D \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb \$GSA/Models/WaterBottle/glTF/WaterBottle.gltf \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet-available.gltf"
 "gltf-read-check|40|GSA AG|python3 scripts/check_gltf.py run --lodbench \$LB --frames 0,30 \$D \$GSA/Models \$AG/Output/Positive"
 )
