@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
 # Remakes every folder of results/cpu/ from the code at HEAD, in the order below, one folder at a time:
 #   scripts/regenerate-results.sh [--list] [--force] [--out ROOT] [NAME ...]
-# Each folder is made in results/cpu/.regen/NAME, then pruned to what the committed folder keeps (its tracked
-# files, plus the run's small outputs: run.json, summary.csv, pairs.csv, rounds.csv, transitions.csv, reports and
-# figures; frames.csv and frame dumps go unless the committed folder kept them) and moved into place. Resumable:
+# Each folder is made in results/cpu/.regen/NAME, then pruned to what the committed folder keeps (a file whose name
+# it has, and figures/ where it has figures: frames.csv and frame dumps go unless it kept them) and moved into place. Resumable:
 # a folder already made by this build (results/cpu/.regen/done lists NAME and the build's commit) is skipped
 # unless --force; an interrupted folder is made again from its start. Prints each folder's time and the total.
 # --out ROOT makes the folders in ROOT instead, whole, leaving results/cpu/ alone (the test that the committed
@@ -113,7 +112,7 @@ folders=(
 "tune-damagedhelmet|2|GSA|\$LB tune --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --budget-lodpop 0.004 --speed 2 --views 8 --out \$D && $PLOT \$D && python3 scripts/tune_rules.py \$D --frames 240"
 "tune-stanford-scan|9|SCAN|\$LB tune --scene bunny-sweep --mesh \$SCAN --budget-lodpop 0.004 --speed 2 --views 8 --out \$D && $PLOT \$D && python3 scripts/tune_rules.py \$D --frames 240"
 "three-fidelity|2|GSA TOOLS|scifi_available && PATH=\$TOOLS/node_modules/.bin:\$PATH python3 scripts/three_fidelity.py --lodbench \$LB --out \$D \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb \$GSA/Models/BoomBoxWithAxes/glTF/BoomBoxWithAxes.gltf \$GSA/Models/Avocado/glTF/Avocado.gltf \$GSA/Models/WaterBottle/glTF/WaterBottle.gltf \$GSA/Models/AlphaBlendModeTest/glTF/AlphaBlendModeTest.gltf \$GSA/Models/VertexColorTest/glTF/VertexColorTest.gltf \$GSA/Models/TextureCoordinateTest/glTF/TextureCoordinateTest.gltf \$GSA/Models/NormalTangentMirrorTest/glTF/NormalTangentMirrorTest.gltf \$GSA/Models/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf \$GSA/Models/TextureSettingsTest/glTF/TextureSettingsTest.gltf \$GSA/Models/MultiUVTest/glTF/MultiUVTest.gltf \$GSA/Models/TextureTransformMultiTest/glTF/TextureTransformMultiTest.gltf \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet-available.gltf"
-"chain-vs-gltfpack|1|GSA TOOLS|scifi_available && here=\$PWD && cd \$TOOLS && python3 \$here/scripts/chain_vs_gltfpack.py --lodbench \$LB --out \$here/\$D/chains.csv \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet-available.gltf \$GSA/Models/Fox/glTF-Binary/Fox.glb \$GSA/Models/Suzanne/glTF/Suzanne.gltf \$here/tests/data/gltf/faceted-sphere.gltf"
+"chain-vs-gltfpack|1|GSA TOOLS|here=\$PWD && cd \$TOOLS && python3 \$here/scripts/chain_vs_gltfpack.py --lodbench \$LB --out \$here/\$D/chains.csv \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet.gltf \$GSA/Models/Fox/glTF-Binary/Fox.glb \$GSA/Models/Suzanne/glTF/Suzanne.gltf \$here/tests/data/gltf/faceted-sphere.gltf"
 "chain-pop-vs-gltfpack|2|GSA TOOLS|scifi_available && python3 scripts/chain_pop_vs_gltfpack.py --lodbench \$LB --tools \$TOOLS --out \$D \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb \$GSA/Models/WaterBottle/glTF/WaterBottle.gltf \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet-available.gltf"
 "gltf-read-check|40|GSA AG|python3 scripts/check_gltf.py run --lodbench \$LB --frames 0,30 \$D \$GSA/Models \$AG/Output/Positive"
 )
@@ -155,21 +154,20 @@ EOF
 }
 export -f scifi_available
 
-# Keeps in $1 (the new folder) what the committed folder $2 keeps: its tracked files, and the run's small outputs.
+# Keeps in $1 (the new folder) what the committed folder $2 keeps: a file whose name the committed folder has
+# (anywhere in it: a new run of an experiment keeps what the other runs keep), and figures/ where it has figures.
 prune() {
     local new=$1 old=$2 rel
     local -A kept=()
+    local figures=0
     while IFS= read -r rel; do
-        kept[$rel]=1
+        kept[${rel##*/}]=1
+        [[ $rel == figures/* || $rel == */figures/* ]] && figures=1
     done < <(git ls-files -- "$old" | sed "s|^$old/||")
     while IFS= read -r rel; do
         rel=${rel#./}
-        [[ -n ${kept[$rel]:-} ]] && continue
-        case ${rel##*/} in
-            run.json | summary.csv | pairs.csv | rounds.csv | transitions.csv | report.md | report.html | \
-                experiment.json | perceptual.csv | probe.csv | probe.json | overhead.csv | overhead.json) continue ;;
-        esac
-        [[ $rel == figures/* || $rel == */figures/* ]] && continue
+        [[ -n ${kept[${rel##*/}]:-} ]] && continue
+        [[ $figures == 1 && ($rel == figures/* || $rel == */figures/*) ]] && continue
         rm -f -- "$new/$rel"
     done < <(cd "$new" && find . -type f)
     find "$new" -mindepth 1 -type d -empty -delete
