@@ -373,7 +373,6 @@ const STRICT_FOLDERS: &[&str] = &["/measure/", "/commands/"];
 /// one that grew, and on a listed one that is now within the limit (so the list only shrinks).
 const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("measure/switch_tuning.rs", "tune_model", 233),
-    ("gpu/probe_kernels.rs", "new", 163),
     ("scene/user/mod.rs", "def", 141),
     ("scene/camera_path.rs", "parse", 141),
     ("geometry/gltf/primitives.rs", "primitive", 132),
