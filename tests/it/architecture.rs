@@ -379,7 +379,6 @@ const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("gpu/pipelines.rs", "mesh_pipeline_from", 128),
     ("cli/run_config.rs", "from_args_in", 124),
     ("scene/export_glb.rs", "glb_with", 120),
-    ("gpu/surface.rs", "new", 120),
     ("results/answer.rs", "block_sentences", 115),
     ("commands/compare.rs", "compare", 115),
     ("scene/user/chains.rs", "build", 112),
