@@ -378,7 +378,6 @@ const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("cli/run_config.rs", "from_args_in", 124),
     ("scene/export_glb.rs", "glb_with", 120),
     ("results/answer.rs", "block_sentences", 115),
-    ("commands/compare.rs", "compare", 115),
     ("scene/user/chains.rs", "build", 112),
     ("measure/probe_rounds.rs", "measure_variants", 111),
     ("geometry/gltf/camera.rs", "animated_camera", 111),
