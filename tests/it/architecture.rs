@@ -379,7 +379,6 @@ const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("scene/export_glb.rs", "glb_with", 120),
     ("results/answer.rs", "block_sentences", 115),
     ("scene/user/chains.rs", "build", 112),
-    ("measure/probe_rounds.rs", "measure_variants", 111),
     ("geometry/gltf/camera.rs", "animated_camera", 111),
     ("cli/run_config.rs", "from_args", 110),
     ("scene/user/models.rs", "chain", 104),
