@@ -384,7 +384,6 @@ const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("scene/user/models.rs", "chain", 104),
     ("geometry/procgen/tree.rs", "generate", 102),
     ("geometry/block_tree.rs", "build", 102),
-    ("commands/describe.rs", "print_blocks", 86),
 ];
 
 /// The name of the function a line declares (`[pub[(..)]] [const] [async] [unsafe] fn NAME`), and the
