@@ -382,7 +382,6 @@ const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("geometry/gltf/camera.rs", "animated_camera", 111),
     ("cli/run_config.rs", "from_args", 110),
     ("scene/user/models.rs", "chain", 104),
-    ("geometry/block_tree.rs", "build", 102),
 ];
 
 /// The name of the function a line declares (`[pub[(..)]] [const] [async] [unsafe] fn NAME`), and the
