@@ -381,7 +381,6 @@ const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("scene/user/chains.rs", "build", 112),
     ("geometry/gltf/camera.rs", "animated_camera", 111),
     ("cli/run_config.rs", "from_args", 110),
-    ("scene/user/models.rs", "chain", 104),
 ];
 
 /// The name of the function a line declares (`[pub[(..)]] [const] [async] [unsafe] fn NAME`), and the
