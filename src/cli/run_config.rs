@@ -52,30 +52,7 @@ impl SceneConfig {
         if a.count.contains(&0) {
             return Err(Error::Config("--count values must be at least 1".into()));
         }
-        if let Some(s) = &a.switch_distances {
-            if s.is_empty() || s.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
-                return Err(Error::Config(format!(
-                    "--switch-distances {s:?} must be positive numbers"
-                )));
-            }
-            if s.windows(2).any(|w| w[1] <= w[0]) {
-                return Err(Error::Config(format!(
-                    "--switch-distances {s:?} must increase"
-                )));
-            }
-        }
-        if let Some(s) = &a.switch_screen_sizes {
-            if s.is_empty() || s.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
-                return Err(Error::Config(format!(
-                    "--switch-screen-sizes {s:?} must be positive numbers"
-                )));
-            }
-            if s.windows(2).any(|w| w[1] >= w[0]) {
-                return Err(Error::Config(format!(
-                    "--switch-screen-sizes {s:?} must decrease (a coarser LOD at a smaller screen size)"
-                )));
-            }
-        }
+        check_switches(a)?;
         let schedule = ScheduleParams {
             fade: a.fade,
             band: a.band,
@@ -126,6 +103,36 @@ impl SceneConfig {
             shadows: a.shadow.resolve()?,
         })
     }
+}
+
+/// `--switch-distances` (positive, increasing) and `--switch-screen-sizes` (positive, decreasing), where
+/// given.
+fn check_switches(a: &SceneArgs) -> Result<()> {
+    if let Some(s) = &a.switch_distances {
+        if s.is_empty() || s.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
+            return Err(Error::Config(format!(
+                "--switch-distances {s:?} must be positive numbers"
+            )));
+        }
+        if s.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(Error::Config(format!(
+                "--switch-distances {s:?} must increase"
+            )));
+        }
+    }
+    if let Some(s) = &a.switch_screen_sizes {
+        if s.is_empty() || s.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(Error::Config(format!(
+                "--switch-screen-sizes {s:?} must be positive numbers"
+            )));
+        }
+        if s.windows(2).any(|w| w[1] >= w[0]) {
+            return Err(Error::Config(format!(
+                "--switch-screen-sizes {s:?} must decrease (a coarser LOD at a smaller screen size)"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Everything a run does, validated. Serialised into run.json as `config`.

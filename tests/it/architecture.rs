@@ -380,7 +380,6 @@ const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("results/answer.rs", "block_sentences", 115),
     ("scene/user/chains.rs", "build", 112),
     ("geometry/gltf/camera.rs", "animated_camera", 111),
-    ("cli/run_config.rs", "from_args", 110),
 ];
 
 /// The name of the function a line declares (`[pub[(..)]] [const] [async] [unsafe] fn NAME`), and the
