@@ -378,7 +378,6 @@ const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("scene/export_glb.rs", "glb_with", 120),
     ("results/answer.rs", "block_sentences", 115),
     ("scene/user/chains.rs", "build", 112),
-    ("geometry/gltf/camera.rs", "animated_camera", 111),
 ];
 
 /// The name of the function a line declares (`[pub[(..)]] [const] [async] [unsafe] fn NAME`), and the
