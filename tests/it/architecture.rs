@@ -373,7 +373,6 @@ const STRICT_FOLDERS: &[&str] = &["/measure/", "/commands/"];
 /// one that grew, and on a listed one that is now within the limit (so the list only shrinks).
 const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("scene/user/mod.rs", "def", 141),
-    ("scene/camera_path.rs", "parse", 141),
     ("geometry/gltf/primitives.rs", "primitive", 132),
     ("scene/export_glb.rs", "glb_with", 120),
     ("results/answer.rs", "block_sentences", 115),
