@@ -375,7 +375,6 @@ const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("scene/user/mod.rs", "def", 141),
     ("geometry/gltf/primitives.rs", "primitive", 132),
     ("scene/export_glb.rs", "glb_with", 120),
-    ("results/answer.rs", "block_sentences", 115),
     ("scene/user/chains.rs", "build", 112),
 ];
 
