@@ -375,7 +375,6 @@ const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("scene/user/mod.rs", "def", 141),
     ("geometry/gltf/primitives.rs", "primitive", 132),
     ("scene/export_glb.rs", "glb_with", 120),
-    ("scene/user/chains.rs", "build", 112),
 ];
 
 /// The name of the function a line declares (`[pub[(..)]] [const] [async] [unsafe] fn NAME`), and the
