@@ -373,7 +373,6 @@ const STRICT_FOLDERS: &[&str] = &["/measure/", "/commands/"];
 /// one that grew, and on a listed one that is now within the limit (so the list only shrinks).
 const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
     ("scene/user/mod.rs", "def", 141),
-    ("geometry/gltf/primitives.rs", "primitive", 132),
 ];
 
 /// The name of the function a line declares (`[pub[(..)]] [const] [async] [unsafe] fn NAME`), and the
