@@ -371,9 +371,7 @@ const STRICT_FOLDERS: &[&str] = &["/measure/", "/commands/"];
 /// The functions over the limits today, each at most as long as listed: (file under src/, function, lines).
 /// Split one and remove it here; the test fails on any function over its limit that is not listed, on a listed
 /// one that grew, and on a listed one that is now within the limit (so the list only shrinks).
-const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[
-    ("scene/user/mod.rs", "def", 141),
-];
+const OVER_THE_LIMIT: &[(&str, &str, usize)] = &[];
 
 /// The name of the function a line declares (`[pub[(..)]] [const] [async] [unsafe] fn NAME`), and the
 /// line's indentation.

@@ -10,7 +10,7 @@ use crate::geometry::lod::{self, LodChain};
 use crate::geometry::mesh::Mesh;
 use crate::scene::bunny::USER_SWITCH_FIT_MULTIPLES;
 use crate::scene::config::{screen_size_distance, SceneConfig};
-use crate::scene::kind::ProfileValues;
+use crate::scene::kind::{ProfileValues, SceneKind};
 use crate::scene::model::Model;
 use crate::scene::user::models::PendingModel;
 use crate::scene::user::parts::ChainDescription;
@@ -21,6 +21,23 @@ pub struct View<'a> {
     pub pv: &'a ProfileValues,
     pub fov_y: f32,
     pub pixel_error: f32,
+}
+
+impl<'a> View<'a> {
+    /// The view of scene `kind` with vertical field of view `fov_y`: its pixel error at the profile's height.
+    pub fn new(
+        kind: SceneKind,
+        cfg: &'a SceneConfig,
+        pv: &'a ProfileValues,
+        fov_y: f32,
+    ) -> View<'a> {
+        View {
+            cfg,
+            pv,
+            fov_y,
+            pixel_error: cfg.pixel_error(kind, pv.height),
+        }
+    }
 }
 
 /// The model of `pending` (file `file`): its chain and switch distances. `seen_from`: the nearest distance the
