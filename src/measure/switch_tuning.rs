@@ -523,7 +523,7 @@ pub fn tune_model(
 }
 
 /// The distances a model's pairs are measured over: from where it fills the viewport to where its bounding
-/// sphere spans a pixel (at least 1% farther), on a log grid.
+/// sphere's radius projects to one pixel (at least 1% farther), on a log grid.
 struct DistanceRange {
     near: f32,
     far: f32,
