@@ -52,30 +52,7 @@ impl SceneConfig {
         if a.count.contains(&0) {
             return Err(Error::Config("--count values must be at least 1".into()));
         }
-        if let Some(s) = &a.switch_distances {
-            if s.is_empty() || s.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
-                return Err(Error::Config(format!(
-                    "--switch-distances {s:?} must be positive numbers"
-                )));
-            }
-            if s.windows(2).any(|w| w[1] <= w[0]) {
-                return Err(Error::Config(format!(
-                    "--switch-distances {s:?} must increase"
-                )));
-            }
-        }
-        if let Some(s) = &a.switch_screen_sizes {
-            if s.is_empty() || s.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
-                return Err(Error::Config(format!(
-                    "--switch-screen-sizes {s:?} must be positive numbers"
-                )));
-            }
-            if s.windows(2).any(|w| w[1] >= w[0]) {
-                return Err(Error::Config(format!(
-                    "--switch-screen-sizes {s:?} must decrease (a coarser LOD at a smaller screen size)"
-                )));
-            }
-        }
+        check_switches(a)?;
         let schedule = ScheduleParams {
             fade: a.fade,
             band: a.band,
@@ -126,6 +103,36 @@ impl SceneConfig {
             shadows: a.shadow.resolve()?,
         })
     }
+}
+
+/// `--switch-distances` (positive, increasing) and `--switch-screen-sizes` (positive, decreasing), where
+/// given.
+fn check_switches(a: &SceneArgs) -> Result<()> {
+    if let Some(s) = &a.switch_distances {
+        if s.is_empty() || s.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
+            return Err(Error::Config(format!(
+                "--switch-distances {s:?} must be positive numbers"
+            )));
+        }
+        if s.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(Error::Config(format!(
+                "--switch-distances {s:?} must increase"
+            )));
+        }
+    }
+    if let Some(s) = &a.switch_screen_sizes {
+        if s.is_empty() || s.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(Error::Config(format!(
+                "--switch-screen-sizes {s:?} must be positive numbers"
+            )));
+        }
+        if s.windows(2).any(|w| w[1] >= w[0]) {
+            return Err(Error::Config(format!(
+                "--switch-screen-sizes {s:?} must decrease (a coarser LOD at a smaller screen size)"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Everything a run does, validated. Serialised into run.json as `config`.
@@ -198,6 +205,95 @@ pub struct ResolvedScene {
     pub baseline: Option<String>,
 }
 
+/// The scene flags that only some scenes take: `--animation` (a glTF scene among them), `--shadows on` (no
+/// unified scene).
+fn check_scene_flags(a: &RunArgs, scenes: &[SceneKind]) -> Result<()> {
+    if let Some(anim) = &a.scene_args.animation {
+        if !scenes.iter().any(|k| k.is_user()) {
+            return Err(Error::Config(format!(
+                "--animation {anim}: only glTF scenes (--scene FILE.glb) have animations, and none is among \
+                 the scenes"
+            )));
+        }
+    }
+    if a.scene_args.shadow.shadows == OnOff::On {
+        if let Some(scene) = scenes.iter().find(|k| k.is_unified()) {
+            return Err(Error::Config(format!(
+                "--shadows on: not built for the unified scenes yet (scene {}: its blocks and seams, and \
+                 clusterlod's cut, have no shadow casters); run it without --shadows",
+                scene.name()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The named methods that need a kind of scene: a unified one, or the terrain's height field.
+fn check_methods_fit(a: &RunArgs, scenes: &[SceneKind], methods: &[String]) -> Result<()> {
+    if let Some(scene) = scenes.iter().find(|k| !k.is_unified()) {
+        if let Some(m) = methods.iter().find(|m| crate::methods::needs_unified(m)) {
+            return Err(Error::Config(format!(
+                "method {m} needs a scene of one large mesh in blocks (bunny-halves, terrain); scene \
+                 {} is not one: run it with --scene bunny-halves or --scene terrain",
+                scene.name()
+            )));
+        }
+    }
+    let height_field = |k: &SceneKind| *k == SceneKind::Terrain && a.scene_args.mesh.is_none();
+    if let Some(scene) = scenes.iter().find(|k| !height_field(k)) {
+        if let Some(m) = methods
+            .iter()
+            .find(|m| crate::methods::needs_height_field(m))
+        {
+            return Err(Error::Config(format!(
+                "method {m} needs the terrain's height field: run it on --scene terrain without --mesh \
+                 (scene {}{} has none: a mesh is not a height field)",
+                scene.name(),
+                if a.scene_args.mesh.is_some() { " with --mesh" } else { "" }
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `--budget-lodpop` in (0, 1), the dump flags, and no flag that needs the quality pass with `--quality off`.
+fn check_budget_and_outputs(a: &RunArgs) -> Result<()> {
+    if let Some(b) = a.budget_lodpop {
+        if !(b > 0.0 && b < 1.0) {
+            return Err(Error::Config(format!(
+                "--budget-lodpop {b}: a lodpop budget is a change in (0, 1) (the RMS over the frame of a \
+                 switch's change, sRGB-encoded)"
+            )));
+        }
+    }
+    if a.dump_every == 0 {
+        return Err(Error::Config("--dump-every must be at least 1".into()));
+    }
+    if a.dump_transitions && !a.dump_frames {
+        return Err(Error::Config(
+            "--dump-transitions selects which frames --dump-frames writes: add --dump-frames"
+                .into(),
+        ));
+    }
+    if a.quality == OnOff::Off {
+        let needs = if a.dump_frames {
+            Some(("--dump-frames", "it writes the quality pass's frames"))
+        } else if a.metrics.contains(&Metric::De2000) {
+            Some(("--metrics de2000", "CIEDE2000 is measured in it"))
+        } else if a.metrics.contains(&Metric::Flip) {
+            Some(("--metrics flip", "FLIP is measured in it"))
+        } else {
+            None
+        };
+        if let Some((flag, why)) = needs {
+            return Err(Error::Config(format!(
+                "--quality off skips the quality pass, and {flag} needs it ({why}): drop one of the two"
+            )));
+        }
+    }
+    Ok(())
+}
+
 impl RunConfig {
     /// The flags checked against the built-in methods.
     pub fn from_args(a: &RunArgs) -> Result<RunConfig> {
@@ -212,48 +308,9 @@ impl RunConfig {
             return Err(Error::Config("--rounds must be at least 1".into()));
         }
         let methods_given = !a.method.is_empty();
-        if let Some(anim) = &a.scene_args.animation {
-            if !scenes.iter().any(|k| k.is_user()) {
-                return Err(Error::Config(format!(
-                    "--animation {anim}: only glTF scenes (--scene FILE.glb) have animations, and none is among \
-                     the scenes"
-                )));
-            }
-        }
-        if a.scene_args.shadow.shadows == OnOff::On {
-            if let Some(scene) = scenes.iter().find(|k| k.is_unified()) {
-                return Err(Error::Config(format!(
-                    "--shadows on: not built for the unified scenes yet (scene {}: its blocks and seams, and \
-                     clusterlod's cut, have no shadow casters); run it without --shadows",
-                    scene.name()
-                )));
-            }
-        }
+        check_scene_flags(a, &scenes)?;
         if methods_given {
-            if let Some(scene) = scenes.iter().find(|k| !k.is_unified()) {
-                if let Some(m) = methods.iter().find(|m| crate::methods::needs_unified(m)) {
-                    return Err(Error::Config(format!(
-                        "method {m} needs a scene of one large mesh in blocks (bunny-halves, terrain); scene \
-                         {} is not one: run it with --scene bunny-halves or --scene terrain",
-                        scene.name()
-                    )));
-                }
-            }
-            let height_field =
-                |k: &SceneKind| *k == SceneKind::Terrain && a.scene_args.mesh.is_none();
-            if let Some(scene) = scenes.iter().find(|k| !height_field(k)) {
-                if let Some(m) = methods
-                    .iter()
-                    .find(|m| crate::methods::needs_height_field(m))
-                {
-                    return Err(Error::Config(format!(
-                        "method {m} needs the terrain's height field: run it on --scene terrain without --mesh \
-                         (scene {}{} has none: a mesh is not a height field)",
-                        scene.name(),
-                        if a.scene_args.mesh.is_some() { " with --mesh" } else { "" }
-                    )));
-                }
-            }
+            check_methods_fit(a, &scenes, &methods)?;
         }
         let baseline = match &a.baseline {
             Some(b) if methods.iter().any(|m| m == b.trim()) => Some(b.trim().to_string()),
@@ -265,39 +322,7 @@ impl RunConfig {
             }
             None => None,
         };
-        if let Some(b) = a.budget_lodpop {
-            if !(b > 0.0 && b < 1.0) {
-                return Err(Error::Config(format!(
-                    "--budget-lodpop {b}: a lodpop budget is a change in (0, 1) (the RMS over the frame of a \
-                     switch's change, sRGB-encoded)"
-                )));
-            }
-        }
-        if a.dump_every == 0 {
-            return Err(Error::Config("--dump-every must be at least 1".into()));
-        }
-        if a.dump_transitions && !a.dump_frames {
-            return Err(Error::Config(
-                "--dump-transitions selects which frames --dump-frames writes: add --dump-frames"
-                    .into(),
-            ));
-        }
-        if a.quality == OnOff::Off {
-            let needs = if a.dump_frames {
-                Some(("--dump-frames", "it writes the quality pass's frames"))
-            } else if a.metrics.contains(&Metric::De2000) {
-                Some(("--metrics de2000", "CIEDE2000 is measured in it"))
-            } else if a.metrics.contains(&Metric::Flip) {
-                Some(("--metrics flip", "FLIP is measured in it"))
-            } else {
-                None
-            };
-            if let Some((flag, why)) = needs {
-                return Err(Error::Config(format!(
-                    "--quality off skips the quality pass, and {flag} needs it ({why}): drop one of the two"
-                )));
-            }
-        }
+        check_budget_and_outputs(a)?;
         let mut cfg = RunConfig {
             scenes,
             methods,

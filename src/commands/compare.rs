@@ -9,7 +9,7 @@
 
 use crate::cli::CompareArgs;
 use crate::error::{Error, Result};
-use crate::measure::records::{Clock, FrameRecord, PairedRatios, Ratio};
+use crate::measure::records::{Clock, FrameRecord, FrameTimes, PairedRatios, Ratio};
 use crate::results::csv::read_frame_times;
 use std::path::Path;
 
@@ -65,10 +65,53 @@ pub fn compare(
     count: Option<u32>,
 ) -> Result<Vec<BlockComparison>> {
     let times = read_frame_times(dir)?;
+    let grouped = group_blocks(dir, times.rows)?;
+    for m in [a, b] {
+        require_listed(dir, "method", m, &grouped.methods)?;
+    }
+    if let Some(s) = scene {
+        require_listed(dir, "scene", s, &grouped.scenes)?;
+    }
+    let mut out = Vec::new();
+    for block in &grouped.blocks {
+        if scene.is_some_and(|s| s != block.scene) || count.is_some_and(|n| n != block.count) {
+            continue;
+        }
+        if let Some(c) = compare_block(&times.lead_header, block, a, b) {
+            out.push(c);
+        }
+    }
+    if out.is_empty() {
+        let filter = match (scene, count) {
+            (None, None) => String::new(),
+            (s, n) => format!(
+                " of{}{}",
+                s.map_or(String::new(), |s| format!(" scene {s}")),
+                n.map_or(String::new(), |n| format!(" count {n}"))
+            ),
+        };
+        return Err(Error::results(
+            dir,
+            format!("has no block{filter} with both {a} and {b} in frames.csv"),
+        ));
+    }
+    Ok(out)
+}
+
+/// frames.csv's rows grouped into blocks, with the methods and scenes they name, each in first-seen order.
+struct Grouped {
+    blocks: Vec<Block>,
+    methods: Vec<String>,
+    scenes: Vec<String>,
+}
+
+/// Groups `dir`'s frames.csv `rows` (leading values, times) into blocks of their leading values, scene and
+/// count. Errors where a row has no timing round.
+fn group_blocks(dir: &Path, rows: Vec<(Vec<String>, FrameTimes)>) -> Result<Grouped> {
     let mut blocks: Vec<Block> = Vec::new();
     let mut methods: Vec<String> = Vec::new();
     let mut scenes: Vec<String> = Vec::new();
-    for (lead, t) in times.rows {
+    for (lead, t) in rows {
         if !methods.contains(&t.method) {
             methods.push(t.method.clone());
         }
@@ -103,74 +146,58 @@ pub fn compare(
             None => block.methods.push((rec.method.clone(), vec![rec])),
         }
     }
-    for m in [a, b] {
-        if !methods.iter().any(|x| x == m) {
-            return Err(Error::results(
-                dir,
-                format!(
-                    "has no method '{m}' in frames.csv; its methods: {}",
-                    methods.join(", ")
-                ),
-            ));
-        }
-    }
-    if let Some(s) = scene {
-        if !scenes.iter().any(|x| x == s) {
-            return Err(Error::results(
-                dir,
-                format!(
-                    "has no scene '{s}' in frames.csv; its scenes: {}",
-                    scenes.join(", ")
-                ),
-            ));
-        }
-    }
-    let mut out = Vec::new();
-    for block in &blocks {
-        if scene.is_some_and(|s| s != block.scene) || count.is_some_and(|n| n != block.count) {
-            continue;
-        }
-        let rows = |m: &str| {
-            block
-                .methods
-                .iter()
-                .find(|(x, _)| x == m)
-                .map(|(_, r)| r.as_slice())
-        };
-        let (Some(ra), Some(rb)) = (rows(a), rows(b)) else {
-            continue;
-        };
-        let clock = Clock::of(block.methods.iter().flat_map(|(_, r)| r));
-        let name: Vec<String> = times
-            .lead_header
-            .iter()
-            .zip(&block.lead)
-            .map(|(h, v)| format!("{h}={v}"))
-            .chain([block.scene.clone(), format!("count {}", block.count)])
-            .collect();
-        out.push(BlockComparison {
-            block: name.join(", "),
-            scene: block.scene.clone(),
-            count: block.count,
-            clock,
-            ratios: PairedRatios::new(ra, rb, clock),
-        });
-    }
-    if out.is_empty() {
-        let filter = match (scene, count) {
-            (None, None) => String::new(),
-            (s, n) => format!(
-                " of{}{}",
-                s.map_or(String::new(), |s| format!(" scene {s}")),
-                n.map_or(String::new(), |n| format!(" count {n}"))
-            ),
-        };
+    Ok(Grouped {
+        blocks,
+        methods,
+        scenes,
+    })
+}
+
+/// An error naming `dir` unless `name` is among the `listed` values of frames.csv's column `kind`.
+fn require_listed(dir: &Path, kind: &str, name: &str, listed: &[String]) -> Result<()> {
+    if !listed.iter().any(|x| x == name) {
         return Err(Error::results(
             dir,
-            format!("has no block{filter} with both {a} and {b} in frames.csv"),
+            format!(
+                "has no {kind} '{name}' in frames.csv; its {kind}s: {}",
+                listed.join(", ")
+            ),
         ));
     }
-    Ok(out)
+    Ok(())
+}
+
+/// A over B in `block` (named by `lead_header`'s values, its scene and count); None unless it holds both.
+fn compare_block(
+    lead_header: &[String],
+    block: &Block,
+    a: &str,
+    b: &str,
+) -> Option<BlockComparison> {
+    let rows = |m: &str| {
+        block
+            .methods
+            .iter()
+            .find(|(x, _)| x == m)
+            .map(|(_, r)| r.as_slice())
+    };
+    let (Some(ra), Some(rb)) = (rows(a), rows(b)) else {
+        return None;
+    };
+    let clock = Clock::of(block.methods.iter().flat_map(|(_, r)| r));
+    let name: Vec<String> = lead_header
+        .iter()
+        .zip(&block.lead)
+        .map(|(h, v)| format!("{h}={v}"))
+        .chain([block.scene.clone(), format!("count {}", block.count)])
+        .collect();
+    Some(BlockComparison {
+        block: name.join(", "),
+        scene: block.scene.clone(),
+        count: block.count,
+        clock,
+        ratios: PairedRatios::new(ra, rb, clock),
+    })
 }
 
 /// The lines `compare` prints for one block.

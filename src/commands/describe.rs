@@ -112,6 +112,13 @@ fn print_blocks(d: &SceneDescription) {
         u.cluster_levels,
         u.clusterlod_bytes as f64 / (1 << 20) as f64
     );
+    print_cut(d);
+    print_hierarchy(d);
+    outln!("(every block's LODs and switch distances: --json)");
+}
+
+/// The clusterlod cut along the camera path, where the description has one.
+fn print_cut(d: &SceneDescription) {
     if let Some(c) = &d.cut {
         outln!(
             "clusterlod cut along the path (pixel error {}, {} frames, means): {:.0} triangles; of {:.0} groups with \
@@ -130,6 +137,10 @@ fn print_blocks(d: &SceneDescription) {
             c.worst.over
         );
     }
+}
+
+/// The blocks-tree's levels, where the scene has one.
+fn print_hierarchy(d: &SceneDescription) {
     if let Some(h) = &d.hierarchy {
         let levels: Vec<String> = h
             .levels
@@ -149,7 +160,6 @@ fn print_blocks(d: &SceneDescription) {
             h.build_ms
         );
     }
-    outln!("(every block's LODs and switch distances: --json)");
 }
 
 /// Each model's LODs and switch distances.

@@ -68,39 +68,7 @@ pub fn execute(args: &OverheadArgs) -> Result<()> {
         options: Default::default(),
         seed: args.seed,
     };
-    let progress = indicatif::ProgressBar::hidden();
-    let (mut rows, mut blocks) = (Vec::new(), Vec::new());
-    for def in &defs {
-        let warmup = args.warmup.unwrap_or_else(|| cfg.resolved(def.kind).warmup);
-        for &count in &def.counts {
-            let scene = def.instantiate(count);
-            let block = BlockGpu::new(&ctx, &scene, setup.clone())?;
-            if block.gpu.materials.is_some() {
-                return Err(Error::Config(format!(
-                    "scene {}: the bare draw draws one colour per model, and this scene has materials; run it \
-                     with --materials flat",
-                    def.name()
-                )));
-            }
-            check_same_image(&block, "reference")?;
-            let mut prepared =
-                block.prepare_methods(&methods, warmup, args.seed, false, &progress)?;
-            let block_seed = args.seed ^ ((blocks.len() as u64 + 1) << 32);
-            let (r, orders) = measure(&block, &mut prepared, (args.rounds, block_seed), &progress)?;
-            ctx.check_errors()?;
-            outln!("{} n={count}: {} rounds", def.name(), args.rounds);
-            rows.extend(r);
-            blocks.push(BlockOrders {
-                scene: def.name(),
-                count,
-                width: scene.width,
-                height: scene.height,
-                frames: scene.frames,
-                warmup,
-                orders,
-            });
-        }
-    }
+    let (rows, blocks) = measure_blocks(&ctx, args, &cfg, &defs, &methods, setup)?;
     write_whole(&out, "overhead.csv", &rows)?;
     let manifest = OverheadManifest {
         lodbench_version: env!("CARGO_PKG_VERSION"),
@@ -128,6 +96,52 @@ pub fn execute(args: &OverheadArgs) -> Result<()> {
     );
     outln!("results in {}", out.display());
     Ok(())
+}
+
+/// Every block of every scene (`defs`, each at each of its counts): the bare draw checked against the
+/// reference, then `methods` and the bare draw timed in `args.rounds` rounds; the rows and each block's orders.
+fn measure_blocks(
+    ctx: &GpuContext,
+    args: &OverheadArgs,
+    cfg: &SceneConfig,
+    defs: &[SceneDef],
+    methods: &[String],
+    setup: MethodSetup,
+) -> Result<(Vec<OverheadRecord>, Vec<BlockOrders>)> {
+    let progress = indicatif::ProgressBar::hidden();
+    let (mut rows, mut blocks) = (Vec::new(), Vec::new());
+    for def in defs {
+        let warmup = args.warmup.unwrap_or_else(|| cfg.resolved(def.kind).warmup);
+        for &count in &def.counts {
+            let scene = def.instantiate(count);
+            let block = BlockGpu::new(ctx, &scene, setup.clone())?;
+            if block.gpu.materials.is_some() {
+                return Err(Error::Config(format!(
+                    "scene {}: the bare draw draws one colour per model, and this scene has materials; run it \
+                     with --materials flat",
+                    def.name()
+                )));
+            }
+            check_same_image(&block, "reference")?;
+            let mut prepared =
+                block.prepare_methods(methods, warmup, args.seed, false, &progress)?;
+            let block_seed = args.seed ^ ((blocks.len() as u64 + 1) << 32);
+            let (r, orders) = measure(&block, &mut prepared, (args.rounds, block_seed), &progress)?;
+            ctx.check_errors()?;
+            outln!("{} n={count}: {} rounds", def.name(), args.rounds);
+            rows.extend(r);
+            blocks.push(BlockOrders {
+                scene: def.name(),
+                count,
+                width: scene.width,
+                height: scene.height,
+                frames: scene.frames,
+                warmup,
+                orders,
+            });
+        }
+    }
+    Ok((rows, blocks))
 }
 
 /// Scenes the bare draw cannot stand beside: their draw is more than instances of one pipeline.

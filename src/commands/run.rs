@@ -9,7 +9,7 @@ use crate::measure::records::{
     pair_records, round_records, BlockInfo, Clock, FrameRecord, PairRecord, RoundRecord,
     SummaryRecord, TransitionRecord,
 };
-use crate::measure::{BlockRunner, FrameImages, MethodSetup, QualityOptions};
+use crate::measure::{BlockOutput, BlockRunner, FrameImages, MethodSetup, QualityOptions};
 use crate::methods::{is_reference, Registry};
 use crate::results::csv::{
     write_pairs, write_rounds, write_summary, write_transitions, FramesWriter,
@@ -280,6 +280,50 @@ fn progress_bar(total: u64) -> ProgressBar {
     progress
 }
 
+/// The quality pass's options for a block of `methods` methods.
+fn quality_options(cfg: &RunConfig, methods: usize) -> QualityOptions {
+    QualityOptions {
+        metrics: cfg.metrics.clone(),
+        reduction: cfg.metric_reduction,
+        region: cfg.metric_region,
+        timing_only: !cfg.quality_pass(),
+        schedule: cfg.quality_schedule,
+        // Kept only for a block whose quality pass runs more than one method.
+        reference_cache_bytes: if methods > 1 {
+            cfg.reference_cache_mib << 20
+        } else {
+            0
+        },
+    }
+}
+
+/// Writes each method's rows to frames.csv and its transitions and block info to the run's, returning the
+/// measured methods in the order they were listed (pairs.csv's a before b).
+fn record_outputs(
+    outputs: Vec<BlockOutput>,
+    methods: &[String],
+    manifest: &mut RunManifest,
+    output: &mut RunOutput,
+) -> Result<Vec<MeasuredMethod>> {
+    let mut measured = Vec::new();
+    for out in outputs {
+        output.frames_csv.write_block(&out.rows)?;
+        output.transitions.extend(out.transitions);
+        measured.push(MeasuredMethod {
+            extra_target_bytes: out.info.extra_target_bytes,
+            rows: out.rows,
+        });
+        manifest.blocks.push(out.info);
+    }
+    // The reported methods in the order they were listed (pairs.csv's a before b).
+    measured.sort_by_key(|m| {
+        m.rows
+            .first()
+            .and_then(|r| methods.iter().position(|l| *l == r.method))
+    });
+    Ok(measured)
+}
+
 impl RunJob<'_> {
     /// Scene block `def` with `count` instances, the `block_index`-th of the run: its methods' rounds (timing,
     /// then quality pass, round by round), their summaries and rounds.
@@ -301,19 +345,7 @@ impl RunJob<'_> {
             options: cfg.method_options,
             seed: cfg.seed,
         };
-        let quality = QualityOptions {
-            metrics: cfg.metrics.clone(),
-            reduction: cfg.metric_reduction,
-            region: cfg.metric_region,
-            timing_only: !cfg.quality_pass(),
-            schedule: cfg.quality_schedule,
-            // Kept only for a block whose quality pass runs more than one method.
-            reference_cache_bytes: if methods.len() > 1 {
-                cfg.reference_cache_mib << 20
-            } else {
-                0
-            },
-        };
+        let quality = quality_options(cfg, methods.len());
         let mut block =
             BlockRunner::new(&self.ctx, &scene, setup, self.dumper.is_some(), &quality)?;
         block.dump_transitions_only(cfg.dump_transitions);
@@ -334,22 +366,8 @@ impl RunJob<'_> {
             &self.progress,
             |method, f, images| self.dump(&scene, method, f, images),
         )?;
-        let mut measured = Vec::new();
-        for out in outputs {
-            output.frames_csv.write_block(&out.rows)?;
-            output.transitions.extend(out.transitions);
-            measured.push(MeasuredMethod {
-                extra_target_bytes: out.info.extra_target_bytes,
-                rows: out.rows,
-            });
-            manifest.blocks.push(out.info);
-        }
-        // The reported methods in the order they were listed (pairs.csv's a before b), and the block's one clock.
-        measured.sort_by_key(|m| {
-            m.rows
-                .first()
-                .and_then(|r| methods.iter().position(|l| *l == r.method))
-        });
+        let measured = record_outputs(outputs, &methods, manifest, output)?;
+        // The block's one clock.
         let clock = Clock::of(measured.iter().flat_map(|m| &m.rows));
         summarise(
             cfg,
@@ -431,7 +449,38 @@ fn summarise(
 /// significant figures, triangles with thousands separators, ratios with their interval; full precision in the
 /// CSVs), then the answer (`results::answer`) and what the columns mean.
 pub fn summary_table(s: &RunSummary) -> String {
-    use crate::results::answer::{aligned, answers, ratio, sig3, thousands};
+    use crate::results::answer::{aligned, answers};
+    let right = [
+        false, false, true, true, true, true, true, true, true, true, true, true, false,
+    ];
+    let mut out = aligned(&summary_rows(s), &right);
+    let said = answers(&s.summaries, &s.pairs, s.budget_lodpop);
+    if said.iter().any(|a| !a.sentences.is_empty()) {
+        out.push('\n');
+        for a in &said {
+            for sentence in &a.sentences {
+                out.push_str(sentence);
+                out.push('\n');
+            }
+        }
+        out.push('\n');
+    }
+    let baseline = s.summaries.iter().find_map(|r| r.baseline.clone());
+    out.push_str(&format!(
+        "gpu ms and cpu ms are medians; q/r = quality-pass time per frame / the timing-pass time of the \
+         renders it makes (method, reference where drawn, lodpop's counterfactual where drawn), paired by round \
+         (geometric mean; its interval in run.json); time / baseline = time over {}'s, paired by timing round, \
+         geometric mean and 95 % t interval over rounds (every other pair: pairs.csv, lodbench compare DIR A B); \
+         '-' = not measured (no timestamps; --quality off: no image figures); full precision in summary.csv\n",
+        baseline.as_deref().unwrap_or("the baseline (none run)")
+    ));
+    push_notes(&mut out, s);
+    out
+}
+
+/// The summary table's header and one row of cells per summary.
+fn summary_rows(s: &RunSummary) -> Vec<Vec<String>> {
+    use crate::results::answer::{ratio, sig3, thousands};
     let mut rows = vec![[
         "scene",
         "method",
@@ -475,30 +524,12 @@ pub fn summary_table(s: &RunSummary) -> String {
             ),
         ]);
     }
-    let right = [
-        false, false, true, true, true, true, true, true, true, true, true, true, false,
-    ];
-    let mut out = aligned(&rows, &right);
-    let said = answers(&s.summaries, &s.pairs, s.budget_lodpop);
-    if said.iter().any(|a| !a.sentences.is_empty()) {
-        out.push('\n');
-        for a in &said {
-            for sentence in &a.sentences {
-                out.push_str(sentence);
-                out.push('\n');
-            }
-        }
-        out.push('\n');
-    }
-    let baseline = s.summaries.iter().find_map(|r| r.baseline.clone());
-    out.push_str(&format!(
-        "gpu ms and cpu ms are medians; q/r = quality-pass time per frame / the timing-pass time of the \
-         renders it makes (method, reference where drawn, lodpop's counterfactual where drawn), paired by round \
-         (geometric mean; its interval in run.json); time / baseline = time over {}'s, paired by timing round, \
-         geometric mean and 95 % t interval over rounds (every other pair: pairs.csv, lodbench compare DIR A B); \
-         '-' = not measured (no timestamps; --quality off: no image figures); full precision in summary.csv\n",
-        baseline.as_deref().unwrap_or("the baseline (none run)")
-    ));
+    rows
+}
+
+/// The notes under the table: each block whose adapter changed speed during it (not on a CPU adapter), and
+/// each block's material limits.
+fn push_notes(out: &mut String, s: &RunSummary) {
     let mut said = Vec::new();
     for b in &s.blocks {
         if s.cpu_adapter {
@@ -525,7 +556,6 @@ pub fn summary_table(s: &RunSummary) -> String {
             out.push_str(&format!("note: {} {}: {limit}\n", b.scene, b.method));
         }
     }
-    out
 }
 
 #[cfg(test)]

@@ -14,8 +14,8 @@ use crate::measure::switch_tuning::{
 };
 use crate::results::csv::write_whole;
 use crate::results::engines::{self, EngineModel};
-use crate::scene::{SceneConfig, SceneDef, SceneKind};
-use glam::Quat;
+use crate::scene::{Scene, SceneConfig, SceneDef, SceneKind};
+use glam::{Quat, Vec3};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -129,38 +129,9 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
     let ctx = GpuContext::new(args.adapter.as_deref())?;
     let views = view_directions(settings.views, settings.seed);
     let mut jod = jod_of(args, &settings, scene.width, scene.height)?;
-    let mut camera = ModelCamera::new(&ctx, &scene)?;
-    let mut samples: Vec<Sample> = Vec::new();
-    let mut models = Vec::new();
-    for (m, model) in scene.models.iter().enumerate() {
-        if model.chain.lods.len() < 2 {
-            continue;
-        }
-        let Some(inst) = scene.instances.iter().find(|i| i.model as usize == m) else {
-            continue;
-        };
-        let rotation = Quat::from_rotation_y(inst.yaw) * inst.rotation;
-        models.push(tune_model(
-            &mut camera,
-            m as u32,
-            rotation,
-            &settings,
-            &views,
-            &mut jod,
-            &mut samples,
-        )?);
-    }
-    let engine_models: Vec<EngineModel> = models.iter().map(|m| engine_model(m, None)).collect();
+    let (models, samples) = tune_models(&ctx, &scene, &settings, &views, &mut jod)?;
     write_samples(&out, &samples)?;
-    write_engines(&out, &engine_models, scene.fov_y)?;
-    if settings.speed.is_some() {
-        // The engines that cross-fade: Unity and Bevy dither (LOD cross-fade shaders, Bevy's visibility-range
-        // fade), Godot blends (its fade modes change the node's transparency).
-        let with = |b: &str| -> Vec<EngineModel> {
-            models.iter().map(|m| engine_model(m, Some(b))).collect()
-        };
-        write_fading(&out, &with("dither"), &with("alpha"), scene.fov_y)?;
-    }
+    let engine_models = write_engine_tables(&out, &models, &settings, scene.fov_y)?;
     let tuned = tuned_scene(&scene, &models);
     let glb = crate::scene::export_glb::glb_with(&tuned, false)?;
     write(&out.join("tuned.glb"), &glb)?;
@@ -182,22 +153,81 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
         serde_json::to_string_pretty(&manifest)?.as_bytes(),
     )?;
     write_rules(&out, &models)?;
-    out!("{}", table(&models, settings.budget));
-    out!("{}", rules_table(&models));
+    print_results(&out, &models, settings.budget);
+    Ok(())
+}
+
+/// Tunes every model of `scene` with at least two LODs and an instance (drawn alone, at its first instance's
+/// rotation): the models' switches, and every sample measured.
+fn tune_models(
+    ctx: &GpuContext,
+    scene: &Scene,
+    settings: &TuneSettings,
+    views: &[Vec3],
+    jod: &mut PairScore,
+) -> Result<(Vec<ModelSwitches>, Vec<Sample>)> {
+    let mut camera = ModelCamera::new(ctx, scene)?;
+    let mut samples: Vec<Sample> = Vec::new();
+    let mut models = Vec::new();
+    for (m, model) in scene.models.iter().enumerate() {
+        if model.chain.lods.len() < 2 {
+            continue;
+        }
+        let Some(inst) = scene.instances.iter().find(|i| i.model as usize == m) else {
+            continue;
+        };
+        let rotation = Quat::from_rotation_y(inst.yaw) * inst.rotation;
+        models.push(tune_model(
+            &mut camera,
+            m as u32,
+            rotation,
+            settings,
+            views,
+            jod,
+            &mut samples,
+        )?);
+    }
+    Ok((models, samples))
+}
+
+/// Writes the engines' settings for the tuned switches, and with `--speed` the cross-fading engines'; returns
+/// the hard-switch engines' models (tune.json's `engines`).
+fn write_engine_tables(
+    out: &Path,
+    models: &[ModelSwitches],
+    settings: &TuneSettings,
+    fov_y: f32,
+) -> Result<Vec<EngineModel>> {
+    let engine_models: Vec<EngineModel> = models.iter().map(|m| engine_model(m, None)).collect();
+    write_engines(out, &engine_models, fov_y)?;
+    if settings.speed.is_some() {
+        // The engines that cross-fade: Unity and Bevy dither (LOD cross-fade shaders, Bevy's visibility-range
+        // fade), Godot blends (its fade modes change the node's transparency).
+        let with = |b: &str| -> Vec<EngineModel> {
+            models.iter().map(|m| engine_model(m, Some(b))).collect()
+        };
+        write_fading(out, &with("dither"), &with("alpha"), fov_y)?;
+    }
+    Ok(engine_models)
+}
+
+/// Prints the switches' and the rules' tables, where the results are, and the commands that use them.
+fn print_results(out: &Path, models: &[ModelSwitches], budget: Budget) {
+    out!("{}", table(models, budget));
+    out!("{}", rules_table(models));
     outln!("results in {}", out.display());
     outln!(
         "figures: python3 scripts/plot.py {}; the rules along a path: python3 scripts/tune_rules.py {}",
         out.display(),
         out.display()
     );
-    if let Budget::Lodpop(x) = settings.budget {
+    if let Budget::Lodpop(x) = budget {
         outln!(
             "every method with these switches, answered within the budget: lodbench run --scene {} \
              --budget-lodpop {x}",
             out.join("tuned.glb").display()
         );
     }
-    Ok(())
 }
 
 /// Scores two frames (RGBA8).

@@ -82,24 +82,29 @@ pub struct Cut {
     pub translucent: Vec<(u32, f32, bool)>,
 }
 
+/// An error unless `mesh` is a grid of `cells` x `cells` quads (`geometry::terrain::terrain_mesh`'s).
+fn check_grid(mesh: &Mesh, cells: u32) -> Result<()> {
+    let row = cells + 1;
+    if mesh.positions.len() != (row * row) as usize
+        || mesh.indices.len() != (6 * cells * cells) as usize
+    {
+        return Err(Error::Config(format!(
+            "blocks-tree needs the terrain's grid of {cells} x {cells} cells; the mesh has {} vertices and {} \
+             triangles",
+            mesh.positions.len(),
+            mesh.indices.len() / 3
+        )));
+    }
+    Ok(())
+}
+
 impl BlockTree {
     /// The hierarchy of `mesh`, a grid of `cells` x `cells` quads as `geometry::terrain::terrain_mesh` makes
     /// it, over `blocks` x `blocks` leaves.
     pub fn build(mesh: &Mesh, cells: u32, blocks: u32) -> Result<BlockTree> {
         let started = std::time::Instant::now();
-        let row = cells + 1;
-        if mesh.positions.len() != (row * row) as usize
-            || mesh.indices.len() != (6 * cells * cells) as usize
-        {
-            return Err(Error::Config(format!(
-                "blocks-tree needs the terrain's grid of {cells} x {cells} cells; the mesh has {} vertices and {} \
-                 triangles",
-                mesh.positions.len(),
-                mesh.indices.len() / 3
-            )));
-        }
+        check_grid(mesh, cells)?;
         let blocks = blocks.clamp(1, cells);
-        let edge = |b: u32, n: u32| (b as u64 * cells as u64 / n as u64) as u32;
         let bytes: &[u8] = bytemuck::cast_slice(&mesh.positions);
         let adapter = meshopt::VertexDataAdapter::new(bytes, 12, 0).map_err(|e| {
             Error::Config(format!("blocks-tree: meshopt rejected the vertices: {e}"))
@@ -112,21 +117,7 @@ impl BlockTree {
             build_ms: 0.0,
         };
         // Leaves, then each level from the one below, 2 x 2 at a time.
-        let mut level: Vec<Vec<u32>> = Vec::new();
-        for bj in 0..blocks {
-            let mut r = Vec::new();
-            for bi in 0..blocks {
-                let region = [
-                    edge(bi, blocks),
-                    edge(bi + 1, blocks),
-                    edge(bj, blocks),
-                    edge(bj + 1, blocks),
-                ];
-                let indices = region_indices(mesh, cells, region);
-                r.push(tree.push_node(mesh, 0, region, indices, 0.0, Vec::new()));
-            }
-            level.push(r);
-        }
+        let mut level = tree.push_leaves(mesh, blocks);
         let mut locks = vec![false; mesh.positions.len()];
         let mut l = 0;
         while level.len() > 1 || level[0].len() > 1 {
@@ -179,13 +170,40 @@ impl BlockTree {
             level = next;
         }
         tree.root = level[0][0];
-        for k in 0..tree.nodes.len() {
-            for c in tree.nodes[k].children.clone() {
-                tree.nodes[c as usize].parent = Some(k as u32);
-            }
-        }
+        tree.link_parents();
         tree.build_ms = started.elapsed().as_secs_f64() * 1e3;
         Ok(tree)
+    }
+
+    /// The `blocks` x `blocks` leaves, each the mesh's full triangles over its cells: their nodes by row.
+    fn push_leaves(&mut self, mesh: &Mesh, blocks: u32) -> Vec<Vec<u32>> {
+        let cells = self.cells;
+        let edge = |b: u32, n: u32| (b as u64 * cells as u64 / n as u64) as u32;
+        let mut level: Vec<Vec<u32>> = Vec::new();
+        for bj in 0..blocks {
+            let mut r = Vec::new();
+            for bi in 0..blocks {
+                let region = [
+                    edge(bi, blocks),
+                    edge(bi + 1, blocks),
+                    edge(bj, blocks),
+                    edge(bj + 1, blocks),
+                ];
+                let indices = region_indices(mesh, cells, region);
+                r.push(self.push_node(mesh, 0, region, indices, 0.0, Vec::new()));
+            }
+            level.push(r);
+        }
+        level
+    }
+
+    /// Sets every node's parent from its parent's children.
+    fn link_parents(&mut self) {
+        for k in 0..self.nodes.len() {
+            for c in self.nodes[k].children.clone() {
+                self.nodes[c as usize].parent = Some(k as u32);
+            }
+        }
     }
 
     fn push_node(

@@ -238,24 +238,29 @@ fn build(ctx: &PipelineContext<'_>, d: &MeshPipeline<'_>, shadow: bool) -> MeshP
     }
 }
 
-fn mesh_pipeline_from(
-    ctx: &PipelineContext<'_>,
-    d: &MeshPipeline<'_>,
-    shadow: bool,
-    class: MaterialClass,
-) -> wgpu::RenderPipeline {
-    let device = ctx.device;
+/// The pipeline layout of `d`: the camera's group, the method's own, and the materials' at
+/// [`MATERIAL_GROUP`] where the scene has them (empty groups between).
+fn mesh_pipeline_layout(ctx: &PipelineContext<'_>, d: &MeshPipeline<'_>) -> wgpu::PipelineLayout {
     let mut layouts: Vec<Option<&wgpu::BindGroupLayout>> = vec![Some(ctx.camera_layout)];
     layouts.extend(d.extra_layouts.iter().map(|l| Some(*l)));
     if let Some(m) = ctx.material_layout {
         layouts.resize(MATERIAL_GROUP as usize, None);
         layouts.push(Some(m));
     }
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(d.label),
-        bind_group_layouts: &layouts,
-        immediate_size: 0,
-    });
+    ctx.device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(d.label),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        })
+}
+
+/// The vertex buffer slots of `d`: vertices, instances, the morph targets (`d.morph`), and with the PBR
+/// surface the surface vertices and their morph targets; trailing empty slots dropped.
+fn mesh_vertex_buffers(
+    ctx: &PipelineContext<'_>,
+    d: &MeshPipeline<'_>,
+) -> Vec<Option<wgpu::VertexBufferLayout<'static>>> {
     const MORPH: [wgpu::VertexAttribute; 2] =
         wgpu::vertex_attr_array![8 => Float32x3, 9 => Float32x3];
     const SURFACE: [wgpu::VertexAttribute; 3] =
@@ -284,6 +289,15 @@ fn mesh_pipeline_from(
     while buffers.last().is_some_and(Option::is_none) {
         buffers.pop();
     }
+    buffers
+}
+
+/// The colour targets of `d` in `class`: the colour (blended over where the class blends and `d` names no
+/// blend), and `d`'s id target.
+fn mesh_color_targets(
+    d: &MeshPipeline<'_>,
+    class: MaterialClass,
+) -> Vec<Option<wgpu::ColorTargetState>> {
     let blend = match (class.blends(), d.blend) {
         (true, Some(b)) => Some(b),
         (true, None) => Some(BLEND_OVER),
@@ -306,6 +320,36 @@ fn mesh_pipeline_from(
             },
         }));
     }
+    targets
+}
+
+/// The faces `d` culls in `class`: its own in a shadow pass, back faces for a single-sided class, else its own
+/// or the scene's.
+fn mesh_cull(
+    ctx: &PipelineContext<'_>,
+    d: &MeshPipeline<'_>,
+    shadow: bool,
+    class: MaterialClass,
+) -> Option<wgpu::Face> {
+    if shadow {
+        d.cull
+    } else if class.culls() {
+        Some(wgpu::Face::Back)
+    } else {
+        d.cull.or(ctx.cull)
+    }
+}
+
+fn mesh_pipeline_from(
+    ctx: &PipelineContext<'_>,
+    d: &MeshPipeline<'_>,
+    shadow: bool,
+    class: MaterialClass,
+) -> wgpu::RenderPipeline {
+    let device = ctx.device;
+    let layout = mesh_pipeline_layout(ctx, d);
+    let buffers = mesh_vertex_buffers(ctx, d);
+    let targets = mesh_color_targets(d, class);
     let constants: &[(&str, f64)] = if ctx.alpha_test {
         &[("ALPHA_TEST", 1.0)]
     } else {
@@ -323,13 +367,7 @@ fn mesh_pipeline_from(
             (None, true) => (Some("fs_depth_masked"), &[]),
             (None, false) => (None, &[]),
         };
-    let cull = if shadow {
-        d.cull
-    } else if class.culls() {
-        Some(wgpu::Face::Back)
-    } else {
-        d.cull.or(ctx.cull)
-    };
+    let cull = mesh_cull(ctx, d, shadow, class);
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(d.label),
         layout: Some(&layout),

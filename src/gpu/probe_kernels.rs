@@ -156,161 +156,37 @@ impl Probes {
     pub fn new(ctx: &GpuContext, (width, height): (u32, u32), amounts: Amounts) -> Result<Probes> {
         ctx.check_viewport(width * 2, height)?;
         let d = &ctx.device;
-        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("probe.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(PROBE_WGSL.into()),
-        });
-        let read_module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("probe_read.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(PROBE_READ_WGSL.into()),
-        });
+        let (module, read_module) = probe_modules(d);
         let params_layout = uniform_layout(d);
         let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("probe"),
             bind_group_layouts: &[Some(&params_layout)],
             immediate_size: 0,
         });
-        let render = |label: &str, vs: &str, blend: Option<wgpu::BlendState>, depth_only: bool| {
-            render_pipeline(d, &layout, &module, label, vs, blend, depth_only)
-        };
-        let texture = |label: &str, w: u32, format| {
-            d.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            })
-            .create_view(&Default::default())
-        };
-        let param = |w: u32, grid: u32| {
-            let words: [u32; 4] = [(w as f32).to_bits(), (height as f32).to_bits(), 0, grid];
-            let buffer = buffer_with(
-                d,
-                "probe params",
-                bytemuck::cast_slice(&words),
-                wgpu::BufferUsages::UNIFORM,
-            );
-            d.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("probe params"),
-                layout: &params_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: buffer.as_entire_binding(),
-                }],
-            })
-        };
-        let max_patches = amounts.patches as u64 * 2;
-        let indices: Vec<u32> = (0..max_patches as u32)
-            .flat_map(|p| PATCH.iter().map(move |&i| p * PATCH_VERTICES + i))
-            .collect();
-        let bytes = amounts.bytes * 2;
-        let source = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("probe read source"),
-            size: bytes.max(16),
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
-        let sink = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("probe read sink"),
-            size: 16,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
-        let read = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("probe bandwidth"),
-            layout: None,
-            module: &read_module,
-            entry_point: Some("cs_read"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        let read_group = |vec4s: u64, reads: u32| {
-            let words: [u32; 4] = [vec4s as u32, reads, 0, 0];
-            let params = buffer_with(
-                d,
-                "probe read params",
-                bytemuck::cast_slice(&words),
-                wgpu::BufferUsages::UNIFORM,
-            );
-            d.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("probe read"),
-                layout: &read.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: source.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: sink.as_entire_binding(),
-                    },
-                ],
-            })
-        };
-        let vec4s = amounts.bytes / 16;
-        if vec4s * 2 > u32::MAX as u64 {
-            return Err(Error::Config(format!(
-                "probe: {} bytes is more than the bandwidth probe addresses",
-                amounts.bytes
-            )));
-        }
+        let (source, sink) = read_buffers(d, amounts.bytes * 2);
+        let read = read_pipeline(d, &read_module);
+        let vec4s = bandwidth_vec4s(amounts)?;
+        let [patches, patches_instanced, degenerate, fill_opaque, fill_blended, depth] =
+            render_pipelines(d, &layout, &module);
+        let (color, depth_view) = targets(d, width, height);
+        let params = param_groups(d, &params_layout, width, height);
+        let (patch_indices, one_patch) = index_buffers(d, amounts.patches);
+        let reads = read_groups(d, &read, (&source, &sink), vec4s);
         let probes = Probes {
             amounts,
             size: (width, height),
-            patches: render("probe triangles", "vs_patches", None, false),
-            patches_instanced: render(
-                "probe triangles instanced",
-                "vs_patches_instanced",
-                None,
-                false,
-            ),
-            degenerate: render("probe vertices", "vs_degenerate", None, false),
-            fill_opaque: render("probe fill opaque", "vs_layer", None, false),
-            fill_blended: render(
-                "probe fill blended",
-                "vs_layer",
-                Some(wgpu::BlendState::ALPHA_BLENDING),
-                false,
-            ),
-            depth: render("probe depth", "vs_layer", None, true),
-            color: [
-                texture("probe target", width, COLOR),
-                texture("probe control target", width * 2, COLOR),
-            ],
-            depth_view: texture("probe depth", width, DEPTH),
-            params: [
-                [param(width, 1), param(width, 2)],
-                [param(width * 2, 1), param(width * 2, 2)],
-            ],
-            patch_indices: buffer_with(
-                d,
-                "probe patch indices",
-                bytemuck::cast_slice(&indices),
-                wgpu::BufferUsages::INDEX,
-            ),
-            one_patch: buffer_with(
-                d,
-                "probe one patch",
-                bytemuck::cast_slice(&PATCH),
-                wgpu::BufferUsages::INDEX,
-            ),
-            reads: [
-                read_group(vec4s, 1),
-                read_group(vec4s * 2, 1),
-                read_group(vec4s, 2),
-            ],
+            patches,
+            patches_instanced,
+            degenerate,
+            fill_opaque,
+            fill_blended,
+            depth,
+            color,
+            depth_view,
+            params,
+            patch_indices,
+            one_patch,
+            reads,
             read,
         };
         ctx.check_errors()?;
@@ -442,6 +318,213 @@ impl Probes {
 const PATCH: [u32; 24] = [
     0, 1, 3, 1, 4, 3, 1, 2, 4, 2, 5, 4, 3, 4, 6, 4, 7, 6, 4, 5, 7, 5, 8, 7,
 ];
+
+/// probe.wgsl's module (the render probes) and probe_read.wgsl's (the bandwidth probe).
+fn probe_modules(d: &wgpu::Device) -> (wgpu::ShaderModule, wgpu::ShaderModule) {
+    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("probe.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(PROBE_WGSL.into()),
+    });
+    let read_module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("probe_read.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(PROBE_READ_WGSL.into()),
+    });
+    (module, read_module)
+}
+
+/// The bandwidth probe's source (`bytes` long, at least 16) and its small sink.
+fn read_buffers(d: &wgpu::Device, bytes: u64) -> (wgpu::Buffer, wgpu::Buffer) {
+    let source = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("probe read source"),
+        size: bytes.max(16),
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    let sink = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("probe read sink"),
+        size: 16,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    (source, sink)
+}
+
+/// The bandwidth probe's compute pipeline (its layout from the shader).
+fn read_pipeline(d: &wgpu::Device, read_module: &wgpu::ShaderModule) -> wgpu::ComputePipeline {
+    d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("probe bandwidth"),
+        layout: None,
+        module: read_module,
+        entry_point: Some("cs_read"),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+/// The base bandwidth probe's 16-byte reads, or an error where the doubled count is beyond a u32.
+fn bandwidth_vec4s(amounts: Amounts) -> Result<u64> {
+    let vec4s = amounts.bytes / 16;
+    if vec4s * 2 > u32::MAX as u64 {
+        return Err(Error::Config(format!(
+            "probe: {} bytes is more than the bandwidth probe addresses",
+            amounts.bytes
+        )));
+    }
+    Ok(vec4s)
+}
+
+/// The render probes' pipelines: patches, one patch instanced, degenerate triangles, opaque and blended fill,
+/// depth alone.
+fn render_pipelines(
+    d: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+) -> [wgpu::RenderPipeline; 6] {
+    let render = |label: &str, vs: &str, blend: Option<wgpu::BlendState>, depth_only: bool| {
+        render_pipeline(d, layout, module, label, vs, blend, depth_only)
+    };
+    [
+        render("probe triangles", "vs_patches", None, false),
+        render(
+            "probe triangles instanced",
+            "vs_patches_instanced",
+            None,
+            false,
+        ),
+        render("probe vertices", "vs_degenerate", None, false),
+        render("probe fill opaque", "vs_layer", None, false),
+        render(
+            "probe fill blended",
+            "vs_layer",
+            Some(wgpu::BlendState::ALPHA_BLENDING),
+            false,
+        ),
+        render("probe depth", "vs_layer", None, true),
+    ]
+}
+
+/// The colour targets' views (`width`, and the control's twice that) and the depth target's view.
+fn targets(
+    d: &wgpu::Device,
+    width: u32,
+    height: u32,
+) -> ([wgpu::TextureView; 2], wgpu::TextureView) {
+    let texture = |label: &str, w: u32, format| {
+        d.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: w,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
+    };
+    let color = [
+        texture("probe target", width, COLOR),
+        texture("probe control target", width * 2, COLOR),
+    ];
+    (color, texture("probe depth", width, DEPTH))
+}
+
+/// The render probes' parameter bind groups: [target, control target] x grid [1, 2].
+fn param_groups(
+    d: &wgpu::Device,
+    params_layout: &wgpu::BindGroupLayout,
+    width: u32,
+    height: u32,
+) -> [[wgpu::BindGroup; 2]; 2] {
+    let param = |w: u32, grid: u32| {
+        let words: [u32; 4] = [(w as f32).to_bits(), (height as f32).to_bits(), 0, grid];
+        let buffer = buffer_with(
+            d,
+            "probe params",
+            bytemuck::cast_slice(&words),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("probe params"),
+            layout: params_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: buffer.as_entire_binding(),
+            }],
+        })
+    };
+    [
+        [param(width, 1), param(width, 2)],
+        [param(width * 2, 1), param(width * 2, 2)],
+    ]
+}
+
+/// The indices of twice `patches` patches, and of one patch.
+fn index_buffers(d: &wgpu::Device, patches: u32) -> (wgpu::Buffer, wgpu::Buffer) {
+    let max_patches = patches as u64 * 2;
+    let indices: Vec<u32> = (0..max_patches as u32)
+        .flat_map(|p| PATCH.iter().map(move |&i| p * PATCH_VERTICES + i))
+        .collect();
+    let patch_indices = buffer_with(
+        d,
+        "probe patch indices",
+        bytemuck::cast_slice(&indices),
+        wgpu::BufferUsages::INDEX,
+    );
+    let one_patch = buffer_with(
+        d,
+        "probe one patch",
+        bytemuck::cast_slice(&PATCH),
+        wgpu::BufferUsages::INDEX,
+    );
+    (patch_indices, one_patch)
+}
+
+/// The bandwidth probe's bind groups over `(source, sink)`: base, doubled (twice the reads), control (half
+/// the invocations, each reading twice).
+fn read_groups(
+    d: &wgpu::Device,
+    read: &wgpu::ComputePipeline,
+    (source, sink): (&wgpu::Buffer, &wgpu::Buffer),
+    vec4s: u64,
+) -> [wgpu::BindGroup; 3] {
+    let read_group = |vec4s: u64, reads: u32| {
+        let words: [u32; 4] = [vec4s as u32, reads, 0, 0];
+        let params = buffer_with(
+            d,
+            "probe read params",
+            bytemuck::cast_slice(&words),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("probe read"),
+            layout: &read.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: source.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: sink.as_entire_binding(),
+                },
+            ],
+        })
+    };
+    [
+        read_group(vec4s, 1),
+        read_group(vec4s * 2, 1),
+        read_group(vec4s, 2),
+    ]
+}
 
 fn uniform_layout(d: &wgpu::Device) -> wgpu::BindGroupLayout {
     d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

@@ -234,221 +234,37 @@ impl SceneGpu {
     /// without shadows.
     pub fn with_shadow_maps(ctx: &GpuContext, scene: &Scene, lit: usize) -> Result<SceneGpu> {
         let device = &ctx.device;
-        let mut vertices: Vec<Vertex> = Vec::new();
-        let mut indices: Vec<u32> = Vec::new();
-        let mut lods = Vec::new();
-        let mut parts: Vec<PartRange> = Vec::new();
         let pbr = !scene.materials.is_empty();
-        let mut surface_vertices: Vec<SurfaceVertex> = Vec::new();
         let deformed = deformed_models(scene);
-        for (mi, model) in scene.models.iter().enumerate() {
-            let mut ranges = Vec::new();
-            for lod in &model.chain.lods {
-                let m = &lod.mesh;
-                let first_part = parts.len() as u32;
-                if pbr {
-                    for p in &m.parts {
-                        let material = &scene.materials.materials[p.material as usize];
-                        parts.push(PartRange {
-                            first_index: indices.len() as u32 + p.first_index,
-                            index_count: p.index_count,
-                            material: p.material,
-                            class: MaterialClass::new(
-                                !material.double_sided,
-                                material.alpha == crate::geometry::material::AlphaMode::Blend,
-                            ),
-                        });
-                    }
-                    surface_vertices.extend((0..m.vertex_count()).map(|v| surface_vertex(m, v)));
-                }
-                ranges.push(LodRange {
-                    base_vertex: i32::try_from(vertices.len())
-                        .map_err(|_| Error::Gpu("scene has too many vertices".into()))?,
-                    first_index: indices.len() as u32,
-                    index_count: m.indices.len() as u32,
-                    parts: (first_part, parts.len() as u32 - first_part),
-                });
-                if deformed.contains(&(mi as u32)) {
-                    vertices.extend(
-                        m.positions
-                            .iter()
-                            .zip(&m.normals)
-                            .map(|(p, n)| deformed_vertex(*p, *n, *p)),
-                    );
-                } else {
-                    vertices.extend(m.positions.iter().zip(&m.normals).zip(&m.aux).map(
-                        |((p, n), a)| Vertex {
-                            position: *p,
-                            normal: *n,
-                            aux: *a,
-                        },
-                    ));
-                }
-                indices.extend_from_slice(&m.indices);
-            }
-            lods.push(ranges);
-        }
-        let seam_base = lods.len() as u32;
-        for seam in scene.unified.iter().flat_map(|u| &u.seams) {
-            let mut ranges = Vec::new();
-            for m in &seam.meshes {
-                ranges.push(LodRange {
-                    base_vertex: i32::try_from(vertices.len())
-                        .map_err(|_| Error::Gpu("scene has too many vertices".into()))?,
-                    first_index: indices.len() as u32,
-                    index_count: m.indices.len() as u32,
-                    parts: (0, 0),
-                });
-                vertices.extend(m.positions.iter().zip(&m.normals).map(|(p, n)| Vertex {
-                    position: *p,
-                    normal: *n,
-                    aux: [0.0; 4],
-                }));
-                indices.extend_from_slice(&m.indices);
-            }
-            lods.push(ranges);
-        }
-        let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene vertices"),
-            contents: bytemuck::cast_slice(&vertices),
-            usage: if deformed.is_empty() {
-                wgpu::BufferUsages::VERTEX
-            } else {
-                wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST
-            },
-        });
-        let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene indices"),
-            contents: bytemuck::cast_slice(&indices),
-            usage: wgpu::BufferUsages::INDEX,
-        });
-        let camera_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("camera uniform"),
-            size: std::mem::size_of::<CameraRaw>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let camera_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("camera layout"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
-            ],
-        });
+        let geometry = SceneGeometry::gather(scene, pbr, &deformed)?;
+        let (vertex_buffer, index_buffer) = geometry.buffers(device, !deformed.is_empty());
+        let camera_buffer = camera_buffer(device);
+        let camera_layout = camera_layout(device);
         let shadow_size = scene.shadows.map_or(1, |s| s.size);
-        let maps = if scene.shadows.is_some() { 1 + lit } else { 1 };
-        let shadow_maps: Vec<wgpu::Texture> = (0..maps)
-            .map(|i| {
-                let side = if i == ShadowMap::NONE.index() {
-                    1
-                } else {
-                    shadow_size
-                };
-                texture_2d(
-                    device,
-                    &format!("shadow map {i}"),
-                    (side, side),
-                    crate::formats::DEPTH_FORMAT,
-                    ATTACHMENT_READ,
-                )
-            })
-            .collect();
+        let shadow_maps = shadow_maps(device, scene, lit, shadow_size);
         let shadow_views: Vec<wgpu::TextureView> = shadow_maps
             .iter()
             .map(|t| t.create_view(&Default::default()))
             .collect();
-        let shadow_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("shadow sampler"),
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            compare: Some(wgpu::CompareFunction::LessEqual),
-            ..Default::default()
-        });
-        let camera_groups = shadow_views
-            .iter()
-            .map(|view| {
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("camera bind group"),
-                    layout: &camera_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: camera_buffer.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::TextureView(view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: wgpu::BindingResource::Sampler(&shadow_sampler),
-                        },
-                    ],
-                })
-            })
-            .collect();
+        let shadow_sampler = shadow_sampler(device);
+        let camera_groups = camera_groups(
+            device,
+            &camera_layout,
+            &camera_buffer,
+            &shadow_views,
+            &shadow_sampler,
+        );
         let surface = if pbr { Surface::Pbr } else { Surface::Flat };
-        let flat_shader = pbr.then(|| {
-            device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("surface/flat.wgsl + mesh.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(mesh_wgsl(Surface::Flat).into()),
-            })
-        });
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(match surface {
-                Surface::Flat => "surface/flat.wgsl + mesh.wgsl",
-                Surface::Pbr => "surface/pbr.wgsl + mesh.wgsl",
-            }),
-            source: wgpu::ShaderSource::Wgsl(mesh_wgsl(surface).into()),
-        });
-        let alpha_test = scene.materials.any_mask()
-            || scene.models.iter().any(|m| {
-                m.chain.lods.iter().any(|l| {
-                    l.mesh.aux.iter().any(|a| {
-                        a[2] == crate::geometry::mesh::AUX_LEAF
-                            || a[2] == crate::geometry::mesh::AUX_LEAF_CLUSTER
-                    })
-                })
-            });
+        let (shader, flat_shader) = mesh_shaders(device, surface);
+        let alpha_test = needs_alpha_test(scene);
         let cull = scene.unified.is_some().then_some(wgpu::Face::Back);
-        let mut classes: Vec<MaterialClass> = parts.iter().map(|p| p.class).collect();
-        classes.sort();
-        classes.dedup();
-        if classes.is_empty() {
-            classes.push(MaterialClass::PLAIN);
-        }
+        let classes = material_classes(&geometry.parts);
         let materials = pbr
             .then(|| {
                 MaterialsGpu::new(
                     ctx,
                     &scene.materials,
-                    &surface_vertices,
+                    &geometry.surface_vertices,
                     !deformed.is_empty(),
                 )
             })
@@ -472,8 +288,8 @@ impl SceneGpu {
             queue: ctx.queue.clone(),
             vertex_buffer,
             index_buffer,
-            lods,
-            seam_base,
+            lods: geometry.lods,
+            seam_base: geometry.seam_base,
             camera_buffer,
             camera_layout,
             camera_groups,
@@ -485,7 +301,7 @@ impl SceneGpu {
             shader,
             flat_shader,
             surface,
-            parts,
+            parts: geometry.parts,
             classes,
             materials,
             opaque_pipeline,
@@ -865,4 +681,308 @@ impl SceneGpu {
         }
         stats
     }
+}
+
+/// The scene's meshes laid end to end on the CPU, as [`SceneGpu`] uploads them: every model's LODs, then every
+/// seam's meshes.
+struct SceneGeometry {
+    vertices: Vec<Vertex>,
+    indices: Vec<u32>,
+    lods: Vec<Vec<LodRange>>,
+    seam_base: u32,
+    parts: Vec<PartRange>,
+    /// One per vertex of the models' LODs (PBR surface only).
+    surface_vertices: Vec<SurfaceVertex>,
+}
+
+impl SceneGeometry {
+    /// Gathers the models' LODs (with their material parts and surface vertices when `pbr`; the `deformed`
+    /// models' rest positions in `aux`), then the unified scene's seams.
+    fn gather(scene: &Scene, pbr: bool, deformed: &[u32]) -> Result<SceneGeometry> {
+        let mut g = SceneGeometry {
+            vertices: Vec::new(),
+            indices: Vec::new(),
+            lods: Vec::new(),
+            seam_base: 0,
+            parts: Vec::new(),
+            surface_vertices: Vec::new(),
+        };
+        for (mi, model) in scene.models.iter().enumerate() {
+            let mut ranges = Vec::new();
+            for lod in &model.chain.lods {
+                ranges.push(g.push_lod(scene, &lod.mesh, pbr, deformed.contains(&(mi as u32)))?);
+            }
+            g.lods.push(ranges);
+        }
+        g.seam_base = g.lods.len() as u32;
+        for seam in scene.unified.iter().flat_map(|u| &u.seams) {
+            let mut ranges = Vec::new();
+            for m in &seam.meshes {
+                ranges.push(g.push_seam_mesh(m)?);
+            }
+            g.lods.push(ranges);
+        }
+        Ok(g)
+    }
+
+    /// The base vertex of the next mesh appended.
+    fn next_base_vertex(&self) -> Result<i32> {
+        i32::try_from(self.vertices.len())
+            .map_err(|_| Error::Gpu("scene has too many vertices".into()))
+    }
+
+    /// Appends one LOD mesh of a model (and its parts and surface vertices when `pbr`), returning its range.
+    fn push_lod(
+        &mut self,
+        scene: &Scene,
+        m: &crate::geometry::mesh::Mesh,
+        pbr: bool,
+        deformed: bool,
+    ) -> Result<LodRange> {
+        let first_part = self.parts.len() as u32;
+        if pbr {
+            for p in &m.parts {
+                let material = &scene.materials.materials[p.material as usize];
+                self.parts.push(PartRange {
+                    first_index: self.indices.len() as u32 + p.first_index,
+                    index_count: p.index_count,
+                    material: p.material,
+                    class: MaterialClass::new(
+                        !material.double_sided,
+                        material.alpha == crate::geometry::material::AlphaMode::Blend,
+                    ),
+                });
+            }
+            self.surface_vertices
+                .extend((0..m.vertex_count()).map(|v| surface_vertex(m, v)));
+        }
+        let range = LodRange {
+            base_vertex: self.next_base_vertex()?,
+            first_index: self.indices.len() as u32,
+            index_count: m.indices.len() as u32,
+            parts: (first_part, self.parts.len() as u32 - first_part),
+        };
+        if deformed {
+            self.vertices.extend(
+                m.positions
+                    .iter()
+                    .zip(&m.normals)
+                    .map(|(p, n)| deformed_vertex(*p, *n, *p)),
+            );
+        } else {
+            self.vertices
+                .extend(
+                    m.positions
+                        .iter()
+                        .zip(&m.normals)
+                        .zip(&m.aux)
+                        .map(|((p, n), a)| Vertex {
+                            position: *p,
+                            normal: *n,
+                            aux: *a,
+                        }),
+                );
+        }
+        self.indices.extend_from_slice(&m.indices);
+        Ok(range)
+    }
+
+    /// Appends one mesh of a seam (no parts, `aux` zero), returning its range.
+    fn push_seam_mesh(&mut self, m: &crate::scene::model::SeamMesh) -> Result<LodRange> {
+        let range = LodRange {
+            base_vertex: self.next_base_vertex()?,
+            first_index: self.indices.len() as u32,
+            index_count: m.indices.len() as u32,
+            parts: (0, 0),
+        };
+        self.vertices
+            .extend(m.positions.iter().zip(&m.normals).map(|(p, n)| Vertex {
+                position: *p,
+                normal: *n,
+                aux: [0.0; 4],
+            }));
+        self.indices.extend_from_slice(&m.indices);
+        Ok(range)
+    }
+
+    /// The vertex buffer (writable when some model deforms) and the index buffer.
+    fn buffers(&self, device: &wgpu::Device, deforms: bool) -> (wgpu::Buffer, wgpu::Buffer) {
+        let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene vertices"),
+            contents: bytemuck::cast_slice(&self.vertices),
+            usage: if deforms {
+                wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST
+            } else {
+                wgpu::BufferUsages::VERTEX
+            },
+        });
+        let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene indices"),
+            contents: bytemuck::cast_slice(&self.indices),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        (vertex_buffer, index_buffer)
+    }
+}
+
+/// The camera uniform buffer ([`CameraRaw`]).
+fn camera_buffer(device: &wgpu::Device) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("camera uniform"),
+        size: std::mem::size_of::<CameraRaw>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Group 0's layout: the camera uniform, a shadow map and its comparison sampler.
+fn camera_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("camera layout"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                count: None,
+            },
+        ],
+    })
+}
+
+/// The shadow maps: the 1x1 placeholder, then `lit` maps of `shadow_size` texels a side under `--shadows on`.
+fn shadow_maps(
+    device: &wgpu::Device,
+    scene: &Scene,
+    lit: usize,
+    shadow_size: u32,
+) -> Vec<wgpu::Texture> {
+    let maps = if scene.shadows.is_some() { 1 + lit } else { 1 };
+    (0..maps)
+        .map(|i| {
+            let side = if i == ShadowMap::NONE.index() {
+                1
+            } else {
+                shadow_size
+            };
+            texture_2d(
+                device,
+                &format!("shadow map {i}"),
+                (side, side),
+                crate::formats::DEPTH_FORMAT,
+                ATTACHMENT_READ,
+            )
+        })
+        .collect()
+}
+
+/// The comparison sampler the shadow maps are read with.
+fn shadow_sampler(device: &wgpu::Device) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("shadow sampler"),
+        address_mode_u: wgpu::AddressMode::ClampToEdge,
+        address_mode_v: wgpu::AddressMode::ClampToEdge,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        compare: Some(wgpu::CompareFunction::LessEqual),
+        ..Default::default()
+    })
+}
+
+/// The camera's bind group with each shadow map's view.
+fn camera_groups(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    camera_buffer: &wgpu::Buffer,
+    shadow_views: &[wgpu::TextureView],
+    shadow_sampler: &wgpu::Sampler,
+) -> Vec<wgpu::BindGroup> {
+    shadow_views
+        .iter()
+        .map(|view| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("camera bind group"),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: camera_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::Sampler(shadow_sampler),
+                    },
+                ],
+            })
+        })
+        .collect()
+}
+
+/// The mesh shader with the scene's `surface`, and (with the PBR surface) the flat one besides, built first.
+fn mesh_shaders(
+    device: &wgpu::Device,
+    surface: Surface,
+) -> (wgpu::ShaderModule, Option<wgpu::ShaderModule>) {
+    let flat_shader = (surface == Surface::Pbr).then(|| {
+        device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("surface/flat.wgsl + mesh.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(mesh_wgsl(Surface::Flat).into()),
+        })
+    });
+    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(match surface {
+            Surface::Flat => "surface/flat.wgsl + mesh.wgsl",
+            Surface::Pbr => "surface/pbr.wgsl + mesh.wgsl",
+        }),
+        source: wgpu::ShaderSource::Wgsl(mesh_wgsl(surface).into()),
+    });
+    (shader, flat_shader)
+}
+
+/// Whether the scene has alpha-tested geometry: masked materials, or leaf cards.
+fn needs_alpha_test(scene: &Scene) -> bool {
+    scene.materials.any_mask()
+        || scene.models.iter().any(|m| {
+            m.chain.lods.iter().any(|l| {
+                l.mesh.aux.iter().any(|a| {
+                    a[2] == crate::geometry::mesh::AUX_LEAF
+                        || a[2] == crate::geometry::mesh::AUX_LEAF_CLUSTER
+                })
+            })
+        })
+}
+
+/// The distinct material classes of the parts, sorted; the plain class alone when there are none.
+fn material_classes(parts: &[PartRange]) -> Vec<MaterialClass> {
+    let mut classes: Vec<MaterialClass> = parts.iter().map(|p| p.class).collect();
+    classes.sort();
+    classes.dedup();
+    if classes.is_empty() {
+        classes.push(MaterialClass::PLAIN);
+    }
+    classes
 }

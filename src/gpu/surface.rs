@@ -217,6 +217,84 @@ impl Cache<'_> {
             })
             .clone()
     }
+
+    /// The views and samplers of `m`'s five texture slots, in binding order (`placeholder` and the default
+    /// sampler where a slot has no texture).
+    fn slot_bindings(
+        &mut self,
+        m: &Material,
+        placeholder: &wgpu::TextureView,
+    ) -> (Vec<wgpu::TextureView>, Vec<wgpu::Sampler>) {
+        let slots: [(TextureSlot, &Option<TextureRef>); 5] = [
+            (TextureSlot::BaseColor, &m.base_color_texture),
+            (
+                TextureSlot::MetallicRoughness,
+                &m.metallic_roughness_texture,
+            ),
+            (TextureSlot::Normal, &m.normal_texture),
+            (TextureSlot::Occlusion, &m.occlusion_texture),
+            (TextureSlot::Emissive, &m.emissive_texture),
+        ];
+        let mut views = Vec::with_capacity(5);
+        let mut samplers = Vec::with_capacity(5);
+        for (slot, t) in slots {
+            match t {
+                Some(t) => {
+                    views.push(self.view(t.image, slot.is_srgb()));
+                    samplers.push(self.sampler(t.sampler));
+                }
+                None => {
+                    views.push(placeholder.clone());
+                    samplers.push(self.sampler(Sampler::default()));
+                }
+            }
+        }
+        (views, samplers)
+    }
+
+    /// Material `m`'s bind group (group 2): its uniform, its slots' views and samplers, the split-sum table.
+    fn material_group(
+        &mut self,
+        m: &Material,
+        layout: &wgpu::BindGroupLayout,
+        placeholder: &wgpu::TextureView,
+        dfg: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        let ctx = self.ctx;
+        let uniform = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("material uniform"),
+                contents: bytemuck::bytes_of(&MaterialRaw::of(m)),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+        let (views, samplers) = self.slot_bindings(m, placeholder);
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: uniform.as_entire_binding(),
+        }];
+        for (k, v) in views.iter().enumerate() {
+            entries.push(wgpu::BindGroupEntry {
+                binding: 1 + k as u32,
+                resource: wgpu::BindingResource::TextureView(v),
+            });
+        }
+        for (k, s) in samplers.iter().enumerate() {
+            entries.push(wgpu::BindGroupEntry {
+                binding: 6 + k as u32,
+                resource: wgpu::BindingResource::Sampler(s),
+            });
+        }
+        entries.push(wgpu::BindGroupEntry {
+            binding: 11,
+            resource: dfg.as_entire_binding(),
+        });
+        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("material"),
+            layout,
+            entries: &entries,
+        })
+    }
 }
 
 impl MaterialsGpu {
@@ -236,92 +314,11 @@ impl MaterialsGpu {
             samplers: HashMap::new(),
             bytes: 0,
         };
-        // What a material without a texture binds in its place (never sampled: the uniform says it is absent).
-        let placeholder = {
-            let texture = device.create_texture_with_data(
-                &ctx.queue,
-                &wgpu::TextureDescriptor {
-                    label: Some("no texture"),
-                    size: wgpu::Extent3d {
-                        width: 1,
-                        height: 1,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: wgpu::TextureFormat::Rgba8Unorm,
-                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                    view_formats: &[],
-                },
-                wgpu::util::TextureDataOrder::LayerMajor,
-                &[255, 255, 255, 255],
-            );
-            texture.create_view(&Default::default())
-        };
-        // The split-sum table every material reads (shaders/surface/pbr.wgsl `dfg`), made once per process.
-        static DFG: std::sync::OnceLock<Vec<[f32; 2]>> = std::sync::OnceLock::new();
-        let dfg = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("split-sum table"),
-            contents: bytemuck::cast_slice(DFG.get_or_init(crate::geometry::material::dfg_table)),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        let placeholder = placeholder_view(ctx);
+        let dfg = dfg_buffer(device);
         let mut groups = Vec::with_capacity(materials.materials.len());
         for m in &materials.materials {
-            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("material uniform"),
-                contents: bytemuck::bytes_of(&MaterialRaw::of(m)),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let slots: [(TextureSlot, &Option<TextureRef>); 5] = [
-                (TextureSlot::BaseColor, &m.base_color_texture),
-                (
-                    TextureSlot::MetallicRoughness,
-                    &m.metallic_roughness_texture,
-                ),
-                (TextureSlot::Normal, &m.normal_texture),
-                (TextureSlot::Occlusion, &m.occlusion_texture),
-                (TextureSlot::Emissive, &m.emissive_texture),
-            ];
-            let mut views = Vec::with_capacity(5);
-            let mut samplers = Vec::with_capacity(5);
-            for (slot, t) in slots {
-                match t {
-                    Some(t) => {
-                        views.push(cache.view(t.image, slot.is_srgb()));
-                        samplers.push(cache.sampler(t.sampler));
-                    }
-                    None => {
-                        views.push(placeholder.clone());
-                        samplers.push(cache.sampler(Sampler::default()));
-                    }
-                }
-            }
-            let mut entries = vec![wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniform.as_entire_binding(),
-            }];
-            for (k, v) in views.iter().enumerate() {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 1 + k as u32,
-                    resource: wgpu::BindingResource::TextureView(v),
-                });
-            }
-            for (k, s) in samplers.iter().enumerate() {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 6 + k as u32,
-                    resource: wgpu::BindingResource::Sampler(s),
-                });
-            }
-            entries.push(wgpu::BindGroupEntry {
-                binding: 11,
-                resource: dfg.as_entire_binding(),
-            });
-            groups.push(device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("material"),
-                layout: &layout,
-                entries: &entries,
-            }));
+            groups.push(cache.material_group(m, &layout, &placeholder, &dfg));
         }
         let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("surface vertices"),
@@ -341,4 +338,39 @@ impl MaterialsGpu {
             texture_bytes,
         })
     }
+}
+
+/// What a material without a texture binds in its place (never sampled: the uniform says it is absent): a
+/// white 1x1 texture's view.
+fn placeholder_view(ctx: &GpuContext) -> wgpu::TextureView {
+    let texture = ctx.device.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("no texture"),
+            size: wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &[255, 255, 255, 255],
+    );
+    texture.create_view(&Default::default())
+}
+
+/// The split-sum table every material reads (shaders/surface/pbr.wgsl `dfg`), computed once per process.
+fn dfg_buffer(device: &wgpu::Device) -> wgpu::Buffer {
+    static DFG: std::sync::OnceLock<Vec<[f32; 2]>> = std::sync::OnceLock::new();
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("split-sum table"),
+        contents: bytemuck::cast_slice(DFG.get_or_init(crate::geometry::material::dfg_table)),
+        usage: wgpu::BufferUsages::UNIFORM,
+    })
 }

@@ -139,12 +139,73 @@ fn measure_variants(
         .flat_map(|&p| variants.iter().map(move |&v| (p, v)))
         .collect();
     let rounds = rounds.max(2);
+    let times = time_items(ctx, probes, &items, rounds, seed)?;
+    Ok(PROBES
+        .iter()
+        .map(|&p| probe_record(probes, p, &items, &times, rounds))
+        .collect())
+}
+
+/// Each item's time per round on both clocks.
+struct ItemTimes {
+    /// time[item][round] on the GPU's clock (NaN where no timestamp came back).
+    gpu: Vec<Vec<f64>>,
+    /// The same on the CPU's, less an empty submission's time.
+    cpu: Vec<Vec<f64>>,
+    /// Every slot has a positive timestamp.
+    stamped: bool,
+}
+
+/// Times every item once per round (after an untimed warm-up), in a fresh random order each round.
+fn time_items(
+    ctx: &GpuContext,
+    probes: &Probes,
+    items: &[(Probe, Variant)],
+    rounds: u32,
+    seed: u64,
+) -> Result<ItemTimes> {
     let total = items.len() as u32 * rounds;
     let timer = GpuTimer::new(ctx, total);
     // Warm-up: every item once, untimed (pipelines compiled, buffers resident).
-    for &item in &items {
+    for &item in items {
         submit(ctx, probes, item, None)?;
     }
+    let timed = run_rounds(ctx, probes, items, (rounds, seed), timer.as_ref())?;
+    let gpu_ms = match &timer {
+        Some(t) => t.read(ctx)?,
+        None => vec![None; timed.slots.len()],
+    };
+    let stamped = gpu_ms.iter().all(|t| t.is_some_and(|t| t > 0.0));
+    let overhead = percentile(&timed.empty_ms, 50.0).unwrap_or(0.0);
+    // time[item][round] on each clock; the CPU's less an empty submission's time.
+    let mut gpu = vec![vec![f64::NAN; rounds as usize]; items.len()];
+    let mut cpu = gpu.clone();
+    for ((&(round, k), g), &c) in timed.slots.iter().zip(&gpu_ms).zip(&timed.cpu_ms) {
+        gpu[k][round as usize] = g.unwrap_or(f64::NAN);
+        cpu[k][round as usize] = (c - overhead).max(1e-6);
+    }
+    Ok(ItemTimes { gpu, cpu, stamped })
+}
+
+/// The timed slots of [`run_rounds`].
+struct Slots {
+    /// (round, item index) of each timed slot, and its CPU time.
+    slots: Vec<(u32, usize)>,
+    cpu_ms: Vec<f64>,
+    /// An empty submission's CPU time, per round: what the CPU clock adds to a probe's work.
+    empty_ms: Vec<f64>,
+}
+
+/// `rounds` rounds of every item, each round an empty submission and then the items in an order shuffled from
+/// `seed`, each timed at the next slot of `timer` where there is one.
+fn run_rounds(
+    ctx: &GpuContext,
+    probes: &Probes,
+    items: &[(Probe, Variant)],
+    (rounds, seed): (u32, u64),
+    timer: Option<&GpuTimer>,
+) -> Result<Slots> {
+    let total = items.len() as u32 * rounds;
     // An empty submission's CPU time, per round: what the CPU clock adds to a probe's work.
     let mut empty_ms = Vec::with_capacity(rounds as usize);
     let mut rng = SplitMix64::new(seed ^ 0x0050_524F_4245);
@@ -166,77 +227,72 @@ fn measure_variants(
         }
         for k in order {
             let slot = slots.len() as u32;
-            cpu_ms.push(submit(
-                ctx,
-                probes,
-                items[k],
-                timer.as_ref().map(|t| (t, slot)),
-            )?);
+            cpu_ms.push(submit(ctx, probes, items[k], timer.map(|t| (t, slot)))?);
             slots.push((round, k));
         }
     }
-    let gpu_ms = match &timer {
-        Some(t) => t.read(ctx)?,
-        None => vec![None; slots.len()],
-    };
-    let stamped = gpu_ms.iter().all(|t| t.is_some_and(|t| t > 0.0));
-    let overhead = percentile(&empty_ms, 50.0).unwrap_or(0.0);
-    // time[item][round] on each clock; the CPU's less an empty submission's time.
-    let mut gpu = vec![vec![f64::NAN; rounds as usize]; items.len()];
-    let mut cpu = gpu.clone();
-    for ((&(round, k), g), &c) in slots.iter().zip(&gpu_ms).zip(&cpu_ms) {
-        gpu[k][round as usize] = g.unwrap_or(f64::NAN);
-        cpu[k][round as usize] = (c - overhead).max(1e-6);
-    }
+    Ok(Slots {
+        slots,
+        cpu_ms,
+        empty_ms,
+    })
+}
+
+/// Probe `p`'s record from the items' `times`: its rate on the clock that saw the work, and its doubled and
+/// control variants' ratios to its base.
+fn probe_record(
+    probes: &Probes,
+    p: Probe,
+    items: &[(Probe, Variant)],
+    times: &ItemTimes,
+    rounds: u32,
+) -> ProbeRecord {
+    let ItemTimes { gpu, cpu, stamped } = times;
+    let stamped = *stamped;
     let index = |p: Probe, v: Variant| items.iter().position(|&x| x == (p, v));
     let none = vec![f64::NAN; rounds as usize];
-    Ok(PROBES
-        .iter()
-        .map(|&p| {
-            let k = index(p, Variant::Base).unwrap_or(0);
-            let gpu_median = percentile(&gpu[k], 50.0).unwrap_or(f64::NAN);
-            let cpu_median = percentile(&cpu[k], 50.0).unwrap_or(f64::NAN);
-            // The timestamps, unless they hold less than half of what the CPU waited for: then they missed the
-            // work (lavapipe's stamps do not wait for a compute dispatch), and the CPU's clock is read.
-            let use_gpu = stamped && gpu_median >= 0.5 * cpu_median;
-            let time = if use_gpu { &gpu } else { &cpu };
-            let base = &time[k];
-            let q = probes.quantity(p, Variant::Base);
-            let rates: Vec<f64> = base.iter().map(|t| q / (t / 1e3)).collect();
-            let (_, rate_ci) = geometric(&rates);
-            let of = |v| index(p, v).map_or(&none, |i| &time[i]);
-            let (doubled, doubled_ci) = paired(of(Variant::Doubled), base);
-            let (control, control_ci) = paired(of(Variant::Control), base);
-            let median_ratio = |a: &[f64]| {
-                let r: Vec<f64> = a.iter().zip(base).map(|(x, y)| x / y).collect();
-                percentile(&r, 50.0).unwrap_or(f64::NAN)
-            };
-            ProbeRecord {
-                probe: p.name(),
-                unit: p.unit(),
-                quantity: q,
-                clock: if use_gpu { "gpu_ms" } else { "cpu_ms" },
-                rounds,
-                ms_median: percentile(base, 50.0).unwrap_or(f64::NAN),
-                gpu_ms_median: stamped.then_some(gpu_median),
-                cpu_ms_median: cpu_median,
-                rate_median: percentile(&rates, 50.0).unwrap_or(f64::NAN),
-                rate_ci95_lo: rate_ci.map(|c| c.0),
-                rate_ci95_hi: rate_ci.map(|c| c.1),
-                doubled_ratio: doubled,
-                doubled_ratio_median: median_ratio(of(Variant::Doubled)),
-                doubled_ci95_lo: doubled_ci.map(|c| c.0),
-                doubled_ci95_hi: doubled_ci.map(|c| c.1),
-                control: p.control(),
-                control_ratio: control,
-                control_ratio_median: median_ratio(of(Variant::Control)),
-                control_ci95_lo: control_ci.map(|c| c.0),
-                control_ci95_hi: control_ci.map(|c| c.1),
-                scales: (DOUBLED_RANGE.0..=DOUBLED_RANGE.1).contains(&doubled)
-                    && (CONTROL_RANGE.0..=CONTROL_RANGE.1).contains(&control),
-            }
-        })
-        .collect())
+    let k = index(p, Variant::Base).unwrap_or(0);
+    let gpu_median = percentile(&gpu[k], 50.0).unwrap_or(f64::NAN);
+    let cpu_median = percentile(&cpu[k], 50.0).unwrap_or(f64::NAN);
+    // The timestamps, unless they hold less than half of what the CPU waited for: then they missed the
+    // work (lavapipe's stamps do not wait for a compute dispatch), and the CPU's clock is read.
+    let use_gpu = stamped && gpu_median >= 0.5 * cpu_median;
+    let time = if use_gpu { gpu } else { cpu };
+    let base = &time[k];
+    let q = probes.quantity(p, Variant::Base);
+    let rates: Vec<f64> = base.iter().map(|t| q / (t / 1e3)).collect();
+    let (_, rate_ci) = geometric(&rates);
+    let of = |v| index(p, v).map_or(&none, |i| &time[i]);
+    let (doubled, doubled_ci) = paired(of(Variant::Doubled), base);
+    let (control, control_ci) = paired(of(Variant::Control), base);
+    let median_ratio = |a: &[f64]| {
+        let r: Vec<f64> = a.iter().zip(base).map(|(x, y)| x / y).collect();
+        percentile(&r, 50.0).unwrap_or(f64::NAN)
+    };
+    ProbeRecord {
+        probe: p.name(),
+        unit: p.unit(),
+        quantity: q,
+        clock: if use_gpu { "gpu_ms" } else { "cpu_ms" },
+        rounds,
+        ms_median: percentile(base, 50.0).unwrap_or(f64::NAN),
+        gpu_ms_median: stamped.then_some(gpu_median),
+        cpu_ms_median: cpu_median,
+        rate_median: percentile(&rates, 50.0).unwrap_or(f64::NAN),
+        rate_ci95_lo: rate_ci.map(|c| c.0),
+        rate_ci95_hi: rate_ci.map(|c| c.1),
+        doubled_ratio: doubled,
+        doubled_ratio_median: median_ratio(of(Variant::Doubled)),
+        doubled_ci95_lo: doubled_ci.map(|c| c.0),
+        doubled_ci95_hi: doubled_ci.map(|c| c.1),
+        control: p.control(),
+        control_ratio: control,
+        control_ratio_median: median_ratio(of(Variant::Control)),
+        control_ci95_lo: control_ci.map(|c| c.0),
+        control_ci95_hi: control_ci.map(|c| c.1),
+        scales: (DOUBLED_RANGE.0..=DOUBLED_RANGE.1).contains(&doubled)
+            && (CONTROL_RANGE.0..=CONTROL_RANGE.1).contains(&control),
+    }
 }
 
 /// Records `item` in an encoder of its own (bracketed by `timed`'s timestamps at its slot, where given),

@@ -773,16 +773,7 @@ impl QualityStage {
             _ => full,
         };
         changed &= !rect.is_empty();
-        let unlagged = method.encode_unlagged(gpu, input, encoder, &t.now);
-        if unlagged {
-            if let Some(taa) = taa {
-                if !changed {
-                    t.now.copy_color_to(encoder, &t.before);
-                }
-                taa.resolve(ctx, encoder, Stream::Unlagged, &t.now);
-            }
-            k.lag.encode(&ctx.queue, encoder, f, 0);
-        }
+        let unlagged = self.encode_unlagged(base, method, (input, changed), encoder);
         if changed {
             let earlier = history.earlier();
             // Inside a scissor, an instance whose rectangle misses it is drawn nowhere: its matrix is zeroed
@@ -791,21 +782,7 @@ impl QualityStage {
             let input = if rect == full {
                 *input
             } else {
-                let view_proj = base.scene.camera(f).view_proj();
-                culled = input
-                    .matrices
-                    .iter()
-                    .enumerate()
-                    .map(|(i, m)| {
-                        match coverage
-                            .instance_rect(base.scene, i, *m, view_proj)
-                            .overlaps(&rect)
-                        {
-                            true => *m,
-                            false => Mat4::ZERO,
-                        }
-                    })
-                    .collect();
+                culled = Self::culled_matrices(base, input, coverage, rect);
                 FrameInput {
                     matrices: &culled,
                     ..*input
@@ -840,6 +817,54 @@ impl QualityStage {
             changed: changed.then_some(rect),
             compared,
         }
+    }
+
+    /// The method's unlagged frame into `now` where it draws one (resolved by TAA, after `now` is copied to
+    /// `before` when nothing `changed`), and the lag kernel on it; whether it drew one.
+    fn encode_unlagged(
+        &self,
+        base: &BlockGpu<'_>,
+        method: &mut dyn Method,
+        (input, changed): (&FrameInput<'_>, bool),
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> bool {
+        let (ctx, gpu, t, k) = (base.ctx, &base.gpu, &self.targets, &self.kernels);
+        let unlagged = method.encode_unlagged(gpu, input, encoder, &t.now);
+        if unlagged {
+            if let Some(taa) = self.taa.as_ref() {
+                if !changed {
+                    t.now.copy_color_to(encoder, &t.before);
+                }
+                taa.resolve(ctx, encoder, Stream::Unlagged, &t.now);
+            }
+            k.lag.encode(&ctx.queue, encoder, input.frame, 0);
+        }
+        unlagged
+    }
+
+    /// The frame's instance matrices with those whose rectangle misses `rect` zeroed (every vertex at the
+    /// clip-space origin, w = 0, so the clipper drops its triangles).
+    fn culled_matrices(
+        base: &BlockGpu<'_>,
+        input: &FrameInput<'_>,
+        coverage: &Coverage,
+        rect: PixelRect,
+    ) -> Vec<Mat4> {
+        let view_proj = base.scene.camera(input.frame).view_proj();
+        input
+            .matrices
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                match coverage
+                    .instance_rect(base.scene, i, *m, view_proj)
+                    .overlaps(&rect)
+                {
+                    true => *m,
+                    false => Mat4::ZERO,
+                }
+            })
+            .collect()
     }
 
     /// Where this frame and its counterfactual can differ: the union of the rectangles of the instances whose

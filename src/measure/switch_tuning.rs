@@ -486,12 +486,7 @@ pub fn tune_model(
 ) -> Result<ModelSwitches> {
     let scene = camera.scene;
     let m = &scene.models[model as usize];
-    let (w, h) = (scene.width, scene.height);
-    let tan = (scene.fov_y * 0.5).tan();
-    let near = crate::scene::bunny::fit_distance(m.radius, w, h, scene.fov_y);
-    let far = (m.radius * h as f32 / (2.0 * tan)).max(near * 1.01);
-    let grid = log_grid(near, far, settings.distances);
-    let screen = |d: f32| m.radius / (d * tan);
+    let range = DistanceRange::of(scene, m.radius, settings.distances);
     let mut pairs: Vec<PairSwitch> = Vec::new();
     let errors: Vec<f32> = m.chain.lods[1..]
         .iter()
@@ -499,16 +494,179 @@ pub fn tune_model(
         .collect();
     let rule_distances: Vec<Vec<f32>> = RULES
         .iter()
-        .map(|r| r.distances(&errors, m.radius, h, scene.fov_y))
+        .map(|r| r.distances(&errors, m.radius, scene.height, scene.fov_y))
         .collect();
+    let mut tuning = ModelTuning {
+        camera,
+        model,
+        rotation,
+        settings,
+        views,
+        jod,
+        samples,
+    };
     // Per blending method, where its previous band ends.
     let mut band_end = [0.0f32; 3];
     for lod in 0..m.chain.lods.len().saturating_sub(1) as u32 {
+        let pair = tuning.tune_pair(lod, &range, &rule_distances, pairs.last(), &mut band_end)?;
+        pairs.push(pair);
+    }
+    Ok(ModelSwitches {
+        model,
+        name: m.name.clone(),
+        radius: m.radius,
+        center: m.center.to_array(),
+        near: range.near,
+        far: range.far,
+        pairs,
+    })
+}
+
+/// The distances a model's pairs are measured over: from where it fills the viewport to where its bounding
+/// sphere's radius projects to one pixel (at least 1% farther), on a log grid.
+struct DistanceRange {
+    near: f32,
+    far: f32,
+    grid: Vec<f32>,
+    /// tan(fov_y / 2).
+    tan: f32,
+    radius: f32,
+}
+
+impl DistanceRange {
+    /// The range of a model of bounding radius `radius` in `scene`, with `distances` grid distances.
+    fn of(scene: &Scene, radius: f32, distances: u32) -> DistanceRange {
+        let (w, h) = (scene.width, scene.height);
+        let tan = (scene.fov_y * 0.5).tan();
+        let near = crate::scene::bunny::fit_distance(radius, w, h, scene.fov_y);
+        let far = (radius * h as f32 / (2.0 * tan)).max(near * 1.01);
+        DistanceRange {
+            near,
+            far,
+            grid: log_grid(near, far, distances),
+            tan,
+            radius,
+        }
+    }
+
+    /// The bounding sphere's projected size at distance `d` ([`PairSwitch::screen_size`]).
+    fn screen(&self, d: f32) -> f32 {
+        self.radius / (d * self.tan)
+    }
+}
+
+/// The views' curves at one pair.
+struct Curves {
+    /// Each view's crossing ([`PairSwitch::per_view`]).
+    per_view: Vec<Option<f32>>,
+    /// The worst excess over the views at each grid distance.
+    worst: Vec<(f32, f64)>,
+}
+
+/// A pair's switch and how far beyond it the dense check went ([`PairSwitch`]'s fields of the same names).
+struct Checked {
+    switch: Option<f32>,
+    value_at_switch: Option<f64>,
+    checked_to: Option<f32>,
+    checked_worst: Option<f64>,
+}
+
+/// One model's tuning: what every pair of it is drawn, scored and recorded with.
+struct ModelTuning<'t, 'c> {
+    camera: &'t mut ModelCamera<'c>,
+    model: u32,
+    rotation: Quat,
+    settings: &'t TuneSettings,
+    views: &'t [Vec3],
+    jod: FrameScore<'t>,
+    samples: &'t mut Vec<Sample>,
+}
+
+impl ModelTuning<'_, '_> {
+    /// [`worst_at`] for the pair (`lod`, `lod + 1`) at distance `d`.
+    fn worst(&mut self, lod: u32, d: f32) -> Result<Option<f64>> {
+        worst_at(
+            self.camera,
+            self.model,
+            lod,
+            self.rotation,
+            self.views,
+            d,
+            self.settings,
+            self.jod,
+        )
+    }
+
+    /// The pair (`lod`, `lod + 1`): each view's crossing, the switch (beyond the band of the `previous` pair's,
+    /// moved out past every distance that breaks the budget), the engines' rules and, with `--speed`, the
+    /// blending methods' bands (each after its `band_end`, moved on).
+    fn tune_pair(
+        &mut self,
+        lod: u32,
+        range: &DistanceRange,
+        rule_distances: &[Vec<f32>],
+        previous: Option<&PairSwitch>,
+        band_end: &mut [f32; 3],
+    ) -> Result<PairSwitch> {
+        let scene = self.camera.scene;
+        let m = &scene.models[self.model as usize];
+        let Curves { per_view, worst } = self.measure_views(lod, range)?;
+        let limiting = limiting_view(&per_view, range.near);
+        let switch = first_switch(limiting, previous, self.settings.band);
+        let (switch, value_at_switch) = self.past_grid_breaks(lod, &range.grid, switch)?;
+        let checked = self.dense_check(lod, &range.grid, &worst, switch, value_at_switch)?;
+        let rules = self.rules_at(lod, range, rule_distances)?;
+        let error_abs = m.chain.lods[lod as usize + 1].error_abs;
+        let bands = blend_bands(self.settings, &worst, checked.switch, band_end);
+        let switch = checked.switch;
+        Ok(PairSwitch {
+            lod_from: lod,
+            lod_to: lod + 1,
+            triangles_from: m.chain.lods[lod as usize].mesh.triangle_count(),
+            triangles_to: m.chain.lods[lod as usize + 1].mesh.triangle_count(),
+            switch_distance: switch,
+            screen_size: switch.map(|d| range.screen(d)),
+            limiting_view: limiting.map(|l| l.0),
+            value_at_switch: checked.value_at_switch,
+            checked_to: checked.checked_to,
+            checked_worst: checked.checked_worst,
+            error_abs,
+            error_px_at_switch: switch.map(|d| {
+                crate::geometry::lod::switch_distance(
+                    error_abs,
+                    m.scale,
+                    1.0,
+                    scene.height,
+                    scene.fov_y,
+                ) / d
+            }),
+            per_view,
+            bands,
+            rules,
+        })
+    }
+
+    /// Every view's curve over the grid for the pair (`lod`, `lod + 1`), each sample recorded: each view's
+    /// crossing (refined between grid distances), and the worst excess over the views at each grid distance.
+    fn measure_views(&mut self, lod: u32, range: &DistanceRange) -> Result<Curves> {
+        let scene = self.camera.scene;
+        let m = &scene.models[self.model as usize];
+        let (grid, near) = (&range.grid, range.near);
+        let ModelTuning {
+            camera,
+            model,
+            rotation,
+            settings,
+            views,
+            jod,
+            samples,
+        } = self;
         let mut per_view = Vec::with_capacity(views.len());
         let mut worst: Vec<(f32, f64)> = grid.iter().map(|&d| (d, 0.0)).collect();
         for (v, &dir) in views.iter().enumerate() {
             let mut measure = |d: f32, refined: bool| -> Result<f64> {
-                let ((pop, cov, shade), [a, b]) = camera.switch_at(model, lod, rotation, dir, d)?;
+                let ((pop, cov, shade), [a, b]) =
+                    camera.switch_at(*model, lod, *rotation, dir, d)?;
                 let j = match settings.budget {
                     Budget::Jod(_) => Some(jod(&a, &b)?),
                     Budget::Lodpop(_) => None,
@@ -519,7 +677,7 @@ pub fn tune_model(
                     lod_to: lod + 1,
                     view: v as u32,
                     distance: d,
-                    screen_size: screen(d),
+                    screen_size: range.screen(d),
                     lodpop: pop,
                     lodpop_coverage: cov,
                     lodpop_shading: shade,
@@ -529,7 +687,7 @@ pub fn tune_model(
                 Ok(j.unwrap_or(pop))
             };
             let mut curve = Vec::with_capacity(grid.len());
-            for &d in &grid {
+            for &d in grid {
                 curve.push((d, measure(d, false)?));
             }
             for (w, c) in worst.iter_mut().zip(&curve) {
@@ -546,45 +704,45 @@ pub fn tune_model(
                 },
             );
         }
-        let limiting = if per_view.iter().any(Option::is_none) {
-            None
-        } else {
-            per_view
-                .iter()
-                .enumerate()
-                .max_by(|a, b| a.1.unwrap_or(0.0).total_cmp(&b.1.unwrap_or(0.0)))
-                .map(|(v, d)| (v as u32, d.unwrap_or(near)))
-        };
-        // A coarser LOD never switches in nearer than the finer one before it, and its transition band starts
-        // where the one before ends (s_k (1 - b) > s_(k-1) (1 + b)).
-        let b = settings.band;
-        let floor = pairs
-            .last()
-            .and_then(|p| p.switch_distance)
-            .map_or(0.0, |d| d * (1.0 + b) / (1.0 - b) * 1.001);
-        let mut switch = match (limiting, pairs.last()) {
-            (_, Some(p)) if p.switch_distance.is_none() => None,
-            (Some((_, d)), _) => Some(d.max(floor)),
-            (None, _) => None,
-        };
-        // Every view at the switch: the views whose crossing lies nearer are within the budget at every grid
-        // distance beyond theirs, but may break it between two; then the switch moves out to the next grid
-        // distance, where none does.
+        Ok(Curves { per_view, worst })
+    }
+
+    /// Every view at the switch: the views whose crossing lies nearer are within the budget at every grid
+    /// distance beyond theirs, but may break it between two; then the switch moves out to the next grid
+    /// distance, where none does. The switch and the worst figure over the views there.
+    fn past_grid_breaks(
+        &mut self,
+        lod: u32,
+        grid: &[f32],
+        mut switch: Option<f32>,
+    ) -> Result<(Option<f32>, Option<f64>)> {
         let mut value_at_switch = None;
         while let Some(d) = switch {
-            let worst_here = worst_at(camera, model, lod, rotation, views, d, settings, jod)?;
+            let worst_here = self.worst(lod, d)?;
             value_at_switch = worst_here;
             match worst_here {
-                Some(v) if settings.budget.broken_by(v) => {
+                Some(v) if self.settings.budget.broken_by(v) => {
                     switch = grid.iter().copied().find(|&g| g > d * 1.0001);
                 }
                 _ => break,
             }
         }
-        // Between grid distances the figure is not smooth: a pixel's coverage flips with sub-pixel motion, and
-        // lodpop moves by some per cent from one distance to a nearby one. Where the grid's worst view comes
-        // within NEAR_BUDGET of the budget beyond the switch, the switch is checked at DENSE_PER_STEP distances per
-        // grid step, every view, and moves past any that breaks the budget.
+        Ok((switch, value_at_switch))
+    }
+
+    /// Between grid distances the figure is not smooth: a pixel's coverage flips with sub-pixel motion, and
+    /// lodpop moves by some per cent from one distance to a nearby one. Where the grid's worst view comes
+    /// within NEAR_BUDGET of the budget beyond the switch, the switch is checked at DENSE_PER_STEP distances per
+    /// grid step, every view, and moves past any that breaks the budget.
+    fn dense_check(
+        &mut self,
+        lod: u32,
+        grid: &[f32],
+        worst: &[(f32, f64)],
+        mut switch: Option<f32>,
+        mut value_at_switch: Option<f64>,
+    ) -> Result<Checked> {
+        let settings = self.settings;
         let mut checked_max = value_at_switch;
         let mut checked_to = switch;
         if let Some(mut d) = switch {
@@ -595,13 +753,13 @@ pub fn tune_model(
                 .and_then(|i| grid.get(i + 1).copied())
                 .unwrap_or(d)
                 .max(d);
-            let points = dense_points(&grid, d, until, DENSE_PER_STEP);
+            let points = dense_points(grid, d, until, DENSE_PER_STEP);
             let mut worst_checked = value_at_switch;
             for (i, &p) in points.iter().enumerate() {
                 if p < d {
                     continue;
                 }
-                let v = worst_at(camera, model, lod, rotation, views, p, settings, jod)?;
+                let v = self.worst(lod, p)?;
                 if p == d {
                     // The switch moved here: its own figure.
                     value_at_switch = v;
@@ -621,8 +779,7 @@ pub fn tune_model(
                         d = next;
                         worst_checked = None;
                         if i + 1 == points.len() {
-                            value_at_switch =
-                                worst_at(camera, model, lod, rotation, views, d, settings, jod)?;
+                            value_at_switch = self.worst(lod, d)?;
                             worst_checked = value_at_switch;
                         }
                     }
@@ -644,69 +801,98 @@ pub fn tune_model(
             checked_max = worst_checked;
             checked_to = switch.map(|s| until.max(s));
         }
-        // The engines' rules at this pair: their distance and the worst the views see there.
-        let mut rules = Vec::with_capacity(RULES.len());
-        for (rule, distances) in RULES.iter().zip(&rule_distances) {
-            let d = distances[lod as usize];
-            let value = worst_at(camera, model, lod, rotation, views, d, settings, jod)?;
-            rules.push(RuleAt {
-                rule: *rule,
-                distance: d,
-                screen_size: screen(d),
-                value,
-                within: value.is_some_and(|v| !settings.budget.broken_by(v)),
-            });
-        }
-        let error_abs = m.chain.lods[lod as usize + 1].error_abs;
-        let mut bands = Vec::new();
-        if let (Some((speed, fps)), Budget::Lodpop(budget), Some(hard)) =
-            (settings.speed, settings.budget, switch)
-        {
-            let step = speed / fps.max(1e-6);
-            for (k, (method, sqrt_law)) in BLEND_METHODS.into_iter().enumerate() {
-                // A band around a distance no farther than the hard switch's, or the hard switch itself.
-                let candidates: Vec<(f32, f64)> =
-                    worst.iter().copied().filter(|(d, _)| *d <= hard).collect();
-                let (d, h, n) = blend_band(&candidates, budget, step, band_end[k], sqrt_law)
-                    .unwrap_or((hard.max(band_end[k] * 1.001), 0.0, 1));
-                band_end[k] = d * (1.0 + h);
-                bands.push(BlendBand {
-                    method,
-                    switch_distance: d,
-                    band: h,
-                    frames: n,
-                });
-            }
-        }
-        pairs.push(PairSwitch {
-            lod_from: lod,
-            lod_to: lod + 1,
-            triangles_from: m.chain.lods[lod as usize].mesh.triangle_count(),
-            triangles_to: m.chain.lods[lod as usize + 1].mesh.triangle_count(),
-            switch_distance: switch,
-            screen_size: switch.map(screen),
-            limiting_view: limiting.map(|l| l.0),
+        Ok(Checked {
+            switch,
             value_at_switch,
             checked_to,
             checked_worst: checked_max,
-            error_abs,
-            error_px_at_switch: switch.map(|d| {
-                crate::geometry::lod::switch_distance(error_abs, m.scale, 1.0, h, scene.fov_y) / d
-            }),
-            per_view,
-            bands,
-            rules,
-        });
+        })
     }
-    Ok(ModelSwitches {
-        model,
-        name: m.name.clone(),
-        radius: m.radius,
-        center: m.center.to_array(),
-        near,
-        far,
-        pairs,
-    })
+
+    /// The engines' rules at the pair (`lod`, `lod + 1`): their distance and the worst the views see there.
+    fn rules_at(
+        &mut self,
+        lod: u32,
+        range: &DistanceRange,
+        rule_distances: &[Vec<f32>],
+    ) -> Result<Vec<RuleAt>> {
+        let mut rules = Vec::with_capacity(RULES.len());
+        for (rule, distances) in RULES.iter().zip(rule_distances) {
+            let d = distances[lod as usize];
+            let value = self.worst(lod, d)?;
+            rules.push(RuleAt {
+                rule: *rule,
+                distance: d,
+                screen_size: range.screen(d),
+                value,
+                within: value.is_some_and(|v| !self.settings.budget.broken_by(v)),
+            });
+        }
+        Ok(rules)
+    }
+}
+
+/// The view whose crossing is farthest, and that distance; None when some view never comes within the budget.
+fn limiting_view(per_view: &[Option<f32>], near: f32) -> Option<(u32, f32)> {
+    if per_view.iter().any(Option::is_none) {
+        None
+    } else {
+        per_view
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.unwrap_or(0.0).total_cmp(&b.1.unwrap_or(0.0)))
+            .map(|(v, d)| (v as u32, d.unwrap_or(near)))
+    }
+}
+
+/// The switch the views ask for: the `limiting` view's, no nearer than the `previous` pair's band (half-width
+/// `b`) allows; none once the previous pair has none.
+fn first_switch(
+    limiting: Option<(u32, f32)>,
+    previous: Option<&PairSwitch>,
+    b: f32,
+) -> Option<f32> {
+    // A coarser LOD never switches in nearer than the finer one before it, and its transition band starts
+    // where the one before ends (s_k (1 - b) > s_(k-1) (1 + b)).
+    let floor = previous
+        .and_then(|p| p.switch_distance)
+        .map_or(0.0, |d| d * (1.0 + b) / (1.0 - b) * 1.001);
+    match (limiting, previous) {
+        (_, Some(p)) if p.switch_distance.is_none() => None,
+        (Some((_, d)), _) => Some(d.max(floor)),
+        (None, _) => None,
+    }
+}
+
+/// With `--speed` and a lodpop budget: alpha's, dither's and geomorph's bands at the hard `switch` or nearer
+/// (`worst`: the grid's worst excess), each starting where its previous one ends (`band_end`, moved on).
+fn blend_bands(
+    settings: &TuneSettings,
+    worst: &[(f32, f64)],
+    switch: Option<f32>,
+    band_end: &mut [f32; 3],
+) -> Vec<BlendBand> {
+    let mut bands = Vec::new();
+    if let (Some((speed, fps)), Budget::Lodpop(budget), Some(hard)) =
+        (settings.speed, settings.budget, switch)
+    {
+        let step = speed / fps.max(1e-6);
+        for (k, (method, sqrt_law)) in BLEND_METHODS.into_iter().enumerate() {
+            // A band around a distance no farther than the hard switch's, or the hard switch itself.
+            let candidates: Vec<(f32, f64)> =
+                worst.iter().copied().filter(|(d, _)| *d <= hard).collect();
+            let (d, h, n) = blend_band(&candidates, budget, step, band_end[k], sqrt_law)
+                .unwrap_or((hard.max(band_end[k] * 1.001), 0.0, 1));
+            band_end[k] = d * (1.0 + h);
+            bands.push(BlendBand {
+                method,
+                switch_distance: d,
+                band: h,
+                frames: n,
+            });
+        }
+    }
+    bands
 }
 
 #[cfg(test)]

@@ -67,74 +67,10 @@ impl AlphaSorted {
                 depth_usage,
             )
         });
-        let zero = texture_2d(
-            device,
-            "alpha-sorted zero depth",
-            size,
-            DEPTH_FORMAT,
-            depth_usage,
-        );
-        let zero_view = zero.create_view(&Default::default());
-        {
-            // Cleared to 0 once: every fragment is behind it.
-            let mut encoder = device.create_command_encoder(&Default::default());
-            drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("alpha-sorted zero depth"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &zero_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(0.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            }));
-            gpu.queue.submit([encoder.finish()]);
-        }
-        let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("alpha-sorted peel layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 3,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Depth,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            }],
-        });
-        let peel_depth_views = [0, 1].map(|i| peel_depth[i].create_view(&Default::default()));
-        let group = |view: &wgpu::TextureView| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("alpha-sorted previous peel"),
-                layout: &peel_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(view),
-                }],
-            })
-        };
-        let peel_groups = [
-            group(&zero_view),
-            group(&peel_depth_views[0]),
-            group(&peel_depth_views[1]),
-        ];
-        let peel_pipeline = gpu.mesh_pipeline(&MeshPipeline {
-            label: "alpha-sorted peel",
-            morph: false,
-            fragment: Some("fs_translucent_peel"),
-            id_target: None,
-            cull: None,
-            depth_compare: wgpu::CompareFunction::LessEqual,
-            depth_write: true,
-            blend: None,
-            extra_layouts: &[&peel_layout],
-        });
+        let (_zero, zero_view) = zero_depth(gpu, size, depth_usage);
+        let (peel_layout, peel_depth_views, peel_groups) =
+            peel_groups(device, &zero_view, &peel_depth);
+        let peel_pipeline = peel_pipeline(gpu, &peel_layout);
         let layer = texture_2d(
             device,
             "alpha-sorted layer",
@@ -143,53 +79,9 @@ impl AlphaSorted {
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
         );
         let layer_view = layer.create_view(&Default::default());
-        let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("alpha-sorted composite layout"),
-            entries: &[
-                texture_entry(0),
-                storage_entry(1),
-                uniform_entry(2),
-                texture_entry(3),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: wgpu::TextureFormat::Rgba8Unorm,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("peel.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(PEEL_WGSL.into()),
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("alpha-sorted composite"),
-            bind_group_layouts: &[Some(&compute_layout)],
-            immediate_size: 0,
-        });
-        let compute = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let acc = crate::gpu::compute::buffer(
-            device,
-            "alpha-sorted accumulation",
-            size.0 as u64 * size.1 as u64 * 16,
-            wgpu::BufferUsages::STORAGE,
-        );
-        let params = uniform_buffer(device, "alpha-sorted params", 16);
-        gpu.queue
-            .write_buffer(&params, 0, bytemuck::cast_slice(&[size.0, size.1, 0, 0]));
+        let compute_layout = composite_layout(device);
+        let (module, layout) = composite_program(device, &compute_layout);
+        let (acc, params) = composite_buffers(gpu, size);
         let output = texture_2d(
             device,
             "alpha-sorted frame",
@@ -197,6 +89,7 @@ impl AlphaSorted {
             wgpu::TextureFormat::Rgba8Unorm,
             wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
         );
+        let compute = |entry: &str| compute_pipeline(device, &layout, &module, entry);
         AlphaSorted {
             lists: BlendLists::default(),
             buffer: gpu
@@ -256,6 +149,169 @@ impl AlphaSorted {
         pass.set_bind_group(0, group, &[]);
         pass.dispatch_workgroups(self.size.0.div_ceil(8), self.size.1.div_ceil(8), 1);
     }
+}
+
+/// A depth texture of `size` cleared to 0 once (every fragment is behind it: what the first layer peels
+/// against), and its view.
+fn zero_depth(
+    gpu: &SceneGpu,
+    size: (u32, u32),
+    usage: wgpu::TextureUsages,
+) -> (wgpu::Texture, wgpu::TextureView) {
+    let device = &gpu.device;
+    let zero = texture_2d(device, "alpha-sorted zero depth", size, DEPTH_FORMAT, usage);
+    let zero_view = zero.create_view(&Default::default());
+    {
+        // Cleared to 0 once: every fragment is behind it.
+        let mut encoder = device.create_command_encoder(&Default::default());
+        drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("alpha-sorted zero depth"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &zero_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        }));
+        gpu.queue.submit([encoder.finish()]);
+    }
+    (zero, zero_view)
+}
+
+/// The peel pass's layout (the previous peel's depth), the peel depths' views, and its three bind groups:
+/// the zero depth, then each peel depth.
+fn peel_groups(
+    device: &wgpu::Device,
+    zero_view: &wgpu::TextureView,
+    peel_depth: &[wgpu::Texture; 2],
+) -> (
+    wgpu::BindGroupLayout,
+    [wgpu::TextureView; 2],
+    [wgpu::BindGroup; 3],
+) {
+    let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("alpha-sorted peel layout"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 3,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Depth,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        }],
+    });
+    let peel_depth_views = [0, 1].map(|i| peel_depth[i].create_view(&Default::default()));
+    let group = |view: &wgpu::TextureView| {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("alpha-sorted previous peel"),
+            layout: &peel_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::TextureView(view),
+            }],
+        })
+    };
+    let peel_groups = [
+        group(zero_view),
+        group(&peel_depth_views[0]),
+        group(&peel_depth_views[1]),
+    ];
+    (peel_layout, peel_depth_views, peel_groups)
+}
+
+/// The pipeline that draws the translucent fragments behind the previous peel's depth.
+fn peel_pipeline(gpu: &SceneGpu, peel_layout: &wgpu::BindGroupLayout) -> crate::gpu::MeshPipelines {
+    gpu.mesh_pipeline(&MeshPipeline {
+        label: "alpha-sorted peel",
+        morph: false,
+        fragment: Some("fs_translucent_peel"),
+        id_target: None,
+        cull: None,
+        depth_compare: wgpu::CompareFunction::LessEqual,
+        depth_write: true,
+        blend: None,
+        extra_layouts: &[peel_layout],
+    })
+}
+
+/// The composite passes' layout: the layer, the accumulation, the parameters, the opaque colour, the frame.
+fn composite_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("alpha-sorted composite layout"),
+        entries: &[
+            texture_entry(0),
+            storage_entry(1),
+            uniform_entry(2),
+            texture_entry(3),
+            wgpu::BindGroupLayoutEntry {
+                binding: 4,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: wgpu::TextureFormat::Rgba8Unorm,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            },
+        ],
+    })
+}
+
+/// peel.wgsl's module and the composite pipeline layout.
+fn composite_program(
+    device: &wgpu::Device,
+    compute_layout: &wgpu::BindGroupLayout,
+) -> (wgpu::ShaderModule, wgpu::PipelineLayout) {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("peel.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(PEEL_WGSL.into()),
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("alpha-sorted composite"),
+        bind_group_layouts: &[Some(compute_layout)],
+        immediate_size: 0,
+    });
+    (module, layout)
+}
+
+/// The composite compute pipeline of peel.wgsl's `entry`, labelled with it.
+fn compute_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: Some(layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+/// The accumulation buffer (16 bytes a pixel) and the parameters uniform, written with the frame's `size`.
+fn composite_buffers(gpu: &SceneGpu, size: (u32, u32)) -> (wgpu::Buffer, wgpu::Buffer) {
+    let device = &gpu.device;
+    let acc = crate::gpu::compute::buffer(
+        device,
+        "alpha-sorted accumulation",
+        size.0 as u64 * size.1 as u64 * 16,
+        wgpu::BufferUsages::STORAGE,
+    );
+    let params = uniform_buffer(device, "alpha-sorted params", 16);
+    gpu.queue
+        .write_buffer(&params, 0, bytemuck::cast_slice(&[size.0, size.1, 0, 0]));
+    (acc, params)
 }
 
 impl Method for AlphaSorted {

@@ -434,107 +434,10 @@ impl Fsi {
             LodBuffer::new(gpu, "fsi LOD buffer 0", w, h, format),
             LodBuffer::new(gpu, "fsi LOD buffer 1", w, h, format),
         ];
-        let vis_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("fsi visibility texture layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            }],
-        });
-        let vis = gpu.create_value_texture(
-            "fsi visibility texture",
-            VIS_TEXTURE_SIZE,
-            &visibility_texture(options.vis_texture, seed),
-        );
-        let vis_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("fsi visibility texture"),
-            layout: &vis_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&vis.create_view(&Default::default())),
-            }],
-        });
-        let pipeline = |label, fragment, cull| {
-            gpu.mesh_pipeline(&MeshPipeline {
-                label,
-                morph: false,
-                fragment: Some(fragment),
-                id_target: Some(format),
-                cull,
-                depth_compare: wgpu::CompareFunction::Less,
-                depth_write: true,
-                blend: None,
-                extra_layouts: &[&vis_layout],
-            })
-        };
-        let n_pipeline = pipeline("fsi n-instances", "fs_fsi_n", None);
-        let t_pipeline = pipeline(
-            "fsi t-instances",
-            match (variant, options.vis_space) {
-                (Variant::Blend, _) => "fs_fsi_t_blend",
-                (_, VisSpace::Object) => "fs_fsi_t",
-                (_, VisSpace::World) => "fs_fsi_t_world",
-            },
-            None,
-        );
-
-        let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Texture {
-                sample_type,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let colour = wgpu::TextureSampleType::Float { filterable: false };
-        let combine_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("fsi combine layout"),
-            entries: &[
-                tex(0, colour),
-                tex(1, wgpu::TextureSampleType::Depth),
-                tex(2, wgpu::TextureSampleType::Uint),
-                tex(3, colour),
-                tex(4, wgpu::TextureSampleType::Depth),
-                tex(5, wgpu::TextureSampleType::Uint),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 7,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: wgpu::TextureFormat::Rgba8Unorm,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 6,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("fsi_combine.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(COMBINE_WGSL.into()),
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("fsi combine"),
-            bind_group_layouts: &[Some(&combine_layout)],
-            immediate_size: 0,
-        });
+        let (vis_layout, vis_group) = visibility_group(gpu, options.vis_texture, seed);
+        let (n_pipeline, t_pipeline) = draw_pipelines(gpu, options, variant, format, &vis_layout);
+        let combine_layout = combine_layout(device);
+        let (module, layout) = combine_program(device, &combine_layout);
         let forward_check =
             variant == Variant::Sequential && options.fsi_check == FsiCheck::Forward;
         let combine_pipeline = combine_pipeline(
@@ -543,20 +446,7 @@ impl Fsi {
             !matches!(variant, Variant::Sequential | Variant::Blend),
             combination(variant, forward_check),
         );
-        let combined = texture_2d(
-            device,
-            "fsi combined frame",
-            (w, h),
-            wgpu::TextureFormat::Rgba8Unorm,
-            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        );
-        let combined_view = combined.create_view(&Default::default());
-        let combine_uniform = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fsi combine uniform"),
-            size: std::mem::size_of::<CombineRaw>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let (combined, combined_view, combine_uniform) = combine_targets(device, w, h);
         let combine_groups = [0, 1].map(|newer| {
             combine_group(
                 device,
@@ -776,6 +666,163 @@ impl Fsi {
 
 /// The combination the pass makes (fsi_combine.wgsl's COMBINATION): 0 the paper's, 1 with the forward check,
 /// 2 frame-sequential blending.
+/// The visibility texture (`vis`, from `seed`) and its layout and bind group, group 1 of the draw pipelines.
+fn visibility_group(
+    gpu: &SceneGpu,
+    vis: VisTexture,
+    seed: u64,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let device = &gpu.device;
+    let vis_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("fsi visibility texture layout"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        }],
+    });
+    let vis = gpu.create_value_texture(
+        "fsi visibility texture",
+        VIS_TEXTURE_SIZE,
+        &visibility_texture(vis, seed),
+    );
+    let vis_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("fsi visibility texture"),
+        layout: &vis_layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::TextureView(&vis.create_view(&Default::default())),
+        }],
+    });
+    (vis_layout, vis_group)
+}
+
+/// The n-instance and t-instance pipelines into the LOD buffers (ids in `format`); the t-instances' fragment
+/// shader follows the variant and the visibility space.
+fn draw_pipelines(
+    gpu: &SceneGpu,
+    options: &FsiOptions,
+    variant: Variant,
+    format: wgpu::TextureFormat,
+    vis_layout: &wgpu::BindGroupLayout,
+) -> (crate::gpu::MeshPipelines, crate::gpu::MeshPipelines) {
+    let pipeline = |label, fragment, cull| {
+        gpu.mesh_pipeline(&MeshPipeline {
+            label,
+            morph: false,
+            fragment: Some(fragment),
+            id_target: Some(format),
+            cull,
+            depth_compare: wgpu::CompareFunction::Less,
+            depth_write: true,
+            blend: None,
+            extra_layouts: &[vis_layout],
+        })
+    };
+    let n_pipeline = pipeline("fsi n-instances", "fs_fsi_n", None);
+    let t_pipeline = pipeline(
+        "fsi t-instances",
+        match (variant, options.vis_space) {
+            (Variant::Blend, _) => "fs_fsi_t_blend",
+            (_, VisSpace::Object) => "fs_fsi_t",
+            (_, VisSpace::World) => "fs_fsi_t_world",
+        },
+        None,
+    );
+    (n_pipeline, t_pipeline)
+}
+
+/// The combine pass's layout: both LOD buffers' colour, depth and ids, the uniform, the combined frame.
+fn combine_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    let colour = wgpu::TextureSampleType::Float { filterable: false };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("fsi combine layout"),
+        entries: &[
+            tex(0, colour),
+            tex(1, wgpu::TextureSampleType::Depth),
+            tex(2, wgpu::TextureSampleType::Uint),
+            tex(3, colour),
+            tex(4, wgpu::TextureSampleType::Depth),
+            tex(5, wgpu::TextureSampleType::Uint),
+            wgpu::BindGroupLayoutEntry {
+                binding: 7,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: wgpu::TextureFormat::Rgba8Unorm,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 6,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+        ],
+    })
+}
+
+/// The combine shader module and its pipeline layout (the combine pipelines are built over both).
+fn combine_program(
+    device: &wgpu::Device,
+    combine_layout: &wgpu::BindGroupLayout,
+) -> (wgpu::ShaderModule, wgpu::PipelineLayout) {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("fsi_combine.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(COMBINE_WGSL.into()),
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("fsi combine"),
+        bind_group_layouts: &[Some(combine_layout)],
+        immediate_size: 0,
+    });
+    (module, layout)
+}
+
+/// The combined frame (`w` x `h`, written by the combine pass), its view, and the combine uniform.
+fn combine_targets(
+    device: &wgpu::Device,
+    w: u32,
+    h: u32,
+) -> (wgpu::Texture, wgpu::TextureView, wgpu::Buffer) {
+    let combined = texture_2d(
+        device,
+        "fsi combined frame",
+        (w, h),
+        wgpu::TextureFormat::Rgba8Unorm,
+        wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+    );
+    let combined_view = combined.create_view(&Default::default());
+    let combine_uniform = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("fsi combine uniform"),
+        size: std::mem::size_of::<CombineRaw>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    (combined, combined_view, combine_uniform)
+}
+
 fn combination(variant: Variant, forward_check: bool) -> u32 {
     match (variant, forward_check) {
         (Variant::Blend, _) => 2,

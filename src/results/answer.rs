@@ -109,6 +109,8 @@ pub fn is_candidate(method: &str) -> bool {
     !base_name(method).starts_with("reference")
 }
 
+/// The answer for block `name`: which method pops least, and the cheapest within the lodpop budget (given,
+/// or half the hard switch's largest lodpop).
 fn block_sentences(
     name: &str,
     rows: &[&SummaryRecord],
@@ -130,11 +132,6 @@ fn block_sentences(
             "{name}: no popping measured (--quality off, or no method with LOD transitions ran)."
         )];
     }
-    let by_cost = |a: &&SummaryRecord, b: &&SummaryRecord| {
-        let c = |r: &SummaryRecord| r.ratio_to_baseline.unwrap_or(f64::INFINITY);
-        c(a).total_cmp(&c(b))
-    };
-    let lodpop = |r: &SummaryRecord| r.lodpop_max.unwrap_or(f64::INFINITY);
     let hard = candidates
         .iter()
         .find(|r| r.method == "discrete")
@@ -147,7 +144,7 @@ fn block_sentences(
         shown(a)
             .total_cmp(&shown(b))
             .then(by_cost(a, b))
-            .then(lodpop(a).total_cmp(&lodpop(b)))
+            .then(lodpop_or_inf(a).total_cmp(&lodpop_or_inf(b)))
     }) else {
         return Vec::new();
     };
@@ -157,17 +154,7 @@ fn block_sentences(
         }
         _ => String::new(),
     };
-    // Methods whose largest lodpop reads the same to 3 figures pop as little as far as the sentence can say.
-    let ties: Vec<&str> = candidates
-        .iter()
-        .filter(|r| r.method != least.method && sig3(r.lodpop_max) == sig3(least.lodpop_max))
-        .map(|r| r.method.as_str())
-        .collect();
-    let ties = if ties.is_empty() {
-        String::new()
-    } else {
-        format!(" ({} too, to 3 figures)", and_list(&ties))
-    };
+    let ties = ties_clause(&candidates, least);
     if candidates.len() == 1 {
         // Nothing to compare its popping with: say what it is, and a budget's verdict only where one was given.
         out.push(format!(
@@ -197,32 +184,75 @@ fn block_sentences(
     let Some((b, source)) = budget else {
         return out;
     };
+    out.push(budget_sentence(
+        &candidates,
+        least,
+        (b, &source),
+        &baseline,
+        pairs,
+    ));
+    out
+}
+
+/// A block's cost order: ratio to the baseline, unmeasured last.
+fn by_cost(a: &&SummaryRecord, b: &&SummaryRecord) -> std::cmp::Ordering {
+    let c = |r: &SummaryRecord| r.ratio_to_baseline.unwrap_or(f64::INFINITY);
+    c(a).total_cmp(&c(b))
+}
+
+/// A method's largest lodpop, infinite where unmeasured.
+fn lodpop_or_inf(r: &SummaryRecord) -> f64 {
+    r.lodpop_max.unwrap_or(f64::INFINITY)
+}
+
+/// The other `candidates` whose largest lodpop reads as `least`'s to 3 figures (they pop as little as far as
+/// the sentence can say): " (a and b too, to 3 figures)", or nothing.
+fn ties_clause(candidates: &[&SummaryRecord], least: &SummaryRecord) -> String {
+    let ties: Vec<&str> = candidates
+        .iter()
+        .filter(|r| r.method != least.method && sig3(r.lodpop_max) == sig3(least.lodpop_max))
+        .map(|r| r.method.as_str())
+        .collect();
+    if ties.is_empty() {
+        String::new()
+    } else {
+        format!(" ({} too, to 3 figures)", and_list(&ties))
+    }
+}
+
+/// The cheapest of the `candidates` within the lodpop budget `b` (from `source`) and how it compares with the
+/// next, or that none is within it and `least` comes nearest.
+fn budget_sentence(
+    candidates: &[&SummaryRecord],
+    least: &SummaryRecord,
+    (b, source): (f64, &str),
+    baseline: &str,
+    pairs: &[PairRecord],
+) -> String {
     let mut within: Vec<&SummaryRecord> = candidates
         .iter()
         .copied()
-        .filter(|r| lodpop(r) <= b && r.ratio_to_baseline.is_some())
+        .filter(|r| lodpop_or_inf(r) <= b && r.ratio_to_baseline.is_some())
         .collect();
     within.sort_by(by_cost);
     let Some(best) = within.first() else {
-        out.push(format!(
+        return format!(
             "No method keeps its largest lodpop within {} ({source}); {} comes nearest.",
             sig3(Some(b)),
             least.method
-        ));
-        return out;
+        );
     };
     let mut s = format!(
         "Within a largest lodpop of {} ({source}), {} is the cheapest: {}.",
         sig3(Some(b)),
         best.method,
-        cost_clause(best, &baseline)
+        cost_clause(best, baseline)
     );
     match within.get(1) {
         None => s.push_str(" No other method is within it."),
         Some(next) => s.push_str(&versus(best, next, pairs)),
     }
-    out.push(s);
-    out
+    s
 }
 
 /// `a`, `a and b`, `a, b and c`.

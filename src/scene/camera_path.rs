@@ -69,108 +69,17 @@ impl CameraPath {
             .iter()
             .map(str::to_string)
             .collect();
-        let known: Vec<&str> = ["time", "frame", "fov_deg"]
-            .into_iter()
-            .chain(POSITION)
-            .chain(TARGET)
-            .chain(QUAT)
-            .collect();
-        if let Some(h) = headers.iter().find(|h| !known.contains(&h.as_str())) {
-            return Err(bad(format!(
-                "unknown column '{h}' (the columns are {})",
-                known.join(", ")
-            )));
-        }
-        let col = |c: &str| headers.iter().position(|h| h == c);
-        let time = match (col("time"), col("frame")) {
-            (Some(t), None) | (None, Some(t)) => t,
-            (Some(_), Some(_)) => {
-                return Err(bad("has both a time and a frame column; give one".into()))
-            }
-            (None, None) => return Err(bad("has no time or frame column".into())),
-        };
-        let need = |cols: &[&str]| -> Result<Option<Vec<usize>>> {
-            let found: Vec<Option<usize>> = cols.iter().map(|c| col(c)).collect();
-            match (
-                found.iter().all(Option::is_some),
-                found.iter().any(Option::is_some),
-            ) {
-                (true, _) => Ok(Some(found.into_iter().flatten().collect())),
-                (false, false) => Ok(None),
-                (false, true) => Err(bad(format!("needs all of the columns {}", cols.join(", ")))),
-            }
-        };
-        let position = need(&POSITION)?.ok_or_else(|| bad("has no x, y, z columns".into()))?;
-        let (target, quat) = (need(&TARGET)?, need(&QUAT)?);
-        if target.is_some() == quat.is_some() {
-            return Err(bad(
-                "needs either target_x, target_y, target_z (a point looked at) or qx, qy, qz, qw (an orientation)"
-                    .into(),
-            ));
-        }
-        let fov = col("fov_deg");
+        let columns = Columns::of(name, headers)?;
         let mut points: Vec<Key> = Vec::new();
         let mut fovs: Vec<f32> = Vec::new();
         for (row, record) in reader.records().enumerate() {
             let line = row + 2;
             let record = record.map_err(|e| bad(format!("line {line}: {e}")))?;
-            let num = |i: usize| -> Result<f64> {
-                let cell = record.get(i).unwrap_or("");
-                // Finite as the f32 the path is kept in (1e39 is not), and small enough that differences of
-                // times stay finite.
-                cell.parse::<f64>()
-                    .ok()
-                    .filter(|v| v.is_finite() && (*v as f32).is_finite() && v.abs() < 1e30)
-                    .ok_or_else(|| {
-                        bad(format!(
-                            "line {line}: {} is '{cell}', not a finite number",
-                            headers[i]
-                        ))
-                    })
-            };
-            let v3 = |c: &[usize]| -> Result<Vec3> {
-                Ok(Vec3::new(
-                    num(c[0])? as f32,
-                    num(c[1])? as f32,
-                    num(c[2])? as f32,
-                ))
-            };
-            let t = num(time)?;
-            if let Some(prev) = points.last() {
-                if t <= prev.t {
-                    return Err(bad(format!(
-                        "line {line}: {} {t} does not come after the previous key's {} (keys must go forward)",
-                        headers[time], prev.t
-                    )));
-                }
-            }
-            let eye = v3(&position)?;
-            let look = match (&target, &quat) {
-                (Some(c), _) => {
-                    let target = v3(c)?;
-                    if target.distance(eye) <= f32::EPSILON * eye.length().max(1.0) {
-                        return Err(bad(format!("line {line}: the target is the eye")));
-                    }
-                    Look::Target(target)
-                }
-                (_, Some(c)) => {
-                    let q = Quat::from_xyzw(
-                        num(c[0])? as f32,
-                        num(c[1])? as f32,
-                        num(c[2])? as f32,
-                        num(c[3])? as f32,
-                    );
-                    if q.length() < 1e-6 {
-                        return Err(bad(format!("line {line}: the quaternion is zero")));
-                    }
-                    Look::Orientation(q.normalize())
-                }
-                _ => unreachable!("checked above"),
-            };
+            let (key, fov) = columns.key(name, line, &record, points.last())?;
             if let Some(f) = fov {
-                fovs.push(num(f)? as f32);
+                fovs.push(f);
             }
-            points.push(Key { t, eye, look });
+            points.push(key);
         }
         if points.len() < 2 {
             return Err(bad(format!(
@@ -178,20 +87,7 @@ impl CameraPath {
                 points.len()
             )));
         }
-        let fov_deg = match fovs.first() {
-            None => None,
-            Some(&f) if fovs.iter().all(|&g| g == f) && f > 1.0 && f < 170.0 => Some(f),
-            Some(_) if fovs.iter().all(|&g| g == fovs[0]) => {
-                return Err(bad(format!("fov_deg {} must be between 1 and 170", fovs[0])))
-            }
-            Some(_) => {
-                return Err(bad(
-                    "fov_deg changes along the path; LOD switch distances are computed for one field of view, \
-                     so give one value (or leave the column out and use --fov)"
-                        .into(),
-                ))
-            }
-        };
+        let fov_deg = one_fov(name, &fovs)?;
         Ok(CameraPath {
             file: name.to_string(),
             keys: points.len(),
@@ -277,6 +173,165 @@ impl CameraPath {
     pub fn eyes(&self) -> impl Iterator<Item = Vec3> + '_ {
         self.points.iter().map(|k| k.eye)
     }
+}
+
+/// Where a path file's columns are.
+struct Columns {
+    headers: Vec<String>,
+    /// The time or the frame column.
+    time: usize,
+    position: Vec<usize>,
+    /// Exactly one of the target's and the quaternion's columns.
+    target: Option<Vec<usize>>,
+    quat: Option<Vec<usize>>,
+    fov: Option<usize>,
+}
+
+impl Columns {
+    /// The columns of `headers` (`name` in errors): known names only, a time or a frame column (not both), x, y,
+    /// z, and either a target or a quaternion, each complete.
+    fn of(name: &str, headers: Vec<String>) -> Result<Columns> {
+        let bad = |problem: String| Error::Config(format!("--camera-path {name}: {problem}"));
+        let known: Vec<&str> = ["time", "frame", "fov_deg"]
+            .into_iter()
+            .chain(POSITION)
+            .chain(TARGET)
+            .chain(QUAT)
+            .collect();
+        if let Some(h) = headers.iter().find(|h| !known.contains(&h.as_str())) {
+            return Err(bad(format!(
+                "unknown column '{h}' (the columns are {})",
+                known.join(", ")
+            )));
+        }
+        let col = |c: &str| headers.iter().position(|h| h == c);
+        let time = match (col("time"), col("frame")) {
+            (Some(t), None) | (None, Some(t)) => t,
+            (Some(_), Some(_)) => {
+                return Err(bad("has both a time and a frame column; give one".into()))
+            }
+            (None, None) => return Err(bad("has no time or frame column".into())),
+        };
+        let need = |cols: &[&str]| -> Result<Option<Vec<usize>>> {
+            let found: Vec<Option<usize>> = cols.iter().map(|c| col(c)).collect();
+            match (
+                found.iter().all(Option::is_some),
+                found.iter().any(Option::is_some),
+            ) {
+                (true, _) => Ok(Some(found.into_iter().flatten().collect())),
+                (false, false) => Ok(None),
+                (false, true) => Err(bad(format!("needs all of the columns {}", cols.join(", ")))),
+            }
+        };
+        let position = need(&POSITION)?.ok_or_else(|| bad("has no x, y, z columns".into()))?;
+        let (target, quat) = (need(&TARGET)?, need(&QUAT)?);
+        if target.is_some() == quat.is_some() {
+            return Err(bad(
+                "needs either target_x, target_y, target_z (a point looked at) or qx, qy, qz, qw (an orientation)"
+                    .into(),
+            ));
+        }
+        let fov = col("fov_deg");
+        Ok(Columns {
+            headers,
+            time,
+            position,
+            target,
+            quat,
+            fov,
+        })
+    }
+
+    /// The key on line `line` (`record`; `name` in errors), after the `prev` key, and its field of view where the
+    /// file has the column.
+    fn key(
+        &self,
+        name: &str,
+        line: usize,
+        record: &csv::StringRecord,
+        prev: Option<&Key>,
+    ) -> Result<(Key, Option<f32>)> {
+        let bad = |problem: String| Error::Config(format!("--camera-path {name}: {problem}"));
+        let headers = &self.headers;
+        let num = |i: usize| -> Result<f64> {
+            let cell = record.get(i).unwrap_or("");
+            // Finite as the f32 the path is kept in (1e39 is not), and small enough that differences of
+            // times stay finite.
+            cell.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && (*v as f32).is_finite() && v.abs() < 1e30)
+                .ok_or_else(|| {
+                    bad(format!(
+                        "line {line}: {} is '{cell}', not a finite number",
+                        headers[i]
+                    ))
+                })
+        };
+        let v3 = |c: &[usize]| -> Result<Vec3> {
+            Ok(Vec3::new(
+                num(c[0])? as f32,
+                num(c[1])? as f32,
+                num(c[2])? as f32,
+            ))
+        };
+        let t = num(self.time)?;
+        if let Some(prev) = prev {
+            if t <= prev.t {
+                return Err(bad(format!(
+                    "line {line}: {} {t} does not come after the previous key's {} (keys must go forward)",
+                    headers[self.time], prev.t
+                )));
+            }
+        }
+        let eye = v3(&self.position)?;
+        let look = match (&self.target, &self.quat) {
+            (Some(c), _) => {
+                let target = v3(c)?;
+                if target.distance(eye) <= f32::EPSILON * eye.length().max(1.0) {
+                    return Err(bad(format!("line {line}: the target is the eye")));
+                }
+                Look::Target(target)
+            }
+            (_, Some(c)) => {
+                let q = Quat::from_xyzw(
+                    num(c[0])? as f32,
+                    num(c[1])? as f32,
+                    num(c[2])? as f32,
+                    num(c[3])? as f32,
+                );
+                if q.length() < 1e-6 {
+                    return Err(bad(format!("line {line}: the quaternion is zero")));
+                }
+                Look::Orientation(q.normalize())
+            }
+            _ => unreachable!("checked above"),
+        };
+        let fov = match self.fov {
+            Some(f) => Some(num(f)? as f32),
+            None => None,
+        };
+        Ok((Key { t, eye, look }, fov))
+    }
+}
+
+/// The path's one field of view from its keys' `fovs` (`name` in errors): None without the column; an error
+/// where it changes or lies outside (1, 170) degrees.
+fn one_fov(name: &str, fovs: &[f32]) -> Result<Option<f32>> {
+    let bad = |problem: String| Error::Config(format!("--camera-path {name}: {problem}"));
+    Ok(match fovs.first() {
+        None => None,
+        Some(&f) if fovs.iter().all(|&g| g == f) && f > 1.0 && f < 170.0 => Some(f),
+        Some(_) if fovs.iter().all(|&g| g == fovs[0]) => {
+            return Err(bad(format!("fov_deg {} must be between 1 and 170", fovs[0])))
+        }
+        Some(_) => {
+            return Err(bad(
+                "fov_deg changes along the path; LOD switch distances are computed for one field of view, \
+                 so give one value (or leave the column out and use --fov)"
+                    .into(),
+            ))
+        }
+    })
 }
 
 #[cfg(test)]

@@ -48,61 +48,14 @@ pub fn glb_with(scene: &Scene, camera: bool) -> Result<Vec<u8>> {
     // A user scene's materials, with their images as PNG.
     let drawn = w.materials_of(&scene.materials)?;
     // Meshes and materials, per model and LOD.
-    let mut lod_meshes: Vec<Vec<usize>> = Vec::new();
-    for m in scene.models.iter() {
-        let mut ids = Vec::new();
-        for (l, lod) in m.chain.lods.iter().enumerate() {
-            let material = w.material(m.color_of(l as u32));
-            ids.push(w.mesh(&format!("{}_LOD{l}", m.name), &lod.mesh, material, &drawn));
-        }
-        lod_meshes.push(ids);
-    }
+    let lod_meshes = w.lod_meshes(scene, &drawn);
     // Instances: LOD0 in the scene, the coarser LODs outside it.
     let mut roots = Vec::new();
     for (i, inst) in scene.instances.iter().enumerate() {
         if scene.ground == Some(i) {
             continue;
         }
-        let m = &scene.models[inst.model as usize];
-        let (s, r, t) = scene.instance_matrix(i, 0).to_scale_rotation_translation();
-        let place = |mesh: usize, name: String| {
-            json!({
-                "name": name,
-                "mesh": mesh,
-                "translation": t.to_array(),
-                "rotation": r.to_array(),
-                "scale": s.to_array(),
-            })
-        };
-        let ids = &lod_meshes[inst.model as usize];
-        let coarser: Vec<usize> = ids[1..]
-            .iter()
-            .enumerate()
-            .map(|(l, &mesh)| w.node(place(mesh, format!("{}_{i}_LOD{}", m.name, l + 1))))
-            .collect();
-        let mut node = place(ids[0], format!("{}_{i}_LOD0", m.name));
-        if !coarser.is_empty() {
-            let tan = (scene.fov_y * 0.5).tan();
-            let mut coverage: Vec<f64> = m
-                .switches
-                .iter()
-                .map(|&d| f64::from(m.radius / (d * tan)))
-                .collect();
-            coverage.push(0.0);
-            node["extensions"] = json!({"MSFT_lod": {"ids": coarser}});
-            node["extras"] = json!({
-                "MSFT_screencoverage": coverage,
-                "lodbench_switch_distances": m.switches,
-            });
-        }
-        if m.spin_per_frame != 0.0 {
-            let extras = node
-                .as_object_mut()
-                .map(|o| o.entry("extras").or_insert_with(|| json!({})));
-            if let Some(e) = extras {
-                e["lodbench_spin_per_frame"] = json!(m.spin_per_frame);
-            }
-        }
+        let node = w.instance(scene, i, &lod_meshes[inst.model as usize]);
         roots.push(w.node(node));
     }
     if scene.models.iter().any(|m| m.chain.lods.len() > 1) {
@@ -111,50 +64,8 @@ pub fn glb_with(scene: &Scene, camera: bool) -> Result<Vec<u8>> {
     if !camera {
         return Ok(w.finish(scene, roots));
     }
-    // The camera, one key per frame; the instances' motion given to it.
-    let frames = scene.frames.max(2);
-    let mut times = Vec::new();
-    let mut eyes = Vec::new();
-    let mut rotations = Vec::new();
-    // Every moving instance moves alike (bunny-sweep's one bunny, `Motion::SweepX`); the ground comes last. A user
-    // scene's animation is not exported: its instances stand where frame 0 has them.
-    let moving = matches!(scene.motion, crate::scene::model::Motion::SweepX { .. })
-        && !scene.instances.is_empty()
-        && scene.ground != Some(0);
-    for f in 0..frames {
-        let c = scene.camera(f.min(scene.frames - 1));
-        let shift = match moving {
-            true => scene.instance_position(0, f) - scene.instance_position(0, 0),
-            false => Vec3::ZERO,
-        };
-        let (_, rot, eye) = c.view.inverse().to_scale_rotation_translation();
-        times.push(f as f32 * FRAME_SECONDS as f32);
-        eyes.extend((eye - shift).to_array());
-        rotations.extend(rot.normalize().to_array());
-    }
-    let camera = w.camera(
-        scene.fov_y,
-        scene.near,
-        scene.far,
-        scene.width,
-        scene.height,
-    );
-    let cam_node = w.node(json!({"name": "lodbench_camera", "camera": camera}));
+    let cam_node = w.camera_path(scene);
     roots.push(cam_node);
-    let input = w.floats(&times, "SCALAR", None);
-    let t_out = w.floats(&eyes, "VEC3", None);
-    let r_out = w.floats(&rotations, "VEC4", None);
-    w.animations.push(json!({
-        "name": "lodbench camera path",
-        "samplers": [
-            {"input": input, "output": t_out, "interpolation": "LINEAR"},
-            {"input": input, "output": r_out, "interpolation": "LINEAR"},
-        ],
-        "channels": [
-            {"sampler": 0, "target": {"node": cam_node, "path": "translation"}},
-            {"sampler": 1, "target": {"node": cam_node, "path": "rotation"}},
-        ],
-    }));
     Ok(w.finish(scene, roots))
 }
 
@@ -409,6 +320,114 @@ impl Writer {
         if !self.used.contains(&name) {
             self.used.push(name);
         }
+    }
+
+    /// Every model's LOD meshes (each with its LOD's material): `[model][lod]`.
+    fn lod_meshes(&mut self, scene: &Scene, drawn: &[usize]) -> Vec<Vec<usize>> {
+        let mut lod_meshes: Vec<Vec<usize>> = Vec::new();
+        for m in scene.models.iter() {
+            let mut ids = Vec::new();
+            for (l, lod) in m.chain.lods.iter().enumerate() {
+                let material = self.material(m.color_of(l as u32));
+                ids.push(self.mesh(&format!("{}_LOD{l}", m.name), &lod.mesh, material, drawn));
+            }
+            lod_meshes.push(ids);
+        }
+        lod_meshes
+    }
+
+    /// Instance `i`'s LOD0 node at its frame-0 placement (not yet added), its model's coarser LODs (`ids[1..]`)
+    /// added as nodes outside the scene and named by MSFT_lod, with their screen coverages and switch distances.
+    fn instance(&mut self, scene: &Scene, i: usize, ids: &[usize]) -> Value {
+        let inst = &scene.instances[i];
+        let m = &scene.models[inst.model as usize];
+        let (s, r, t) = scene.instance_matrix(i, 0).to_scale_rotation_translation();
+        let place = |mesh: usize, name: String| {
+            json!({
+                "name": name,
+                "mesh": mesh,
+                "translation": t.to_array(),
+                "rotation": r.to_array(),
+                "scale": s.to_array(),
+            })
+        };
+        let coarser: Vec<usize> = ids[1..]
+            .iter()
+            .enumerate()
+            .map(|(l, &mesh)| self.node(place(mesh, format!("{}_{i}_LOD{}", m.name, l + 1))))
+            .collect();
+        let mut node = place(ids[0], format!("{}_{i}_LOD0", m.name));
+        if !coarser.is_empty() {
+            let tan = (scene.fov_y * 0.5).tan();
+            let mut coverage: Vec<f64> = m
+                .switches
+                .iter()
+                .map(|&d| f64::from(m.radius / (d * tan)))
+                .collect();
+            coverage.push(0.0);
+            node["extensions"] = json!({"MSFT_lod": {"ids": coarser}});
+            node["extras"] = json!({
+                "MSFT_screencoverage": coverage,
+                "lodbench_switch_distances": m.switches,
+            });
+        }
+        if m.spin_per_frame != 0.0 {
+            let extras = node
+                .as_object_mut()
+                .map(|o| o.entry("extras").or_insert_with(|| json!({})));
+            if let Some(e) = extras {
+                e["lodbench_spin_per_frame"] = json!(m.spin_per_frame);
+            }
+        }
+        node
+    }
+
+    /// The camera node, with the scene's camera path as its animation (one key per frame); returns the node.
+    fn camera_path(&mut self, scene: &Scene) -> usize {
+        // The instances' motion given to the camera.
+        let frames = scene.frames.max(2);
+        let mut times = Vec::new();
+        let mut eyes = Vec::new();
+        let mut rotations = Vec::new();
+        // Every moving instance moves alike (bunny-sweep's one bunny, `Motion::SweepX`); the ground comes last.
+        // A user scene's animation is not exported: its instances stand where frame 0 has them.
+        let moving = matches!(scene.motion, crate::scene::model::Motion::SweepX { .. })
+            && !scene.instances.is_empty()
+            && scene.ground != Some(0);
+        for f in 0..frames {
+            let c = scene.camera(f.min(scene.frames - 1));
+            let shift = match moving {
+                true => scene.instance_position(0, f) - scene.instance_position(0, 0),
+                false => Vec3::ZERO,
+            };
+            let (_, rot, eye) = c.view.inverse().to_scale_rotation_translation();
+            times.push(f as f32 * FRAME_SECONDS as f32);
+            eyes.extend((eye - shift).to_array());
+            rotations.extend(rot.normalize().to_array());
+        }
+        let camera = self.camera(
+            scene.fov_y,
+            scene.near,
+            scene.far,
+            scene.width,
+            scene.height,
+        );
+        let cam_node = self.node(json!({"name": "lodbench_camera", "camera": camera}));
+        let input = self.floats(&times, "SCALAR", None);
+        let t_out = self.floats(&eyes, "VEC3", None);
+        let r_out = self.floats(&rotations, "VEC4", None);
+        self.animations.push(json!({
+            "name": "lodbench camera path",
+            "samplers": [
+                {"input": input, "output": t_out, "interpolation": "LINEAR"},
+                {"input": input, "output": r_out, "interpolation": "LINEAR"},
+            ],
+            "channels": [
+                {"sampler": 0, "target": {"node": cam_node, "path": "translation"}},
+                {"sampler": 1, "target": {"node": cam_node, "path": "rotation"}},
+            ],
+        }));
+        cam_node
     }
 
     fn node(&mut self, node: Value) -> usize {

@@ -25,28 +25,7 @@ impl Content<'_> {
     pub fn animated_camera(&mut self) -> Result<Option<AnimatedCamera>, String> {
         let json = self.doc.json.clone();
         let cameras = array(&json, "cameras").len();
-        let moved = |n: usize| {
-            array(&json, "animations").iter().position(|a| {
-                array(a, "channels").iter().any(|c| {
-                    super::json::uint(&c["target"]["node"]) == Some(n as u64)
-                        && matches!(
-                            c["target"]["path"].as_str(),
-                            Some("translation" | "rotation")
-                        )
-                })
-            })
-        };
-        let mut found = None;
-        for &n in &self.nodes.scene_order {
-            if json["nodes"][n].get("camera").is_none() {
-                continue;
-            }
-            if let Some(a) = moved(n) {
-                found = Some((n, a));
-                break;
-            }
-        }
-        let Some((node, anim)) = found else {
+        let Some((node, anim)) = self.first_moved_camera(&json) else {
             return Ok(None);
         };
         let what = format!("the animation of camera node {node}");
@@ -54,13 +33,7 @@ impl Content<'_> {
             .doc
             .animation(anim)
             .map_err(|e| format!("{what}: {e}"))?;
-        let (t0, r0) = match self.nodes.local[node] {
-            super::nodes::Local::Trs { t, r, .. } => (t, r),
-            super::nodes::Local::Matrix(m) => {
-                let (_, r, t) = m.to_scale_rotation_translation();
-                (t, r)
-            }
-        };
+        let (t0, r0) = self.rest_translation_rotation(node);
         let channels: Vec<_> = animation
             .channels
             .iter()
@@ -132,5 +105,43 @@ impl Content<'_> {
             zfar: perspective("zfar"),
             keys,
         }))
+    }
+
+    /// The first camera node in scene order whose translation or rotation an animation drives, and the first
+    /// such animation.
+    fn first_moved_camera(&self, json: &serde_json::Value) -> Option<(usize, usize)> {
+        let moved = |n: usize| {
+            array(json, "animations").iter().position(|a| {
+                array(a, "channels").iter().any(|c| {
+                    super::json::uint(&c["target"]["node"]) == Some(n as u64)
+                        && matches!(
+                            c["target"]["path"].as_str(),
+                            Some("translation" | "rotation")
+                        )
+                })
+            })
+        };
+        let mut found = None;
+        for &n in &self.nodes.scene_order {
+            if json["nodes"][n].get("camera").is_none() {
+                continue;
+            }
+            if let Some(a) = moved(n) {
+                found = Some((n, a));
+                break;
+            }
+        }
+        found
+    }
+
+    /// Node `node`'s local translation and rotation at rest.
+    fn rest_translation_rotation(&self, node: usize) -> (Vec3, Quat) {
+        match self.nodes.local[node] {
+            super::nodes::Local::Trs { t, r, .. } => (t, r),
+            super::nodes::Local::Matrix(m) => {
+                let (_, r, t) = m.to_scale_rotation_translation();
+                (t, r)
+            }
+        }
     }
 }

@@ -271,59 +271,10 @@ impl Doc<'_> {
             }
             None => None,
         };
-        let aux = match attribute(attrs, "_LODBENCH_AUX", what, accessors)? {
-            Some(a) => {
-                let (v, c) = self.read_floats(a)?;
-                if c != 4 || v.len() != n * 4 {
-                    return Err(format!("{what}: _LODBENCH_AUX is not one VEC4 per vertex"));
-                }
-                Some(
-                    v.chunks_exact(4)
-                        .map(|a| [a[0], a[1], a[2], a[3]])
-                        .collect(),
-                )
-            }
-            None => None,
-        };
+        let aux = self.lodbench_aux(attrs, what, n)?;
         let skin = self.skin_influences(attrs, what, n)?;
-        let mut targets = Vec::new();
-        for (k, t) in array(prim, "targets").iter().enumerate() {
-            let twhat = format!("{what} morph target {k}");
-            let read3 = |doc: &mut Self,
-                         key: &str,
-                         kind: &str|
-             -> Result<Option<Vec<[f32; 3]>>, String> {
-                match attribute(t, key, &twhat, accessors)? {
-                    Some(a) => {
-                        let v = doc.read_vecs::<3>(a, &twhat, kind)?;
-                        if v.len() != n {
-                            return Err(format!("{twhat} has {} {kind} for {n} vertices", v.len()));
-                        }
-                        Ok(Some(v))
-                    }
-                    None => Ok(None),
-                }
-            };
-            let positions = read3(self, "POSITION", "position displacements")?;
-            let normals = read3(self, "NORMAL", "normal displacements")?;
-            targets.push(MorphTarget {
-                positions: positions.unwrap_or_else(|| vec![[0.0; 3]; n]),
-                normals,
-            });
-        }
-        let count = u32::try_from(n).map_err(|_| format!("{what} has too many vertices"))?;
-        let order: Vec<u32> =
-            match opt_index(&prim["indices"], || format!("{what}'s indices"), accessors)? {
-                Some(ix) => self.read_indices(ix, what)?,
-                None => (0..count).collect(),
-            };
-        if let Some(&bad) = order.iter().find(|&&ix| ix >= count) {
-            return Err(format!(
-                "{what} uses vertex index {bad} but has {count} vertices"
-            ));
-        }
-        let indices = triangulate(mode, &order)
-            .ok_or_else(|| format!("{what} has {} indices, not a multiple of 3", order.len()))?;
+        let targets = self.morph_targets(prim, what, n)?;
+        let indices = self.triangle_indices(prim, mode, what, n)?;
         let materials = array(&self.json, "materials").len();
         let material = opt_index(
             &prim["material"],
@@ -349,6 +300,93 @@ impl Doc<'_> {
             }
         }
         Ok(t)
+    }
+
+    /// The `_LODBENCH_AUX` attribute (lodbench's own export: one VEC4 per vertex of the `n`), where present.
+    fn lodbench_aux(
+        &mut self,
+        attrs: &Value,
+        what: &str,
+        n: usize,
+    ) -> Result<Option<Vec<[f32; 4]>>, String> {
+        let accessors = array(&self.json, "accessors").len();
+        Ok(match attribute(attrs, "_LODBENCH_AUX", what, accessors)? {
+            Some(a) => {
+                let (v, c) = self.read_floats(a)?;
+                if c != 4 || v.len() != n * 4 {
+                    return Err(format!("{what}: _LODBENCH_AUX is not one VEC4 per vertex"));
+                }
+                Some(
+                    v.chunks_exact(4)
+                        .map(|a| [a[0], a[1], a[2], a[3]])
+                        .collect(),
+                )
+            }
+            None => None,
+        })
+    }
+
+    /// The primitive's morph targets over its `n` vertices: POSITION displacements (zeros where a target has
+    /// none) and NORMAL ones.
+    fn morph_targets(
+        &mut self,
+        prim: &Value,
+        what: &str,
+        n: usize,
+    ) -> Result<Vec<MorphTarget>, String> {
+        let accessors = array(&self.json, "accessors").len();
+        let mut targets = Vec::new();
+        for (k, t) in array(prim, "targets").iter().enumerate() {
+            let twhat = format!("{what} morph target {k}");
+            let read3 = |doc: &mut Self,
+                         key: &str,
+                         kind: &str|
+             -> Result<Option<Vec<[f32; 3]>>, String> {
+                match attribute(t, key, &twhat, accessors)? {
+                    Some(a) => {
+                        let v = doc.read_vecs::<3>(a, &twhat, kind)?;
+                        if v.len() != n {
+                            return Err(format!("{twhat} has {} {kind} for {n} vertices", v.len()));
+                        }
+                        Ok(Some(v))
+                    }
+                    None => Ok(None),
+                }
+            };
+            let positions = read3(self, "POSITION", "position displacements")?;
+            let normals = read3(self, "NORMAL", "normal displacements")?;
+            targets.push(MorphTarget {
+                positions: positions.unwrap_or_else(|| vec![[0.0; 3]; n]),
+                normals,
+            });
+        }
+        Ok(targets)
+    }
+
+    /// The primitive's triangles (`mode`'s strips and fans triangulated) as indices into its `n` vertices:
+    /// its index accessor, or the vertices in order.
+    fn triangle_indices(
+        &mut self,
+        prim: &Value,
+        mode: u64,
+        what: &str,
+        n: usize,
+    ) -> Result<Vec<u32>, String> {
+        let accessors = array(&self.json, "accessors").len();
+        let count = u32::try_from(n).map_err(|_| format!("{what} has too many vertices"))?;
+        let order: Vec<u32> =
+            match opt_index(&prim["indices"], || format!("{what}'s indices"), accessors)? {
+                Some(ix) => self.read_indices(ix, what)?,
+                None => (0..count).collect(),
+            };
+        if let Some(&bad) = order.iter().find(|&&ix| ix >= count) {
+            return Err(format!(
+                "{what} uses vertex index {bad} but has {count} vertices"
+            ));
+        }
+        let indices = triangulate(mode, &order)
+            .ok_or_else(|| format!("{what} has {} indices, not a multiple of 3", order.len()))?;
+        Ok(indices)
     }
 
     /// The texture coordinate set of material `m`'s normal texture, when it has one.

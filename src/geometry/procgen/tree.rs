@@ -143,24 +143,7 @@ impl Rng {
 impl TreeSkeleton {
     fn generate(seed: u64) -> TreeSkeleton {
         let mut rng = Rng(SplitMix64::new(seed));
-        let mut branches = Vec::new();
-        // Trunk.
-        let trunk_len = 5.6;
-        let lean = Vec3::new(rng.range(-0.04, 0.04), 1.0, rng.range(-0.04, 0.04));
-        let trunk = grow(
-            &mut rng,
-            Vec3::ZERO,
-            lean.normalize_or(Vec3::Y),
-            trunk_len,
-            (0.28, 0.05),
-            FINE_SEGMENTS[0],
-            0.03,
-        );
-        branches.push(Branch {
-            level: 0,
-            points: trunk.0,
-            radii: trunk.1,
-        });
+        let mut branches = vec![Self::trunk(&mut rng)];
         // Children, level by level.
         let mut parents = vec![0usize];
         for level in 1..4 {
@@ -219,29 +202,54 @@ impl TreeSkeleton {
         // Leaves around every twig.
         let mut leaves = Vec::with_capacity(parents.len());
         for &ti in &parents {
-            let tw = &branches[ti];
-            let len: f32 = tw.points.windows(2).map(|w| w[0].distance(w[1])).sum();
-            let spread = 0.55 * len;
-            let mut list = Vec::with_capacity(LEAVES_PER_TWIG);
-            for _ in 0..LEAVES_PER_TWIG {
-                let t = rng.range(0.15, 1.0);
-                let (at, _, _) = sample_polyline(&tw.points, &tw.radii, t);
-                let base = at + rng.in_ball() * spread;
-                let along = rng.unit();
-                let across = along.any_orthonormal_vector();
-                let spin = Quat::from_axis_angle(along, rng.range(0.0, TAU));
-                list.push(Leaf {
-                    base,
-                    across: spin * across,
-                    along,
-                    length: rng.range(0.13, 0.19),
-                });
-            }
-            leaves.push(list);
+            leaves.push(Self::twig_leaves(&mut rng, &branches[ti]));
         }
         let mut sk = TreeSkeleton { branches, leaves };
         sk.normalise_height();
         sk
+    }
+
+    /// The trunk: 5.6 units, leaning a little off the vertical.
+    fn trunk(rng: &mut Rng) -> Branch {
+        let trunk_len = 5.6;
+        let lean = Vec3::new(rng.range(-0.04, 0.04), 1.0, rng.range(-0.04, 0.04));
+        let trunk = grow(
+            rng,
+            Vec3::ZERO,
+            lean.normalize_or(Vec3::Y),
+            trunk_len,
+            (0.28, 0.05),
+            FINE_SEGMENTS[0],
+            0.03,
+        );
+        Branch {
+            level: 0,
+            points: trunk.0,
+            radii: trunk.1,
+        }
+    }
+
+    /// [`LEAVES_PER_TWIG`] leaves scattered around twig `tw`, each at a random point along it and turned at
+    /// random.
+    fn twig_leaves(rng: &mut Rng, tw: &Branch) -> Vec<Leaf> {
+        let len: f32 = tw.points.windows(2).map(|w| w[0].distance(w[1])).sum();
+        let spread = 0.55 * len;
+        let mut list = Vec::with_capacity(LEAVES_PER_TWIG);
+        for _ in 0..LEAVES_PER_TWIG {
+            let t = rng.range(0.15, 1.0);
+            let (at, _, _) = sample_polyline(&tw.points, &tw.radii, t);
+            let base = at + rng.in_ball() * spread;
+            let along = rng.unit();
+            let across = along.any_orthonormal_vector();
+            let spin = Quat::from_axis_angle(along, rng.range(0.0, TAU));
+            list.push(Leaf {
+                base,
+                across: spin * across,
+                along,
+                length: rng.range(0.13, 0.19),
+            });
+        }
+        list
     }
 
     /// Scales everything about the origin so that LOD0's highest point is at [`TREE_HEIGHT`].

@@ -110,12 +110,59 @@ impl SummaryRecord {
         clock: Clock,
     ) -> Option<SummaryRecord> {
         let first = rows.first()?;
+        let mut s = SummaryRecord {
+            scene: first.scene.clone(),
+            method: first.method.clone(),
+            count: first.count,
+            frames: rows.len() as u32,
+            extra_target_bytes,
+            tri_alternation_max: tri_alternation_max(rows),
+            clock,
+            rounds: rows.iter().map(|r| r.round + 1).max().unwrap_or(0),
+            // The baseline, the ratios and the ceiling's columns: set_ratios and set_ceiling fill them.
+            ..SummaryRecord::default()
+        };
+        s.set_timing_figures(rows);
+        s.set_image_figures(rows, seed);
+        Some(s)
+    }
+
+    /// The timing pass's figures of the block's rows: times (the GPU's also in and out of transition), and
+    /// what was drawn.
+    fn set_timing_figures(&mut self, rows: &[FrameRecord]) {
+        let gpu: Vec<f64> = rows.iter().filter_map(|r| r.gpu_ms).collect();
+        let cpu: Vec<f64> = rows.iter().map(|r| r.cpu_ms).collect();
+        let gpu_where = |transition: bool| {
+            rows.iter()
+                .filter(|r| (r.t_instances > 0) == transition)
+                .filter_map(|r| r.gpu_ms)
+                .collect::<Vec<_>>()
+        };
+        self.gpu_ms_median = percentile(&gpu, 50.0);
+        self.gpu_ms_median_transition = percentile(&gpu_where(true), 50.0);
+        self.gpu_ms_median_steady = percentile(&gpu_where(false), 50.0);
+        self.gpu_ms_p5 = percentile(&gpu, 5.0);
+        self.gpu_ms_p95 = percentile(&gpu, 95.0);
+        self.cpu_ms_median = percentile(&cpu, 50.0).unwrap_or(f64::NAN);
+        self.triangles_mean = mean(rows.iter().map(|r| r.triangles as f64));
+        self.draw_calls_mean = mean(rows.iter().map(|r| r.draw_calls as f64));
+        self.t_instances_mean = mean(rows.iter().map(|r| r.t_instances as f64));
+        self.units_drawn_mean = mean(rows.iter().map(|r| r.units_drawn as f64));
+        self.combine_gpu_ms_median = percentile(
+            &rows
+                .iter()
+                .filter_map(|r| r.combine_gpu_ms)
+                .collect::<Vec<_>>(),
+            50.0,
+        );
+    }
+
+    /// The quality pass's figures of the block's rows (`seed` drives the RMSE's bootstrap): each None when a
+    /// frame has none (`--quality off`).
+    fn set_image_figures(&mut self, rows: &[FrameRecord], seed: u64) {
         let lag: Option<Vec<f64>> = rows.iter().map(|r| r.lag_rmse).collect();
         let shadow_rmse: Option<Vec<f64>> = rows.iter().map(|r| r.shadow_rmse).collect();
         let shadow_lodpop: Option<Vec<f64>> = rows.iter().map(|r| r.shadow_lodpop).collect();
-        let gpu: Vec<f64> = rows.iter().filter_map(|r| r.gpu_ms).collect();
-        let cpu: Vec<f64> = rows.iter().map(|r| r.cpu_ms).collect();
-        // The quality pass's figures: None when a frame has none (`--quality off`).
         let pop: Option<Vec<f64>> = rows.iter().map(|r| r.pop).collect();
         let rmse: Option<Vec<f64>> = rows.iter().map(|r| r.rmse).collect();
         let lodpop: Option<Vec<f64>> = rows.iter().map(|r| r.lodpop).collect();
@@ -123,80 +170,34 @@ impl SummaryRecord {
         let crack: Option<Vec<u64>> = rows.iter().map(|r| r.crack_px).collect();
         let max = |v: &Vec<f64>| v.iter().copied().fold(0.0, f64::max);
         let mean_of = |v: &Vec<u64>| mean(v.iter().map(|&x| x as f64));
-        let gpu_where = |transition: bool| {
-            rows.iter()
-                .filter(|r| (r.t_instances > 0) == transition)
-                .filter_map(|r| r.gpu_ms)
-                .collect::<Vec<_>>()
-        };
         let de2000: Option<Vec<f64>> = rows.iter().map(|r| r.de2000_mean).collect();
         let rmse_ci = rmse.as_ref().map(|rmse| {
             bootstrap_ci(rmse, seed ^ 0x524D_5345, |v| Some(mean(v.iter().copied())))
                 .unwrap_or((0.0, 0.0))
         });
-        Some(SummaryRecord {
-            scene: first.scene.clone(),
-            method: first.method.clone(),
-            count: first.count,
-            frames: rows.len() as u32,
-            gpu_ms_median: percentile(&gpu, 50.0),
-            gpu_ms_median_transition: percentile(&gpu_where(true), 50.0),
-            gpu_ms_median_steady: percentile(&gpu_where(false), 50.0),
-            gpu_ms_p5: percentile(&gpu, 5.0),
-            gpu_ms_p95: percentile(&gpu, 95.0),
-            cpu_ms_median: percentile(&cpu, 50.0).unwrap_or(f64::NAN),
-            triangles_mean: mean(rows.iter().map(|r| r.triangles as f64)),
-            draw_calls_mean: mean(rows.iter().map(|r| r.draw_calls as f64)),
-            t_instances_mean: mean(rows.iter().map(|r| r.t_instances as f64)),
-            rmse_mean: rmse.as_ref().map(|v| mean(v.iter().copied())),
-            rmse_mean_ci95_lo: rmse_ci.map(|c| c.0),
-            rmse_mean_ci95_hi: rmse_ci.map(|c| c.1),
-            rmse_max: rmse.as_ref().map(max),
-            pop_max: pop.as_ref().map(max),
-            pop_p95: pop.as_ref().map(|v| percentile(v, 95.0).unwrap_or(0.0)),
-            lodpop_max: lodpop.as_ref().map(max),
-            lodpop_p95: lodpop.as_ref().map(|v| percentile(v, 95.0).unwrap_or(0.0)),
-            lodpop_sum: lodpop.as_ref().map(|v| v.iter().sum()),
-            de2000_mean: de2000.as_ref().map(|v| mean(v.iter().copied())),
-            de2000_max: de2000.map(|v| v.into_iter().fold(0.0, f64::max)),
-            flip_mean: rows
-                .iter()
-                .map(|r| r.flip_mean)
-                .collect::<Option<Vec<f64>>>()
-                .map(|v| mean(v.into_iter())),
-            units_drawn_mean: mean(rows.iter().map(|r| r.units_drawn as f64)),
-            uncovered_px_mean: uncovered.as_ref().map(mean_of),
-            crack_px_mean: crack.as_ref().map(mean_of),
-            crack_px_max: crack.map(|v| v.into_iter().max().unwrap_or(0)),
-            extra_target_bytes,
-            tri_alternation_max: tri_alternation_max(rows),
-            combine_gpu_ms_median: percentile(
-                &rows
-                    .iter()
-                    .filter_map(|r| r.combine_gpu_ms)
-                    .collect::<Vec<_>>(),
-                50.0,
-            ),
-            lag_rmse_mean: lag.as_ref().map(|v| mean(v.iter().copied())),
-            lag_rmse_max: lag.map(|v| v.into_iter().fold(0.0, f64::max)),
-            shadow_rmse_mean: shadow_rmse.as_ref().map(|v| mean(v.iter().copied())),
-            shadow_lodpop_max: shadow_lodpop.map(|v| v.into_iter().fold(0.0, f64::max)),
-            baseline: None,
-            clock,
-            rounds: rows.iter().map(|r| r.round + 1).max().unwrap_or(0),
-            ratio_to_baseline: None,
-            ratio_to_baseline_ci95_lo: None,
-            ratio_to_baseline_ci95_hi: None,
-            ratio_to_baseline_transition: None,
-            ratio_to_baseline_transition_ci95_lo: None,
-            ratio_to_baseline_transition_ci95_hi: None,
-            ratio_to_baseline_steady: None,
-            ratio_to_baseline_steady_ci95_lo: None,
-            ratio_to_baseline_steady_ci95_hi: None,
-            triangles_per_s: None,
-            triangle_ceiling_share: None,
-            bound: None,
-        })
+        self.rmse_mean = rmse.as_ref().map(|v| mean(v.iter().copied()));
+        self.rmse_mean_ci95_lo = rmse_ci.map(|c| c.0);
+        self.rmse_mean_ci95_hi = rmse_ci.map(|c| c.1);
+        self.rmse_max = rmse.as_ref().map(max);
+        self.pop_max = pop.as_ref().map(max);
+        self.pop_p95 = pop.as_ref().map(|v| percentile(v, 95.0).unwrap_or(0.0));
+        self.lodpop_max = lodpop.as_ref().map(max);
+        self.lodpop_p95 = lodpop.as_ref().map(|v| percentile(v, 95.0).unwrap_or(0.0));
+        self.lodpop_sum = lodpop.as_ref().map(|v| v.iter().sum());
+        self.de2000_mean = de2000.as_ref().map(|v| mean(v.iter().copied()));
+        self.de2000_max = de2000.map(|v| v.into_iter().fold(0.0, f64::max));
+        self.flip_mean = rows
+            .iter()
+            .map(|r| r.flip_mean)
+            .collect::<Option<Vec<f64>>>()
+            .map(|v| mean(v.into_iter()));
+        self.uncovered_px_mean = uncovered.as_ref().map(mean_of);
+        self.crack_px_mean = crack.as_ref().map(mean_of);
+        self.crack_px_max = crack.map(|v| v.into_iter().max().unwrap_or(0));
+        self.lag_rmse_mean = lag.as_ref().map(|v| mean(v.iter().copied()));
+        self.lag_rmse_max = lag.map(|v| v.into_iter().fold(0.0, f64::max));
+        self.shadow_rmse_mean = shadow_rmse.as_ref().map(|v| mean(v.iter().copied()));
+        self.shadow_lodpop_max = shadow_lodpop.map(|v| v.into_iter().fold(0.0, f64::max));
     }
 
     /// Fills the ratio columns from this block's rows and the baseline's (same scene, count, frames, rounds),

@@ -5,12 +5,12 @@
 //! camera's path.
 
 use crate::error::{Error, Result};
-use crate::geometry::gltf::ChainSource;
+use crate::geometry::gltf::{AuthoredChain, ChainSource};
 use crate::geometry::lod::{self, LodChain};
 use crate::geometry::mesh::Mesh;
 use crate::scene::bunny::USER_SWITCH_FIT_MULTIPLES;
 use crate::scene::config::{screen_size_distance, SceneConfig};
-use crate::scene::kind::ProfileValues;
+use crate::scene::kind::{ProfileValues, SceneKind};
 use crate::scene::model::Model;
 use crate::scene::user::models::PendingModel;
 use crate::scene::user::parts::ChainDescription;
@@ -21,6 +21,23 @@ pub struct View<'a> {
     pub pv: &'a ProfileValues,
     pub fov_y: f32,
     pub pixel_error: f32,
+}
+
+impl<'a> View<'a> {
+    /// The view of scene `kind` with vertical field of view `fov_y`: its pixel error at the profile's height.
+    pub fn new(
+        kind: SceneKind,
+        cfg: &'a SceneConfig,
+        pv: &'a ProfileValues,
+        fov_y: f32,
+    ) -> View<'a> {
+        View {
+            cfg,
+            pv,
+            fov_y,
+            pixel_error: cfg.pixel_error(kind, pv.height),
+        }
+    }
 }
 
 /// The model of `pending` (file `file`): its chain and switch distances. `seen_from`: the nearest distance the
@@ -38,35 +55,7 @@ pub fn build(
     };
     let (center, radius) = pending.levels[0].bounding_sphere();
     let Some(info) = &pending.authored else {
-        let errors: Vec<f32> = USER_SWITCH_FIT_MULTIPLES
-            .iter()
-            .map(|m| {
-                lod::error_at_distance(
-                    m * seen_from,
-                    1.0,
-                    view.pixel_error,
-                    view.pv.height,
-                    view.fov_y,
-                )
-            })
-            .collect();
-        let mesh = pending
-            .levels
-            .into_iter()
-            .next()
-            .ok_or_else(|| bad("a model without a mesh".into()))?;
-        let (chain, note) =
-            LodChain::build_by_error(&pending.name, &mesh, &errors, view.cfg.simplify)?;
-        let mut model = finish(
-            view,
-            pending.name,
-            chain,
-            (center, radius),
-            "pixel-error",
-            pending.color,
-        )?;
-        model.lod_colors = pending.lod_colors;
-        return Ok((model, None, note.map(|n| format!("{file}: mesh {n}"))));
+        return generated(file, pending, view, seen_from, (center, radius));
     };
     let chain = &info.chain;
     let meshes = pending.levels;
@@ -74,37 +63,8 @@ pub fn build(
         .switch_distances
         .as_ref()
         .filter(|d| d.len() + 1 == meshes.len());
-    let to_errors = |d: &[f32]| -> Vec<f32> {
-        std::iter::once(0.0)
-            .chain(d.iter().map(|&d| {
-                lod::error_at_distance(d, 1.0, view.pixel_error, view.pv.height, view.fov_y)
-            }))
-            .collect()
-    };
-    let (errors, thresholds, source) = match (&chain.screen_coverage, exact) {
-        (_, Some(d)) => (
-            to_errors(d),
-            format!("extras.lodbench_switch_distances {d:?} (lodbench export's exact distances)"),
-            "lodbench_switch_distances",
-        ),
-        (Some(c), None) if c.len() + 1 >= meshes.len() && meshes.len() > 1 => {
-            let d: Vec<f32> = c[..meshes.len() - 1]
-                .iter()
-                .map(|&c| screen_size_distance(radius, c as f32, view.fov_y))
-                .collect();
-            (
-                to_errors(&d),
-                format!("MSFT_screencoverage {c:?} (the last value, the cull threshold, not used)"),
-                "MSFT_screencoverage",
-            )
-        }
-        _ => (
-            estimated_errors(file, &meshes)?,
-            "meshopt's error at each level's triangle count, projected to --pixel-error"
-                .to_string(),
-            "pixel-error (estimated)",
-        ),
-    };
+    let (errors, thresholds, source) =
+        authored_errors(file, (chain, exact), &meshes, radius, view)?;
     let levels = meshes.len();
     let lod_chain = LodChain::from_meshes(&pending.name, meshes, &errors)
         .map_err(|e| bad(format!("LOD chain '{}': {e}", chain.name)))?;
@@ -137,6 +97,92 @@ pub fn build(
         }),
         None,
     ))
+}
+
+/// The model of a `pending` model without an authored chain: LOD0 simplified to the errors `--pixel-error`
+/// allows at multiples of `seen_from`, and meshopt's note where it stopped short.
+fn generated(
+    file: &str,
+    pending: PendingModel,
+    view: &View<'_>,
+    seen_from: f32,
+    (center, radius): (glam::Vec3, f32),
+) -> Result<(Model, Option<ChainDescription>, Option<String>)> {
+    let bad = |problem: String| Error::Mesh {
+        path: file.to_string(),
+        problem,
+    };
+    let errors: Vec<f32> = USER_SWITCH_FIT_MULTIPLES
+        .iter()
+        .map(|m| {
+            lod::error_at_distance(
+                m * seen_from,
+                1.0,
+                view.pixel_error,
+                view.pv.height,
+                view.fov_y,
+            )
+        })
+        .collect();
+    let mesh = pending
+        .levels
+        .into_iter()
+        .next()
+        .ok_or_else(|| bad("a model without a mesh".into()))?;
+    let (chain, note) = LodChain::build_by_error(&pending.name, &mesh, &errors, view.cfg.simplify)?;
+    let mut model = finish(
+        view,
+        pending.name,
+        chain,
+        (center, radius),
+        "pixel-error",
+        pending.color,
+    )?;
+    model.lod_colors = pending.lod_colors;
+    Ok((model, None, note.map(|n| format!("{file}: mesh {n}"))))
+}
+
+/// An authored chain's errors per level, how its thresholds were given, and the switch source: its `exact`
+/// switch distances, else its screen coverages (for a model of bounding radius `radius`), else meshopt's
+/// estimate.
+fn authored_errors(
+    file: &str,
+    (chain, exact): (&AuthoredChain, Option<&Vec<f32>>),
+    meshes: &[Mesh],
+    radius: f32,
+    view: &View<'_>,
+) -> Result<(Vec<f32>, String, &'static str)> {
+    let to_errors = |d: &[f32]| -> Vec<f32> {
+        std::iter::once(0.0)
+            .chain(d.iter().map(|&d| {
+                lod::error_at_distance(d, 1.0, view.pixel_error, view.pv.height, view.fov_y)
+            }))
+            .collect()
+    };
+    Ok(match (&chain.screen_coverage, exact) {
+        (_, Some(d)) => (
+            to_errors(d),
+            format!("extras.lodbench_switch_distances {d:?} (lodbench export's exact distances)"),
+            "lodbench_switch_distances",
+        ),
+        (Some(c), None) if c.len() + 1 >= meshes.len() && meshes.len() > 1 => {
+            let d: Vec<f32> = c[..meshes.len() - 1]
+                .iter()
+                .map(|&c| screen_size_distance(radius, c as f32, view.fov_y))
+                .collect();
+            (
+                to_errors(&d),
+                format!("MSFT_screencoverage {c:?} (the last value, the cull threshold, not used)"),
+                "MSFT_screencoverage",
+            )
+        }
+        _ => (
+            estimated_errors(file, meshes)?,
+            "meshopt's error at each level's triangle count, projected to --pixel-error"
+                .to_string(),
+            "pixel-error (estimated)",
+        ),
+    })
 }
 
 /// An authored chain's errors without thresholds: for each level after LOD0, the error meshopt reaches when it

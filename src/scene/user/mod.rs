@@ -48,20 +48,11 @@ pub fn def(
 ) -> Result<(ModelSet, UserParts)> {
     let started = std::time::Instant::now();
     let file = kind.user_path().unwrap_or(kind.name());
-    let bad = |problem: String| Error::Mesh {
-        path: file.to_string(),
-        problem,
-    };
-    let path = Path::new(file);
-    let bytes = read_mesh_file(path, file)?;
-    let mut content = gltf::read(&bytes, path.parent().unwrap_or(Path::new(""))).map_err(bad)?;
+    let bytes = read_mesh_file(Path::new(file), file)?;
 
     // The camera and the animation: the file camera's field of view replaces --fov before any switch distance.
-    let camera = flight::file_camera(file, &mut content, cfg)?;
+    let (mut content, camera, rig, clip) = open(file, &bytes, cfg)?;
     let fov_y = camera.as_ref().and_then(|c| c.0.yfov).unwrap_or(fov_y);
-    let clip_index = motion::choose(file, &content, &cfg.animation)?;
-    let rig = content.rig(clip_index).map_err(bad)?;
-    let clip = motion::clip(&rig);
 
     // The models at rest, and how the clip moves their instances.
     let mut collected =
@@ -77,12 +68,7 @@ pub fn def(
     let (eye0, start) = flight::start(sphere, pv, fov_y);
 
     // The LOD chains, a generated chain's levels at multiples of the distance its model is first seen from.
-    let view = chains::View {
-        cfg,
-        pv,
-        fov_y,
-        pixel_error: cfg.pixel_error(kind, pv.height),
-    };
+    let view = chains::View::new(kind, cfg, pv, fov_y);
     let first_seen = FirstSeen {
         spheres: &spheres,
         eye: (camera.is_none() && cfg.camera_path.is_none()).then_some(eye0),
@@ -95,16 +81,7 @@ pub fn def(
         &first_seen,
     )?;
     notes.splice(0..0, collected.notes);
-    let instances: Vec<Instance> = collected
-        .instances
-        .iter()
-        .map(|i| Instance {
-            model: i.model as u32,
-            position: i.translation + i.rotation * models[i.model].center,
-            yaw: 0.0,
-            rotation: i.rotation,
-        })
-        .collect();
+    let instances = place_instances(&collected.instances, &models);
 
     // The animation, when something moves, and the deformed models' reach over every pose.
     let animation = clip
@@ -132,22 +109,7 @@ pub fn def(
     );
     let (from, to) = (eye0, sphere.0 + Vec3::Z * end);
     let (near, far) = clip_planes(&models, &instances, &placed, pv.frames, &camera, [from, to]);
-    let camera_source = match &camera {
-        Some((a, c)) => format!(
-            "the file's camera animation (node {}, {} keys{}), resampled to the frames",
-            a.node,
-            c.keys,
-            a.yfov
-                .map_or(String::new(), |f| format!(", vertical fov {:.2} deg", f.to_degrees()))
-        ),
-        None => format!(
-            "a flight from {:?} to {:?} looking along -z: frame 0 shows the whole scene (its bounding sphere, \
-             radius {:.4}, fits the view), then out until every model has passed its last switch",
-            from.to_array(),
-            to.to_array(),
-            sphere.1
-        ),
-    };
+    let camera_source = camera_source(&camera, [from, to], sphere.1);
     let parts = UserParts {
         materials,
         instance_count: instances.len(),
@@ -166,11 +128,7 @@ pub fn def(
         animation: animation.map(Arc::new),
         animations: content.animation_names(),
         notes,
-        sources: collected
-            .instances
-            .iter()
-            .map(|i| i.source.clone())
-            .collect(),
+        sources: instance_sources(&collected.instances),
         skipped: collected.skipped,
     };
     let set = ModelSet {
@@ -180,6 +138,76 @@ pub fn def(
         notes: Vec::new(),
     };
     Ok((set, parts))
+}
+
+/// The file camera's animation, when the file has one.
+type FileCamera = Option<(
+    gltf::AnimatedCamera,
+    Arc<crate::scene::camera_path::CameraPath>,
+)>;
+
+/// glTF file `file` (its `bytes`) opened: its content, its camera (`--camera-path` or the file's), and its rig
+/// with the clip `--animation` chooses.
+fn open<'b>(
+    file: &'b str,
+    bytes: &'b [u8],
+    cfg: &SceneConfig,
+) -> Result<(
+    gltf::Content<'b>,
+    FileCamera,
+    gltf::Rig,
+    Option<crate::scene::animated::Clip>,
+)> {
+    let bad = |problem: String| Error::Mesh {
+        path: file.to_string(),
+        problem,
+    };
+    let path = Path::new(file);
+    let mut content = gltf::read(bytes, path.parent().unwrap_or(Path::new(""))).map_err(bad)?;
+    let camera = flight::file_camera(file, &mut content, cfg)?;
+    let clip_index = motion::choose(file, &content, &cfg.animation)?;
+    let rig = content.rig(clip_index).map_err(bad)?;
+    let clip = motion::clip(&rig);
+    Ok((content, camera, rig, clip))
+}
+
+/// The instances at rest: each at its placement, its model's centre moved with it.
+fn place_instances(pending: &[models::PendingInstance], models: &[Model]) -> Vec<Instance> {
+    pending
+        .iter()
+        .map(|i| Instance {
+            model: i.model as u32,
+            position: i.translation + i.rotation * models[i.model].center,
+            yaw: 0.0,
+            rotation: i.rotation,
+        })
+        .collect()
+}
+
+/// Each instance's source: its node, and what it holds.
+fn instance_sources(pending: &[models::PendingInstance]) -> Vec<InstanceSource> {
+    pending.iter().map(|i| i.source.clone()).collect()
+}
+
+/// What the camera does, in words: the file's camera animation, or the default flight `[from, to]` over a
+/// scene of bounding radius `radius`.
+fn camera_source(camera: &FileCamera, [from, to]: [Vec3; 2], radius: f32) -> String {
+    match camera {
+        Some((a, c)) => format!(
+            "the file's camera animation (node {}, {} keys{}), resampled to the frames",
+            a.node,
+            c.keys,
+            a.yfov
+                .map_or(String::new(), |f| format!(", vertical fov {:.2} deg", f.to_degrees()))
+        ),
+        None => format!(
+            "a flight from {:?} to {:?} looking along -z: frame 0 shows the whole scene (its bounding sphere, \
+             radius {:.4}, fits the view), then out until every model has passed its last switch",
+            from.to_array(),
+            to.to_array(),
+            radius
+        ),
+    }
 }
 
 /// Every instance's model-to-world matrix on every frame: its track where the clip moves it, else its rest
@@ -319,10 +347,7 @@ fn clip_planes(
     instances: &[Instance],
     placed: &Placed,
     frames: u32,
-    camera: &Option<(
-        gltf::AnimatedCamera,
-        Arc<crate::scene::camera_path::CameraPath>,
-    )>,
+    camera: &FileCamera,
     flight: [Vec3; 2],
 ) -> (f32, f32) {
     let eyes: Vec<Vec3> = match camera {

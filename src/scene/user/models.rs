@@ -497,30 +497,7 @@ impl<'c, 'a> Collector<'c, 'a> {
             let mut levels = Vec::new();
             let mut colors = Vec::new();
             for (l, ps) in level_placements.iter().enumerate() {
-                let mut merged: Option<gltf::MergedParts> = None;
-                for p in ps {
-                    let prims = c.primitives(p.mesh)?;
-                    if Content::is_skinned(p, &prims) || c.weighs(p.node) {
-                        c.out.notes.push(format!(
-                            "{}: {what}: level {l}'s mesh {} is skinned or has animated weights; drawn at rest \
-                             (lodbench animates the skins and morph targets of meshes without authored chains)",
-                            c.file, p.mesh
-                        ));
-                    }
-                    let part = c
-                        .content
-                        .placed_as(p, &prims, to_model * p.world, to_model)
-                        .map_err(|e| c.bad(e))?;
-                    match &mut merged {
-                        Some(m) => m.append(part).map_err(|e| c.bad(e))?,
-                        None => merged = Some(part),
-                    }
-                }
-                let mut parts = merged.ok_or_else(|| c.bad(format!("{what}: level {l} is empty")))?;
-                parts.data.deform = None;
-                if parts.indices.is_empty() {
-                    return Err(c.bad(format!("{what}: level {l} has no triangles")));
-                }
+                let parts = c.chain_level(&what, l, ps, to_model)?;
                 levels.push(c.mesh_from(parts)?);
                 colors.push(c.content.mesh_color(ps[0].mesh));
             }
@@ -566,6 +543,42 @@ impl<'c, 'a> Collector<'c, 'a> {
             });
         }
         Ok(())
+    }
+
+    /// Level `l` of the authored chain `what`: its placements `ps` merged in the chain's model space (`to_model`),
+    /// at rest (with a note where a mesh is skinned or has animated weights). Errors where it has no triangles.
+    fn chain_level(
+        &mut self,
+        what: &str,
+        l: usize,
+        ps: &[Placement],
+        to_model: Mat4,
+    ) -> Result<gltf::MergedParts> {
+        let mut merged: Option<gltf::MergedParts> = None;
+        for p in ps {
+            let prims = self.primitives(p.mesh)?;
+            if Content::is_skinned(p, &prims) || self.weighs(p.node) {
+                self.out.notes.push(format!(
+                    "{}: {what}: level {l}'s mesh {} is skinned or has animated weights; drawn at rest \
+                     (lodbench animates the skins and morph targets of meshes without authored chains)",
+                    self.file, p.mesh
+                ));
+            }
+            let part = self
+                .content
+                .placed_as(p, &prims, to_model * p.world, to_model)
+                .map_err(|e| self.bad(e))?;
+            match &mut merged {
+                Some(m) => m.append(part).map_err(|e| self.bad(e))?,
+                None => merged = Some(part),
+            }
+        }
+        let mut parts = merged.ok_or_else(|| self.bad(format!("{what}: level {l} is empty")))?;
+        parts.data.deform = None;
+        if parts.indices.is_empty() {
+            return Err(self.bad(format!("{what}: level {l} has no triangles")));
+        }
+        Ok(parts)
     }
 
     /// Where level `l` of `chain` stands at rest: its node's world matrix, or, for an MSFT_lod level outside the
