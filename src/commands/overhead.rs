@@ -82,11 +82,7 @@ pub fn execute(args: &OverheadArgs) -> Result<()> {
         blocks,
         rows: &rows,
     };
-    let json = serde_json::to_string_pretty(&manifest)?;
-    std::fs::write(out.join("overhead.json"), json).map_err(|e| Error::Output {
-        path: out.join("overhead.json"),
-        problem: format!("cannot be written ({e})"),
-    })?;
+    crate::results::manifest::write_json_file(&out, "overhead.json", &manifest)?;
     out!("{}", table(&rows));
     outln!(
         "adapter: {}; medians over {} rounds; throughput: triangles per second over the bare draw's, paired by \

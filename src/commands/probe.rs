@@ -67,11 +67,7 @@ pub fn execute(args: &ProbeArgs) -> Result<()> {
         scale: args.scale,
         probes: &rows,
     };
-    let json = serde_json::to_string_pretty(&manifest)?;
-    std::fs::write(out.join("probe.json"), json).map_err(|e| Error::Output {
-        path: out.join("probe.json"),
-        problem: format!("cannot be written ({e})"),
-    })?;
+    crate::results::manifest::write_json_file(&out, "probe.json", &manifest)?;
     out!("{}", table(&rows));
     outln!(
         "adapter: {}; rates are medians over {} rounds with the geometric mean's 95 % interval; x2 and control \

@@ -245,7 +245,7 @@ pub struct OverheadRecord {
 struct PerRound {
     ms: Vec<f64>,
     triangles: Vec<f64>,
-    frames: u32,
+    frames: Vec<u32>,
     draw_calls: f64,
 }
 
@@ -281,7 +281,7 @@ pub fn measure(
             };
             per[c].ms.push(ms);
             per[c].triangles.push(triangles);
-            per[c].frames += hi - lo;
+            per[c].frames.push(hi - lo);
         }
         orders.push(order.iter().map(|&c| label(prepared, &bares, c)).collect());
     }
@@ -294,15 +294,7 @@ pub fn measure(
     }
     let bare = n_methods; // Bare::Plain, the first of the bare draws
     let rows = (0..per.len())
-        .map(|c| {
-            record(
-                block,
-                label(prepared, &bares, c),
-                &per[c],
-                &per[bare],
-                rounds,
-            )
-        })
+        .map(|c| record(block, label(prepared, &bares, c), &per[c], &per[bare]))
         .collect();
     Ok((rows, orders))
 }
@@ -352,17 +344,13 @@ fn record(
     contender: String,
     p: &PerRound,
     bare: &PerRound,
-    rounds: u32,
 ) -> OverheadRecord {
-    let frames_of = |round: usize| {
-        let (lo, hi) = round_frames(round as u32, rounds, block.scene.frames);
-        (hi - lo).max(1) as f64
-    };
     let ms_per_frame: Vec<f64> =
         p.ms.iter()
-            .enumerate()
-            .map(|(r, ms)| ms / frames_of(r))
+            .zip(&p.frames)
+            .map(|(ms, &n)| ms / n.max(1) as f64)
             .collect();
+    let frames: u32 = p.frames.iter().sum();
     let rate = |q: &PerRound, r: usize| q.triangles[r] / (q.ms[r] / 1e3);
     let rates: Vec<f64> = (0..p.ms.len()).map(|r| rate(p, r)).collect();
     let logs: Vec<f64> = (0..p.ms.len())
@@ -373,9 +361,9 @@ fn record(
         scene: block.scene.name().to_string(),
         count: block.scene.count,
         contender,
-        rounds,
-        frames: p.frames,
-        triangles_per_frame: p.triangles.iter().sum::<f64>() / p.frames.max(1) as f64,
+        rounds: p.ms.len() as u32,
+        frames,
+        triangles_per_frame: p.triangles.iter().sum::<f64>() / frames.max(1) as f64,
         draw_calls_per_frame: p.draw_calls,
         ms_per_frame_median: percentile(&ms_per_frame, 50.0).unwrap_or(f64::NAN),
         triangles_per_s_median: percentile(&rates, 50.0).unwrap_or(f64::NAN),

@@ -344,6 +344,16 @@ impl ExperimentRecord<PlannedRunRecord> {
     }
 }
 
+/// Writes `value` as pretty JSON to `dir/name` (probe.json, overhead.json), the path named when it cannot be.
+pub fn write_json_file<T: Serialize + ?Sized>(dir: &Path, name: &str, value: &T) -> Result<()> {
+    let path = dir.join(name);
+    let json = serde_json::to_string_pretty(value)?;
+    std::fs::write(&path, json).map_err(|e| Error::Output {
+        path: path.clone(),
+        problem: format!("cannot be written ({e})"),
+    })
+}
+
 /// Writes `value` as `dir/experiment.json`.
 pub fn write_experiment_json<T: Serialize + ?Sized>(dir: &Path, value: &T) -> Result<()> {
     let path = dir.join(EXPERIMENT_JSON);
