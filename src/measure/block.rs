@@ -243,7 +243,7 @@ impl<'a> BlockRunner<'a> {
         let mut driver = FrameDriver::new(base.scene);
         base.warm_up((&m.label, method.as_mut(), &mut driver), &p.plan, progress)?;
         let mut stage = QualityStage::new(base, self.dumps.dump, &self.quality)?;
-        let walk = stage.begin(base, (method.as_ref(), is_reference(&m.label)), dump_frames);
+        let walk = stage.begin(base, (method.as_mut(), is_reference(&m.label)), dump_frames);
         Ok(QualityRun {
             method,
             driver,

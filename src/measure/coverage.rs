@@ -11,7 +11,7 @@
 //! at or behind the camera plane makes the instance's bound the whole frame.
 //!
 //! The bound holds only for a frame that shows nothing but the instances' meshes over the background: a method
-//! says so with [`crate::methods::Method::image_confined_to_instances`], and a scene with TAA (the history
+//! says so with [`crate::methods::common::Counterfactual::image_confined_to_instances`], and a scene with TAA (the history
 //! shows earlier frames), shadows (a shadow falls outside its caster) or unified blocks (one mesh in world
 //! space) always uses the whole frame.
 

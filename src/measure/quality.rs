@@ -28,7 +28,7 @@ use crate::error::{Error, Result};
 use crate::gpu::timestamps::GpuTimer;
 use crate::gpu::{GpuContext, RenderTarget, SceneGpu, TextureReadback};
 use crate::measure::metrics::{FrameMetrics, Metric, MetricReduction, MetricRegion};
-use crate::methods::common::DumpKind;
+use crate::methods::common::{ask_counterfactual, Counterfactual, DumpKind};
 use crate::methods::{FrameInput, Method, Registry};
 use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
@@ -221,7 +221,7 @@ pub const METRIC_TIMED_EVERY: u32 = 8;
 
 /// The schedule states of the last frames, newest first: lodpop's history.
 struct StateHistory {
-    /// How many earlier frames the method's counterfactual reads (`Method::lodpop_history`, at least 1).
+    /// How many earlier frames the method's counterfactual reads (`Counterfactual::lodpop_history`, at least 1).
     depth: usize,
     frames: VecDeque<Vec<InstanceState>>,
 }
@@ -268,7 +268,7 @@ impl StateHistory {
     }
 }
 
-/// Whether two states of an instance draw the same image of it (`Method::same_image_state`).
+/// Whether two states of an instance draw the same image of it (`Counterfactual::same_image_state`).
 type SameImage<'m> = dyn Fn(&InstanceState, &InstanceState) -> bool + 'm;
 
 /// Which counterfactual frames were drawn this frame.
@@ -399,24 +399,22 @@ impl QualityStage {
     pub fn begin(
         &mut self,
         base: &BlockGpu<'_>,
-        (method, is_reference): (&dyn Method, bool),
+        (method, is_reference): (&mut dyn Method, bool),
         dump_frames: Vec<bool>,
     ) -> Walk {
         if let Some(taa) = &mut self.taa {
             taa.reset();
         }
+        let history = ask_counterfactual(method, |m| m.lodpop_history().max(1));
+        let confined = ask_counterfactual(method, |m| m.image_confined_to_instances())
+            && ask_counterfactual(self.reference.as_mut(), |m| m.image_confined_to_instances());
         let mut walk = Walk {
             dump_frames,
-            history: StateHistory::new(method.lodpop_history().max(1)),
+            history: StateHistory::new(history),
             in_flight: VecDeque::new(),
             flip: vec![None; base.scene.frames as usize],
             has_lag: false,
-            coverage: Coverage::new(
-                base.scene,
-                self.region == MetricRegion::Covered
-                    && method.image_confined_to_instances()
-                    && self.reference.image_confined_to_instances(),
-            ),
+            coverage: Coverage::new(base.scene, self.region == MetricRegion::Covered && confined),
             tiles_read: 0,
             counterfactual_pixels: (0, 0),
             reference_is_method_frame: is_reference
@@ -514,13 +512,15 @@ impl QualityStage {
             .submit(shadows.into_iter().chain([encoder.finish()]));
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         walk.history.push(&driver.states);
-        let drawn = self.counterfactuals(
-            base,
-            method,
-            (&input, &walk.history),
-            (&walk.coverage, dump),
-            &mut encoder,
-        );
+        let drawn = ask_counterfactual(method, |method| {
+            self.counterfactuals(
+                base,
+                method,
+                (&input, &walk.history),
+                (&walk.coverage, dump),
+                &mut encoder,
+            )
+        });
         walk.has_lag |= drawn.unlagged;
         if let Some(rect) = drawn.changed {
             walk.counterfactual_pixels.0 += rect.pixels();
@@ -748,7 +748,7 @@ impl QualityStage {
     fn counterfactuals(
         &self,
         base: &BlockGpu<'_>,
-        method: &mut dyn Method,
+        method: &mut dyn Counterfactual,
         (input, history): (&FrameInput<'_>, &StateHistory),
         (coverage, dump): (&Coverage, bool),
         encoder: &mut wgpu::CommandEncoder,
@@ -824,7 +824,7 @@ impl QualityStage {
     fn encode_unlagged(
         &self,
         base: &BlockGpu<'_>,
-        method: &mut dyn Method,
+        method: &mut dyn Counterfactual,
         (input, changed): (&FrameInput<'_>, bool),
         encoder: &mut wgpu::CommandEncoder,
     ) -> bool {

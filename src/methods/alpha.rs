@@ -4,7 +4,7 @@
 //! by instance distance, depth test on (less-equal, so a translucent surface coinciding with the opaque one
 //! still blends), depth writes off.
 
-use super::common::{BlendLists, FrameInput, Method};
+use super::common::{BlendLists, Counterfactual, FrameInput, Method};
 use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
@@ -38,10 +38,6 @@ impl Alpha {
 }
 
 impl Method for Alpha {
-    fn image_confined_to_instances(&self) -> bool {
-        true
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,
@@ -66,5 +62,15 @@ impl Method for Alpha {
             &[&self.translucent_pipeline],
         );
         a + b
+    }
+
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for Alpha {
+    fn image_confined_to_instances(&self) -> bool {
+        true
     }
 }

@@ -25,7 +25,7 @@
 //! objects). Cost: two render passes per translucent draw.
 
 use super::alpha::OVER;
-use super::common::{BlendLists, FrameInput, Method};
+use super::common::{BlendLists, Counterfactual, FrameInput, Method};
 use crate::formats::DEPTH_FORMAT;
 use crate::gpu::{texture_2d, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::schedule::InstanceState;
@@ -164,10 +164,6 @@ impl Method for AlphaTwoPass {
             .then(|| "BLEND materials' parts of an instance in transition are not drawn: the double pass keeps the fragments at each translucent LOD's nearest opaque surface (a depth-equal test), and a blended surface writes no depth".to_string())
     }
 
-    fn image_confined_to_instances(&self) -> bool {
-        true
-    }
-
     fn extra_target_bytes(&self) -> u64 {
         let s = self.object_depth.size();
         s.width as u64 * s.height as u64 * 4
@@ -234,6 +230,16 @@ impl Method for AlphaTwoPass {
             }
         }
         stats
+    }
+
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for AlphaTwoPass {
+    fn image_confined_to_instances(&self) -> bool {
+        true
     }
 }
 

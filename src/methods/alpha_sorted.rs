@@ -10,7 +10,7 @@
 //! surface loses the farthest; fragments at exactly the depth of the previous layer are peeled once. Not run by
 //! default; its frame time is that of a reference, not of a method anyone would ship.
 
-use super::common::{BlendLists, FrameInput, Method};
+use super::common::{BlendLists, Counterfactual, FrameInput, Method};
 use crate::formats::{COLOR_FORMAT, DEPTH_FORMAT};
 use crate::gpu::compute::{
     bind_group, storage_entry, texture_entry, uniform_buffer, uniform_entry,
@@ -323,10 +323,6 @@ impl Method for AlphaSorted {
             .then(|| "BLEND materials' parts of an instance in transition are blended in draw order over the peeled layers, not peeled with them".to_string())
     }
 
-    fn image_confined_to_instances(&self) -> bool {
-        true
-    }
-
     fn extra_target_bytes(&self) -> u64 {
         // Three depths, the layer, the accumulation (16 bytes a pixel) and the output.
         let (w, h) = (self.size.0 as u64, self.size.1 as u64);
@@ -410,5 +406,15 @@ impl Method for AlphaSorted {
             self.output.size(),
         );
         stats
+    }
+
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for AlphaSorted {
+    fn image_confined_to_instances(&self) -> bool {
+        true
     }
 }

@@ -6,7 +6,7 @@
 //! draws first, translucent ones back to front.
 
 use super::alpha::OVER;
-use super::common::{unpop, BlendLists, FrameInput, Method, SeamDraws};
+use super::common::{unpop, BlendLists, Counterfactual, FrameInput, Method, SeamDraws};
 use crate::gpu::{DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::scene::Scene;
 
@@ -62,10 +62,6 @@ impl AlphaZWrite {
 }
 
 impl Method for AlphaZWrite {
-    fn image_confined_to_instances(&self) -> bool {
-        true
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,
@@ -102,5 +98,15 @@ impl Method for AlphaZWrite {
             &[&self.less_equal, &self.less],
         );
         a + b
+    }
+
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for AlphaZWrite {
+    fn image_confined_to_instances(&self) -> bool {
+        true
     }
 }

@@ -7,10 +7,10 @@
 //!
 //! The shared schedule's block states are not used: the cut is this method's own selection, and lodpop's
 //! counterfactual is the previous frame's cut (nodes, alphas and seams) drawn at this frame's pose
-//! ([`Method::selection_changed`]). `units_drawn` counts the nodes drawn, opaque or translucent.
+//! ([`Counterfactual::selection_changed`]). `units_drawn` counts the nodes drawn, opaque or translucent.
 
 use super::alpha::OVER;
-use super::common::{mesh_vertex_buffer, FrameInput, Method};
+use super::common::{mesh_vertex_buffer, Counterfactual, FrameInput, Method};
 use crate::error::{Error, Result};
 use crate::geometry::block_tree::{BlockTree, Cut};
 use crate::geometry::cluster_dag::CutBound;
@@ -238,6 +238,12 @@ impl Method for BlocksTree {
         self.draw(gpu, encoder, target, camera.eye, false)
     }
 
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for BlocksTree {
     fn selection_changed(&self) -> bool {
         self.frame != self.previous
     }

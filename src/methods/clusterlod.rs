@@ -2,9 +2,9 @@
 //! scene's whole mesh, with the per-frame cut at `--pixel-error` ([`crate::geometry::cluster_dag`]). Clusters are drawn
 //! where the cut selects them, opaque; a cut change is a hard switch. The shared schedule's block states are
 //! not used: the cut is this method's own selection, and lodpop's counterfactual is the previous frame's cut
-//! drawn at this frame's pose ([`Method::selection_changed`]).
+//! drawn at this frame's pose ([`Counterfactual::selection_changed`]).
 
-use super::common::{identity_instance, mesh_vertex_buffer, FrameInput, Method};
+use super::common::{identity_instance, mesh_vertex_buffer, Counterfactual, FrameInput, Method};
 use crate::error::{Error, Result};
 use crate::geometry::cluster_dag::{CutBound, CutCamera};
 use crate::gpu::{DrawStats, InstanceBuffer, RenderTarget, SceneGpu};
@@ -135,6 +135,12 @@ impl Method for ClusterLod {
         stats
     }
 
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for ClusterLod {
     fn selection_changed(&self) -> bool {
         self.cut != self.previous
     }

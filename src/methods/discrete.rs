@@ -2,7 +2,7 @@
 //! Each instance shows one LOD; the switch is hard, at the centre of the schedule's band (k = 0.5, i.e. at the
 //! switch distance itself).
 
-use super::common::{FrameInput, Method, OpaqueInstances};
+use super::common::{Counterfactual, FrameInput, Method, OpaqueInstances};
 use crate::effects::shadow::Caster;
 use crate::gpu::{DrawStats, RenderTarget, SceneGpu};
 use crate::scene::schedule::InstanceState;
@@ -29,16 +29,6 @@ impl Discrete {
 }
 
 impl Method for Discrete {
-    fn image_confined_to_instances(&self) -> bool {
-        true
-    }
-
-    /// The LOD shown is the whole of the state's effect: k reaches the instance data (params.x) but the
-    /// opaque pipeline's fragment shader does not read it.
-    fn same_image_state(&self, a: &InstanceState, b: &InstanceState) -> bool {
-        a.discrete_lod() == b.discrete_lod()
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,
@@ -55,5 +45,21 @@ impl Method for Discrete {
     /// The LOD it shows.
     fn shadow_caster(&self, states: &[InstanceState], i: usize, _before: bool) -> Caster {
         Caster::Lod(states[i].discrete_lod())
+    }
+
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for Discrete {
+    fn image_confined_to_instances(&self) -> bool {
+        true
+    }
+
+    /// The LOD shown is the whole of the state's effect: k reaches the instance data (params.x) but the
+    /// opaque pipeline's fragment shader does not read it.
+    fn same_image_state(&self, a: &InstanceState, b: &InstanceState) -> bool {
+        a.discrete_lod() == b.discrete_lod()
     }
 }

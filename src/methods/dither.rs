@@ -9,7 +9,7 @@
 //! where k > t, so none while k <= the pattern's smallest threshold; the outgoing keeps one where k <= t, so
 //! none while k > its largest. The image is dither's, byte for byte; only the skipped draws go.
 
-use super::common::{instance_raw, FrameInput, Method};
+use super::common::{instance_raw, Counterfactual, FrameInput, Method};
 use crate::gpu::{DrawList, DrawStats, InstanceBuffer, MeshPipeline, RenderTarget, SceneGpu};
 use crate::methods::noise::threshold_texture;
 use crate::methods::noise::NoisePattern;
@@ -177,34 +177,6 @@ pub fn temporal_offset(size: u32, frame: u32) -> [f32; 2] {
 }
 
 impl Method for Dither {
-    fn image_confined_to_instances(&self) -> bool {
-        true
-    }
-
-    fn transition_pattern_moves(&self) -> bool {
-        self.temporal.is_some()
-    }
-
-    /// The previous frame's states, and under `--noise-temporal` the previous frame's pattern phase: the
-    /// pattern moves only because instances are in transition, so its motion is part of the transition.
-    fn encode_before(
-        &mut self,
-        gpu: &SceneGpu,
-        input: &FrameInput<'_>,
-        history: &[&[InstanceState]],
-        encoder: &mut wgpu::CommandEncoder,
-        before: &RenderTarget,
-    ) {
-        let previous = FrameInput {
-            states: history[0],
-            timed: false,
-            ..*input
-        };
-        self.pattern_frame = Some(input.frame.wrapping_sub(1));
-        self.encode(gpu, &previous, encoder, before);
-        self.pattern_frame = None;
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,
@@ -264,6 +236,40 @@ impl Method for Dither {
             &self.list,
             &[&self.steady, &self.dithered],
         )
+    }
+
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for Dither {
+    fn image_confined_to_instances(&self) -> bool {
+        true
+    }
+
+    fn transition_pattern_moves(&self) -> bool {
+        self.temporal.is_some()
+    }
+
+    /// The previous frame's states, and under `--noise-temporal` the previous frame's pattern phase: the
+    /// pattern moves only because instances are in transition, so its motion is part of the transition.
+    fn encode_before(
+        &mut self,
+        gpu: &SceneGpu,
+        input: &FrameInput<'_>,
+        history: &[&[InstanceState]],
+        encoder: &mut wgpu::CommandEncoder,
+        before: &RenderTarget,
+    ) {
+        let previous = FrameInput {
+            states: history[0],
+            timed: false,
+            ..*input
+        };
+        self.pattern_frame = Some(input.frame.wrapping_sub(1));
+        self.encode(gpu, &previous, encoder, before);
+        self.pattern_frame = None;
     }
 }
 

@@ -46,7 +46,7 @@
 //!   `lod_to` in the other, same camera) and combines without reprojection: visibility textures without frame
 //!   sequencing.
 
-use super::common::{instance_raw_with, DumpKind, FrameInput, Method};
+use super::common::{instance_raw_with, Counterfactual, DumpKind, FrameInput, Method};
 use crate::effects::shadow::Caster;
 use crate::error::Result;
 use crate::gpu::timestamps::GpuTimer;
@@ -1105,6 +1105,31 @@ impl Method for Fsi {
         stats
     }
 
+    fn extra_target_bytes(&self) -> u64 {
+        let px = self.buffers[0].target.width as u64 * self.buffers[0].target.height as u64;
+        2 * px * (8 + id_bytes(self.id_format) as u64)
+    }
+
+    fn stage_gpu_ms(&self, ctx: &GpuContext) -> Result<Option<Vec<Option<f64>>>> {
+        match &self.combine_timer {
+            Some(t) => Ok(Some(t.read(ctx)?)),
+            None => Ok(None),
+        }
+    }
+
+    fn debug_targets(&self) -> Vec<(DumpKind, &RenderTarget)> {
+        vec![
+            (DumpKind::LodBuffer0, &self.buffers[0].target),
+            (DumpKind::LodBuffer1, &self.buffers[1].target),
+        ]
+    }
+
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for Fsi {
     /// X_t: this frame's combination with both LOD buffers drawn at this frame's pose (the newer buffer's
     /// choices of t, the older buffer's of t-1): the frame without FSI's one-frame lag.
     fn encode_unlagged(
@@ -1142,25 +1167,6 @@ impl Method for Fsi {
 
     fn lodpop_history(&self) -> usize {
         2
-    }
-
-    fn extra_target_bytes(&self) -> u64 {
-        let px = self.buffers[0].target.width as u64 * self.buffers[0].target.height as u64;
-        2 * px * (8 + id_bytes(self.id_format) as u64)
-    }
-
-    fn stage_gpu_ms(&self, ctx: &GpuContext) -> Result<Option<Vec<Option<f64>>>> {
-        match &self.combine_timer {
-            Some(t) => Ok(Some(t.read(ctx)?)),
-            None => Ok(None),
-        }
-    }
-
-    fn debug_targets(&self) -> Vec<(DumpKind, &RenderTarget)> {
-        vec![
-            (DumpKind::LodBuffer0, &self.buffers[0].target),
-            (DumpKind::LodBuffer1, &self.buffers[1].target),
-        ]
     }
 }
 

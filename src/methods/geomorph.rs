@@ -5,7 +5,7 @@
 //! measured by the `pop` column on those frames. Targets come from `--correspondence` (`src/geometry/morph.rs`), computed
 //! once per LOD pair and cached.
 
-use super::common::{instance_raw, FrameInput, Method};
+use super::common::{instance_raw, Counterfactual, FrameInput, Method};
 use crate::geometry::mesh::Mesh;
 use crate::geometry::morph::Correspondence;
 use crate::geometry::morph::{morph_targets_by_material, MorphTargets};
@@ -194,10 +194,6 @@ impl Geomorph {
 }
 
 impl Method for Geomorph {
-    fn image_confined_to_instances(&self) -> bool {
-        true
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,
@@ -244,5 +240,15 @@ impl Method for Geomorph {
             &self.list,
             &[&gpu.opaque_pipeline, &self.morph],
         )
+    }
+
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for Geomorph {
+    fn image_confined_to_instances(&self) -> bool {
+        true
     }
 }

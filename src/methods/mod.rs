@@ -20,6 +20,7 @@ pub mod geomorph;
 pub mod noise;
 pub mod reference;
 pub mod roam;
+pub mod traits;
 
 pub use common::{instance_raw, instance_raw_with, FrameInput, Method, OpaqueInstances};
 

@@ -1,7 +1,7 @@
 //! `reference`: the high-poly baseline of Sheliemietiev et al. 2023 section 6: every instance at LOD0, always. The quality pass
 //! compares every method against this.
 
-use super::common::{FrameInput, Method, OpaqueInstances};
+use super::common::{Counterfactual, FrameInput, Method, OpaqueInstances};
 use crate::effects::shadow::Caster;
 use crate::gpu::{DrawStats, RenderTarget, SceneGpu};
 use crate::scene::schedule::InstanceState;
@@ -29,15 +29,6 @@ impl Reference {
 }
 
 impl Method for Reference {
-    fn image_confined_to_instances(&self) -> bool {
-        true
-    }
-
-    /// LOD0 whatever the state.
-    fn same_image_state(&self, _a: &InstanceState, _b: &InstanceState) -> bool {
-        true
-    }
-
     fn encode(
         &mut self,
         gpu: &SceneGpu,
@@ -52,5 +43,20 @@ impl Method for Reference {
     /// LOD0, always.
     fn shadow_caster(&self, _states: &[InstanceState], _i: usize, _before: bool) -> Caster {
         Caster::Lod(0)
+    }
+
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for Reference {
+    fn image_confined_to_instances(&self) -> bool {
+        true
+    }
+
+    /// LOD0 whatever the state.
+    fn same_image_state(&self, _a: &InstanceState, _b: &InstanceState) -> bool {
+        true
     }
 }

@@ -8,11 +8,11 @@
 //!
 //! The shared schedule's block states are not used: the triangulation is this method's own selection, and
 //! lodpop's counterfactual is the previous frame's triangulation (and its morphing vertices) drawn at this
-//! frame's pose ([`Method::selection_changed`]). Each frame's splits and merges (bintree nodes) and the CPU
+//! frame's pose ([`Counterfactual::selection_changed`]). Each frame's splits and merges (bintree nodes) and the CPU
 //! time of the update, the triangulation's walk and the morphs go to frames.csv (`splits`, `merges`,
 //! `select_cpu_ms`).
 
-use super::common::{identity_instance, FrameInput, Method};
+use super::common::{identity_instance, Counterfactual, FrameInput, Method};
 use crate::error::{Error, Result};
 use crate::geometry::cluster_dag::CutBound;
 use crate::geometry::roam_mesh::{Bintree, HeightField};
@@ -302,6 +302,12 @@ impl Method for Roam {
         stats
     }
 
+    fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
+        Some(self)
+    }
+}
+
+impl Counterfactual for Roam {
     fn selection_changed(&self) -> bool {
         self.frame != self.previous
     }

@@ -93,6 +93,16 @@ fn a_method_added_with_one_registry_line_runs_like_a_builtin() {
         before_midpoint > 0,
         "no transition frame told the two apart"
     );
+    // lod-to gives no answers of its own to the quality pass (no `Counterfactual`): lodpop's default
+    // counterfactual draws its frame again with the states of the frame before, so it pops on the frames where
+    // some lod_to changed, and as often as discrete, which switches once per transition too.
+    let pops = |rows: &[&HashMap<String, String>]| {
+        rows.iter()
+            .filter(|r| r["lodpop"].parse::<f64>().unwrap() > 0.0)
+            .count()
+    };
+    assert!(pops(&lod_to) > 0, "lod-to never popped");
+    assert_eq!(pops(&lod_to), pops(&discrete));
     let manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("run.json")).unwrap())
             .unwrap();
