@@ -24,5 +24,5 @@ pub use pipelines::{
     Vertex,
 };
 pub use readback::{read_texture, TextureReadback};
-pub use scene_gpu::{surface_vertex, LodRange, PartRange, SceneGpu, AMBIENT, LIGHT_DIR};
+pub use scene_gpu::{surface_vertex, LodRange, PartRange, SceneGpu, View, AMBIENT, LIGHT_DIR};
 pub use targets::{texture_2d, RenderTarget, ATTACHMENT_READ};

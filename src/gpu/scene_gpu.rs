@@ -59,6 +59,35 @@ impl ShadowMap {
     }
 }
 
+/// What a pass sees of the frame beyond its instances: the shadow map its shading reads (the camera bind group
+/// with that map, group 0) and the scissor rectangle `[x, y, width, height]` its colour passes draw within (None:
+/// the whole target; clears still cover the whole target). The quality pass draws one frame under several views
+/// (the method's, the reference's, lodpop's counterfactual inside the rectangle where it can differ); the view
+/// travels with the frame's input (`FrameInput::view`) to every pass begun for it ([`SceneGpu::begin_pass`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct View {
+    pub shadow: ShadowMap,
+    pub scissor: Option<[u32; 4]>,
+}
+
+impl View {
+    /// The whole target, lit by shadow map `shadow`.
+    pub const fn lit_by(shadow: ShadowMap) -> View {
+        View {
+            shadow,
+            scissor: None,
+        }
+    }
+
+    /// This view with its colour passes limited to `rect`, `[x, y, width, height]`.
+    pub fn scissored(self, rect: [u32; 4]) -> View {
+        View {
+            scissor: Some(rect),
+            ..self
+        }
+    }
+}
+
 /// Where one LOD of one model lives in the shared vertex and index buffers.
 #[derive(Debug, Clone, Copy)]
 pub struct LodRange {
@@ -97,12 +126,8 @@ pub struct SceneGpu {
     pub seam_base: u32,
     pub camera_buffer: wgpu::Buffer,
     pub camera_layout: wgpu::BindGroupLayout,
-    /// The camera's bind group (group 0) with each shadow map ([`ShadowMap`]); draws use the active one.
+    /// The camera's bind group (group 0) with each shadow map ([`ShadowMap`]); a pass binds its view's.
     pub camera_groups: Vec<wgpu::BindGroup>,
-    active_group: std::cell::Cell<usize>,
-    /// The scissor rectangle `[x, y, width, height]` every colour pass of [`SceneGpu::begin_pass`] draws
-    /// within ([`SceneGpu::scissored`]); None = the whole target.
-    scissor: std::cell::Cell<Option<[u32; 4]>>,
     /// The shadow maps' depth views, indexed like `camera_groups` (`--shadows on`; only the placeholder
     /// otherwise).
     pub shadow_views: Vec<wgpu::TextureView>,
@@ -293,8 +318,6 @@ impl SceneGpu {
             camera_buffer,
             camera_layout,
             camera_groups,
-            active_group: std::cell::Cell::new(ShadowMap::NONE.index()),
-            scissor: std::cell::Cell::new(None),
             shadow_views,
             shadow_maps,
             shadow_size,
@@ -323,7 +346,12 @@ impl SceneGpu {
         let readback =
             crate::gpu::readback::TextureReadback::color(&self.device, "background probe", 1, 1);
         let mut encoder = self.device.create_command_encoder(&Default::default());
-        drop(self.begin_clear_pass(&mut encoder, &target, "background probe"));
+        drop(self.begin_clear_pass(
+            &mut encoder,
+            &target,
+            View::lit_by(ShadowMap::NONE),
+            "background probe",
+        ));
         readback.encode_copy(&mut encoder, &target);
         self.queue.submit([encoder.finish()]);
         let px = readback.read(ctx)?;
@@ -427,35 +455,10 @@ impl SceneGpu {
         );
     }
 
-    /// The camera bind group draws use from now on: the one with shadow map `map` (the placeholder when the
-    /// scene has no such map: shadows off).
-    pub fn use_shadow_map(&self, map: ShadowMap) {
-        self.active_group
-            .set(map.index().min(self.camera_groups.len().saturating_sub(1)));
-    }
-
-    /// Runs `draw` lit by shadow map `map`, then restores the map that was in use.
-    pub fn lit_by<T>(&self, map: ShadowMap, draw: impl FnOnce() -> T) -> T {
-        let active = self.active_group.get();
-        self.use_shadow_map(map);
-        let out = draw();
-        self.active_group.set(active);
-        out
-    }
-
-    /// Runs `draw` with every colour pass begun by [`SceneGpu::begin_pass`] limited to the scissor rectangle
-    /// `[x, y, width, height]` (inside every target drawn to; the clears still cover the whole target), then
-    /// restores the whole target.
-    pub fn scissored<T>(&self, rect: [u32; 4], draw: impl FnOnce() -> T) -> T {
-        let before = self.scissor.replace(Some(rect));
-        let out = draw();
-        self.scissor.set(before);
-        out
-    }
-
-    /// The camera bind group of the shadow map in use.
-    pub fn camera_group(&self) -> &wgpu::BindGroup {
-        &self.camera_groups[self.active_group.get()]
+    /// The camera bind group with shadow map `map` (the placeholder's when the scene has no such map: shadows
+    /// off).
+    pub fn camera_group(&self, map: ShadowMap) -> &wgpu::BindGroup {
+        &self.camera_groups[map.index().min(self.camera_groups.len().saturating_sub(1))]
     }
 
     /// A `side` x `side` R32Float texture holding `values` (row-major): the screen-space thresholds of
@@ -482,25 +485,28 @@ impl SceneGpu {
         texture
     }
 
-    /// Begins a pass that clears `target` to the background and its depth to 1.
+    /// Begins a pass of `view` that clears `target` to the background and its depth to 1.
     pub fn begin_clear_pass<'e>(
         &self,
         encoder: &'e mut wgpu::CommandEncoder,
         target: &RenderTarget,
+        view: View,
         label: &str,
     ) -> wgpu::RenderPass<'e> {
-        self.begin_pass(encoder, &target.color_view, &target.depth_view, label, true)
+        let views = (&target.color_view, &target.depth_view);
+        self.begin_pass(encoder, views, view, label, true)
     }
 
-    /// Begins a pass on a colour and a depth view, clearing both (`clear`) or keeping what they hold.
-    /// A depth-only pass into `depth`, cleared to 1 (alpha-2pass's nearest surface, the shadow pass).
+    /// A depth-only pass into `depth`, cleared to 1 (alpha-2pass's nearest surface, the shadow pass), with the
+    /// camera bind group of shadow map `map` bound (the scissor is for colour passes).
     pub fn begin_depth_pass<'e>(
         &self,
         encoder: &'e mut wgpu::CommandEncoder,
         depth: &wgpu::TextureView,
+        map: ShadowMap,
         label: &str,
     ) -> wgpu::RenderPass<'e> {
-        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
@@ -514,14 +520,18 @@ impl SceneGpu {
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
-        })
+        });
+        pass.set_bind_group(0, self.camera_group(map), &[]);
+        pass
     }
 
+    /// Begins a pass of `view` on a colour and a depth view, clearing both (`clear`) or keeping what they hold:
+    /// the camera bind group of the view's shadow map bound, the view's scissor set.
     pub fn begin_pass<'e>(
         &self,
         encoder: &'e mut wgpu::CommandEncoder,
-        color: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
+        (color, depth): (&wgpu::TextureView, &wgpu::TextureView),
+        view: View,
         label: &str,
         clear: bool,
     ) -> wgpu::RenderPass<'e> {
@@ -563,15 +573,11 @@ impl SceneGpu {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if let Some([x, y, w, h]) = self.scissor.get() {
+        pass.set_bind_group(0, self.camera_group(view.shadow), &[]);
+        if let Some([x, y, w, h]) = view.scissor {
             pass.set_scissor_rect(x, y, w, h);
         }
         pass
-    }
-
-    /// The scissor rectangle draws are limited to now ([`SceneGpu::scissored`]), for passes a method begins itself.
-    pub fn scissor(&self) -> Option<[u32; 4]> {
-        self.scissor.get()
     }
 
     /// Draws `count` instances from absolute instance `first` of `buffer` at (model, LOD) with `pipeline`;
@@ -602,8 +608,8 @@ impl SceneGpu {
     }
 
     /// Records the draws of `list` (uploaded to `buffer` at instance `first`, see [`SceneGpu::upload_at`])
-    /// into `pass`, with `pipelines[d.pipeline]` for each draw. Bind groups other than the camera's (group 0)
-    /// are the caller's to set.
+    /// into `pass`, with `pipelines[d.pipeline]` for each draw. The camera's bind group (group 0) is the pass's
+    /// ([`SceneGpu::begin_pass`]); the others are the caller's to set.
     pub fn draw(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
@@ -616,7 +622,6 @@ impl SceneGpu {
         if list.draws.is_empty() {
             return stats;
         }
-        pass.set_bind_group(0, self.camera_group(), &[]);
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, buffer.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);

@@ -46,9 +46,9 @@ impl ShadowPass {
     ) -> DrawStats {
         let buffer = &self.buffers[map.index()];
         gpu.upload(buffer, list);
-        let mut pass = gpu.begin_depth_pass(encoder, &gpu.shadow_views[map.index()], "shadow pass");
-        gpu.lit_by(ShadowMap::NONE, || {
-            gpu.draw(&mut pass, buffer, 0, list, &[&self.whole, &self.dithered])
-        })
+        // Lit by the placeholder, so that the map being written is never the one bound.
+        let view = &gpu.shadow_views[map.index()];
+        let mut pass = gpu.begin_depth_pass(encoder, view, ShadowMap::NONE, "shadow pass");
+        gpu.draw(&mut pass, buffer, 0, list, &[&self.whole, &self.dithered])
     }
 }

@@ -66,14 +66,13 @@ impl<'a> BlockGpu<'a> {
     }
 
     /// The frame's camera, and with `--shadows on` its light, into the camera uniform, and the frame's pose of
-    /// the deformed models into the vertex buffer; draws are lit by the method's shadow map unless a stage says
-    /// otherwise.
+    /// the deformed models into the vertex buffer (the frame's input says which shadow map its passes are lit
+    /// by: `FrameDriver::input`).
     pub fn write_frame(&self, f: u32) {
         self.gpu.write_camera(&self.scene.camera(f));
         self.gpu.write_pose(self.scene, f);
         if let Some(s) = &self.shadows {
             s.write_light(&self.gpu, f);
         }
-        self.gpu.use_shadow_map(ShadowRole::Method.map());
     }
 }

@@ -2,6 +2,8 @@
 //! for every method.
 
 use crate::error::{Error, Result};
+use crate::gpu::View;
+use crate::measure::effects::ShadowRole;
 use crate::measure::records::TransitionPair;
 use crate::methods::FrameInput;
 use crate::scene::schedule::{InstanceState, LodSchedule};
@@ -103,6 +105,7 @@ impl<'s> FrameDriver<'s> {
             matrices: &self.matrices,
             distances: &self.distances,
             timed: false,
+            view: View::lit_by(ShadowRole::Method.map()),
         }
     }
 }

@@ -22,6 +22,7 @@
 
 use super::block_gpu::BlockGpu;
 use super::driver::FrameDriver;
+use super::effects::ShadowRole;
 use super::rounds::{round_frames, shuffled_order, Prepared};
 use super::stats::{paired_log_ratio, percentile};
 use crate::error::{Error, Result};
@@ -29,6 +30,7 @@ use crate::gpu::draw_list::DrawList;
 use crate::gpu::instances::InstanceBuffer;
 use crate::gpu::readback::TextureReadback;
 use crate::gpu::timestamps::GpuTimer;
+use crate::gpu::View;
 use crate::methods::common::instance_raw;
 use crate::rng::SplitMix64;
 use indicatif::ProgressBar;
@@ -136,9 +138,10 @@ impl<'s> BareDraw<'s> {
         }
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         {
-            let mut pass = gpu.begin_clear_pass(&mut encoder, &block.timing_target, "bare pass");
+            let view = View::lit_by(ShadowRole::Method.map());
+            let target = &block.timing_target;
+            let mut pass = gpu.begin_clear_pass(&mut encoder, target, view, "bare pass");
             pass.set_pipeline(gpu.opaque_pipeline.base());
-            pass.set_bind_group(0, gpu.camera_group(), &[]);
             pass.set_vertex_buffer(0, gpu.vertex_buffer.slice(..));
             pass.set_vertex_buffer(1, self.buffer.buffer.slice(..));
             pass.set_index_buffer(gpu.index_buffer.slice(..), wgpu::IndexFormat::Uint32);

@@ -566,13 +566,15 @@ impl QualityStage {
         let from_cache = cache.is_some_and(|c| c.restore(encoder, f, &t.reference));
         let from_method = !from_cache && copy_method;
         if !from_cache && !from_method {
-            gpu.lit_by(ShadowRole::Reference.map(), || {
-                reference.encode(gpu, input, encoder, &t.reference)
-            });
+            let input = input.lit_by(ShadowRole::Reference.map());
+            reference.encode(gpu, &input, encoder, &t.reference);
         }
-        gpu.lit_by(ShadowRole::Method.map(), || {
-            method.encode(gpu, input, encoder, &t.method)
-        });
+        method.encode(
+            gpu,
+            &input.lit_by(ShadowRole::Method.map()),
+            encoder,
+            &t.method,
+        );
         if from_method && read_back {
             t.method.copy_color_to(encoder, &t.reference);
         }
@@ -648,13 +650,11 @@ impl QualityStage {
         let Some(share) = &self.shadow_share else {
             return;
         };
-        gpu.lit_by(ShadowRole::Method.map(), || {
-            reference.encode(gpu, input, encoder, &share.now)
-        });
+        let now = input.lit_by(ShadowRole::Method.map());
+        reference.encode(gpu, &now, encoder, &share.now);
         if has_previous {
-            gpu.lit_by(ShadowRole::Before.map(), || {
-                reference.encode(gpu, input, encoder, &share.before);
-            });
+            let before = input.lit_by(ShadowRole::Before.map());
+            reference.encode(gpu, &before, encoder, &share.before);
         } else {
             share.now.copy_color_to(encoder, &share.before);
         }
@@ -779,26 +779,19 @@ impl QualityStage {
             // Inside a scissor, an instance whose rectangle misses it is drawn nowhere: its matrix is zeroed
             // (every vertex at the clip-space origin, w = 0, so the clipper drops its triangles).
             let culled: Vec<Mat4>;
+            let lit = input.lit_by(ShadowRole::Before.map());
             let input = if rect == full {
-                *input
+                lit
             } else {
                 culled = Self::culled_matrices(base, input, coverage, rect);
+                let [x, y] = [rect.x0, rect.y0];
                 FrameInput {
                     matrices: &culled,
-                    ..*input
+                    view: lit.view.scissored([x, y, rect.x1 - x, rect.y1 - y]),
+                    ..lit
                 }
             };
-            let mut draw = || {
-                gpu.lit_by(ShadowRole::Before.map(), || {
-                    method.encode_before(gpu, &input, &earlier, encoder, &t.before)
-                })
-            };
-            if rect == full {
-                draw();
-            } else {
-                let [x, y] = [rect.x0, rect.y0];
-                gpu.scissored([x, y, rect.x1 - x, rect.y1 - y], draw);
-            }
+            method.encode_before(gpu, &input, &earlier, encoder, &t.before);
         }
         if let Some(taa) = taa {
             taa.resolve(ctx, encoder, Stream::Before, &t.before);

@@ -16,7 +16,10 @@
 //! [`NEAR_BUDGET`] of the budget, the switch moving past any distance that breaks it.
 
 use crate::error::Result;
-use crate::gpu::{DrawList, GpuContext, InstanceRaw, RenderTarget, SceneGpu, TextureReadback};
+use crate::gpu::scene_gpu::ShadowMap;
+use crate::gpu::{
+    DrawList, GpuContext, InstanceRaw, RenderTarget, SceneGpu, TextureReadback, View,
+};
 use crate::measure::engine_rules::{Rule, RULES};
 use crate::measure::metrics::rms_difference_parts;
 use crate::scene::{Camera, Scene};
@@ -272,9 +275,12 @@ impl<'a> ModelCamera<'a> {
         self.gpu.upload(&self.buffer, &self.list);
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
-            let mut pass = self
-                .gpu
-                .begin_clear_pass(&mut encoder, &self.target, "tune pass");
+            let mut pass = self.gpu.begin_clear_pass(
+                &mut encoder,
+                &self.target,
+                View::lit_by(ShadowMap::NONE),
+                "tune pass",
+            );
             self.gpu.draw(
                 &mut pass,
                 &self.buffer,

@@ -46,7 +46,7 @@ impl Method for Alpha {
         target: &RenderTarget,
     ) -> DrawStats {
         let n_opaque = self.lists.prepare(gpu, input, &self.buffer, |_| 0);
-        let mut pass = gpu.begin_clear_pass(encoder, target, "alpha pass");
+        let mut pass = gpu.begin_clear_pass(encoder, target, input.view, "alpha pass");
         let a = gpu.draw(
             &mut pass,
             &self.buffer,

@@ -188,7 +188,7 @@ impl Method for AlphaTwoPass {
         );
         let (opaque, translucent) = (&self.lists.opaque, &self.lists.translucent);
         let mut stats = {
-            let mut pass = gpu.begin_clear_pass(encoder, target, "alpha-2pass opaque");
+            let mut pass = gpu.begin_clear_pass(encoder, target, input.view, "alpha-2pass opaque");
             gpu.draw(&mut pass, &self.buffer, 0, opaque, &[&gpu.opaque_pipeline])
         };
         for d in &translucent.draws {
@@ -198,6 +198,7 @@ impl Method for AlphaTwoPass {
                     let mut pass = gpu.begin_depth_pass(
                         encoder,
                         &self.object_depth_view,
+                        input.view.shadow,
                         "alpha-2pass nearest surface",
                     );
                     stats += gpu.draw_instances(
@@ -212,8 +213,8 @@ impl Method for AlphaTwoPass {
                 }
                 let mut pass = gpu.begin_pass(
                     encoder,
-                    &target.color_view,
-                    &self.object_depth_view,
+                    (&target.color_view, &self.object_depth_view),
+                    input.view,
                     "alpha-2pass colour",
                     false,
                 );

@@ -339,7 +339,7 @@ impl Method for AlphaSorted {
         let t = self.target_state(gpu, target);
         let n_opaque = self.lists.prepare(gpu, input, &self.buffer, |_| 0);
         let mut stats = {
-            let mut pass = gpu.begin_clear_pass(encoder, target, "alpha-sorted opaque");
+            let mut pass = gpu.begin_clear_pass(encoder, target, input.view, "alpha-sorted opaque");
             gpu.draw(
                 &mut pass,
                 &self.buffer,
@@ -382,7 +382,8 @@ impl Method for AlphaSorted {
                         occlusion_query_set: None,
                         multiview_mask: None,
                     });
-                    if let Some([x, y, w, h]) = gpu.scissor() {
+                    pass.set_bind_group(0, gpu.camera_group(input.view.shadow), &[]);
+                    if let Some([x, y, w, h]) = input.view.scissor {
                         pass.set_scissor_rect(x, y, w, h);
                     }
                     let previous = if layer == 0 { 0 } else { 1 + (1 - cur) };

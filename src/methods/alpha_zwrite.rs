@@ -79,7 +79,7 @@ impl Method for AlphaZWrite {
         if let Some(seams) = &mut self.seams {
             seams.prepare(gpu, input, |s| unpop(s).opaque);
         }
-        let mut pass = gpu.begin_clear_pass(encoder, target, "alpha-zwrite pass");
+        let mut pass = gpu.begin_clear_pass(encoder, target, input.view, "alpha-zwrite pass");
         let mut a = gpu.draw(
             &mut pass,
             &self.buffer,

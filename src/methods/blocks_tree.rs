@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 use crate::geometry::block_tree::{BlockTree, Cut};
 use crate::geometry::cluster_dag::CutBound;
 use crate::gpu::{
-    DrawList, DrawStats, InstanceBuffer, InstanceRaw, MeshPipeline, RenderTarget, SceneGpu,
+    DrawList, DrawStats, InstanceBuffer, InstanceRaw, MeshPipeline, RenderTarget, SceneGpu, View,
 };
 use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
@@ -136,7 +136,7 @@ impl BlocksTree {
         &mut self,
         gpu: &SceneGpu,
         encoder: &mut wgpu::CommandEncoder,
-        target: &RenderTarget,
+        (target, view): (&RenderTarget, View),
         eye: Vec3,
         before: bool,
     ) -> DrawStats {
@@ -178,8 +178,7 @@ impl BlocksTree {
         }
         self.list.build_in_order();
         gpu.upload(&buffers.instances, &self.list);
-        let mut pass = gpu.begin_clear_pass(encoder, target, "blocks-tree pass");
-        pass.set_bind_group(0, gpu.camera_group(), &[]);
+        let mut pass = gpu.begin_clear_pass(encoder, target, view, "blocks-tree pass");
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, buffers.instances.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
@@ -235,7 +234,7 @@ impl Method for BlocksTree {
         self.tree.cut(&camera, self.band, &mut self.frame.cut);
         self.tree
             .seams(&self.frame.cut.opaque, &mut self.frame.seams);
-        self.draw(gpu, encoder, target, camera.eye, false)
+        self.draw(gpu, encoder, (target, input.view), camera.eye, false)
     }
 
     fn counterfactual(&mut self) -> Option<&mut dyn Counterfactual> {
@@ -257,6 +256,6 @@ impl Counterfactual for BlocksTree {
         before: &RenderTarget,
     ) {
         let eye = input.scene.camera(input.frame).eye;
-        self.draw(gpu, encoder, before, eye, true);
+        self.draw(gpu, encoder, (before, input.view), eye, true);
     }
 }

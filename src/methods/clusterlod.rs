@@ -7,7 +7,7 @@
 use super::common::{identity_instance, mesh_vertex_buffer, Counterfactual, FrameInput, Method};
 use crate::error::{Error, Result};
 use crate::geometry::cluster_dag::{CutBound, CutCamera};
-use crate::gpu::{DrawStats, InstanceBuffer, RenderTarget, SceneGpu};
+use crate::gpu::{DrawStats, InstanceBuffer, RenderTarget, SceneGpu, View};
 use crate::scene::schedule::InstanceState;
 use crate::scene::unified::Unified;
 use crate::scene::Scene;
@@ -77,12 +77,11 @@ impl ClusterLod {
         &self,
         gpu: &SceneGpu,
         encoder: &mut wgpu::CommandEncoder,
-        target: &RenderTarget,
+        (target, view): (&RenderTarget, View),
         cut: &[u32],
     ) -> DrawStats {
         let dag = &self.unified.dag;
-        let mut pass = gpu.begin_clear_pass(encoder, target, "clusterlod pass");
-        pass.set_bind_group(0, gpu.camera_group(), &[]);
+        let mut pass = gpu.begin_clear_pass(encoder, target, view, "clusterlod pass");
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
         pass.set_vertex_buffer(1, self.instance.buffer.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
@@ -130,7 +129,7 @@ impl Method for ClusterLod {
             .dag
             .cut_into(&camera, &mut self.over, &mut self.cut);
         let cut = std::mem::take(&mut self.cut);
-        let stats = self.draw(gpu, encoder, target, &cut);
+        let stats = self.draw(gpu, encoder, (target, input.view), &cut);
         self.cut = cut;
         stats
     }
@@ -148,13 +147,13 @@ impl Counterfactual for ClusterLod {
     fn encode_before(
         &mut self,
         gpu: &SceneGpu,
-        _input: &FrameInput<'_>,
+        input: &FrameInput<'_>,
         _history: &[&[InstanceState]],
         encoder: &mut wgpu::CommandEncoder,
         before: &RenderTarget,
     ) {
         let previous = std::mem::take(&mut self.previous);
-        self.draw(gpu, encoder, before, &previous);
+        self.draw(gpu, encoder, (before, input.view), &previous);
         self.previous = previous;
     }
 }

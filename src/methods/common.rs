@@ -354,7 +354,7 @@ impl OpaqueInstances {
         if let Some(seams) = &mut self.seams {
             seams.prepare(gpu, input, &lod_of);
         }
-        let mut pass = gpu.begin_clear_pass(encoder, target, label);
+        let mut pass = gpu.begin_clear_pass(encoder, target, input.view, label);
         let stats = gpu.draw(
             &mut pass,
             &self.buffer,

@@ -227,7 +227,7 @@ impl Method for Dither {
             gpu.queue
                 .write_buffer(&self.params, 0, bytemuck::cast_slice(&words));
         }
-        let mut pass = gpu.begin_clear_pass(encoder, target, "dither pass");
+        let mut pass = gpu.begin_clear_pass(encoder, target, input.view, "dither pass");
         pass.set_bind_group(1, &self.noise_group, &[]);
         gpu.draw(
             &mut pass,

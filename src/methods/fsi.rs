@@ -49,6 +49,7 @@
 use super::common::{instance_raw_with, Counterfactual, DumpKind, FrameInput, Method};
 use crate::effects::shadow::Caster;
 use crate::error::Result;
+use crate::gpu::scene_gpu::ShadowMap;
 use crate::gpu::timestamps::GpuTimer;
 use crate::gpu::GpuContext;
 use crate::gpu::{
@@ -587,14 +588,14 @@ impl Fsi {
 
     fn render(
         &self,
-        gpu: &SceneGpu,
+        (gpu, shadow): (&SceneGpu, ShadowMap),
         encoder: &mut wgpu::CommandEncoder,
         slot: usize,
         buffer: usize,
         instances: u32,
     ) -> DrawStats {
         self.render_into(
-            gpu,
+            (gpu, shadow),
             encoder,
             &self.buffers[buffer],
             &self.lists[slot],
@@ -603,10 +604,11 @@ impl Fsi {
         )
     }
 
-    /// Draws `list` (uploaded to `instances` from `first` on) into LOD buffer `b`, cleared first.
+    /// Draws `list` (uploaded to `instances` from `first` on) into LOD buffer `b`, cleared first, lit by shadow
+    /// map `shadow`.
     fn render_into(
         &self,
-        gpu: &SceneGpu,
+        (gpu, shadow): (&SceneGpu, ShadowMap),
         encoder: &mut wgpu::CommandEncoder,
         b: &LodBuffer,
         list: &DrawList,
@@ -653,6 +655,7 @@ impl Fsi {
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        pass.set_bind_group(0, gpu.camera_group(shadow), &[]);
         pass.set_bind_group(1, &self.vis_group, &[]);
         gpu.draw(
             &mut pass,
@@ -945,7 +948,7 @@ impl Fsi {
             fill_list(list, input, c);
             gpu.upload_at(&scratch.instances, slot as u32 * n, list);
             self.render_into(
-                gpu,
+                (gpu, input.view.shadow),
                 encoder,
                 &scratch.buffers[k],
                 list,
@@ -1061,13 +1064,13 @@ impl Method for Fsi {
                 // Both buffers this frame, same camera (at a path's start: the previous frame as it would
                 // have been, the other LOD of each t-instance).
                 self.prepare(gpu, input, 1 - newer, old_toggle);
-                stats += self.render(gpu, encoder, 1 - newer, 1 - newer, n);
+                stats += self.render((gpu, input.view.shadow), encoder, 1 - newer, 1 - newer, n);
                 camera
             }
             (_, true, Some((_, c))) => c,
         };
         self.prepare(gpu, input, newer, new_toggle);
-        stats += self.render(gpu, encoder, newer, newer, n);
+        stats += self.render((gpu, input.view.shadow), encoder, newer, newer, n);
         self.last_newer = newer;
         self.previous = Some((f, camera));
         if !input.timed {

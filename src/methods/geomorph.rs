@@ -228,7 +228,7 @@ impl Method for Geomorph {
         self.list.build();
         gpu.upload(&self.buffer, &self.list);
         self.follow_poses(gpu);
-        let mut pass = gpu.begin_clear_pass(encoder, target, "geomorph pass");
+        let mut pass = gpu.begin_clear_pass(encoder, target, input.view, "geomorph pass");
         pass.set_vertex_buffer(2, self.targets.slice(..));
         if let Some(s) = &self.surface_targets {
             pass.set_vertex_buffer(4, s.slice(..));

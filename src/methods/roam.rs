@@ -17,7 +17,7 @@ use crate::error::{Error, Result};
 use crate::geometry::cluster_dag::CutBound;
 use crate::geometry::roam_mesh::{Bintree, HeightField};
 use crate::geometry::terrain::{height, TERRAIN_SIZE};
-use crate::gpu::{DrawStats, InstanceBuffer, RenderTarget, SceneGpu, Selection, Vertex};
+use crate::gpu::{DrawStats, InstanceBuffer, RenderTarget, SceneGpu, Selection, Vertex, View};
 use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
 use glam::Vec3;
@@ -201,7 +201,7 @@ impl Roam {
         &self,
         gpu: &SceneGpu,
         encoder: &mut wgpu::CommandEncoder,
-        target: &RenderTarget,
+        (target, view): (&RenderTarget, View),
         before: bool,
     ) -> DrawStats {
         let (frame, vertices, index) = if before {
@@ -220,8 +220,7 @@ impl Roam {
             gpu.queue
                 .write_buffer(index, 0, bytemuck::cast_slice(&frame.indices));
         }
-        let mut pass = gpu.begin_clear_pass(encoder, target, "roam pass");
-        pass.set_bind_group(0, gpu.camera_group(), &[]);
+        let mut pass = gpu.begin_clear_pass(encoder, target, view, "roam pass");
         pass.set_vertex_buffer(0, vertices.buffer.slice(..));
         pass.set_vertex_buffer(1, self.instance.buffer.slice(..));
         pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
@@ -293,7 +292,7 @@ impl Method for Roam {
         self.last_frame = Some(input.frame);
         let select_ns = started.elapsed().as_nanos() as u64;
         self.reserve_slots(gpu, self.frame.morphing.len());
-        let mut stats = self.draw(gpu, encoder, target, false);
+        let mut stats = self.draw(gpu, encoder, (target, input.view), false);
         stats.selection = Some(Selection {
             splits: counts.splits,
             merges: counts.merges,
@@ -315,12 +314,12 @@ impl Counterfactual for Roam {
     fn encode_before(
         &mut self,
         gpu: &SceneGpu,
-        _input: &FrameInput<'_>,
+        input: &FrameInput<'_>,
         _history: &[&[InstanceState]],
         encoder: &mut wgpu::CommandEncoder,
         before: &RenderTarget,
     ) {
         self.reserve_slots(gpu, self.previous.morphing.len());
-        self.draw(gpu, encoder, before, true);
+        self.draw(gpu, encoder, (before, input.view), true);
     }
 }

@@ -8,7 +8,8 @@
 
 use crate::effects::shadow::Caster;
 use crate::error::Result;
-use crate::gpu::{DrawStats, RenderTarget, SceneGpu};
+use crate::gpu::scene_gpu::ShadowMap;
+use crate::gpu::{DrawStats, RenderTarget, SceneGpu, View};
 use crate::scene::schedule::InstanceState;
 use crate::scene::Scene;
 use glam::Mat4;
@@ -69,6 +70,22 @@ pub struct FrameInput<'a> {
     pub distances: &'a [f32],
     /// This frame belongs to the timing pass (methods that time a pass of their own do it only then).
     pub timed: bool,
+    /// The shadow map every pass of the frame is lit by and the scissor its colour passes draw within: each
+    /// pass a method begins takes it ([`SceneGpu::begin_pass`]).
+    pub view: View,
+}
+
+impl FrameInput<'_> {
+    /// This frame's input with its passes lit by shadow map `map`.
+    pub fn lit_by(&self, map: ShadowMap) -> Self {
+        FrameInput {
+            view: View {
+                shadow: map,
+                ..self.view
+            },
+            ..*self
+        }
+    }
 }
 
 pub trait Method {
