@@ -3,7 +3,7 @@
 //!
 //! One rule says where a test goes (docs/ARCHITECTURE.md, "Contributing: where a test goes"): a file per folder
 //! of `src/` whose behaviour it checks, named `<folder>_<subject>.rs` (`methods_fsi.rs` checks
-//! `src/methods/fsi.rs`, `effects_taa.rs` the TAA of `src/effects/`); a test that checks every layer at once
+//! `src/methods/fsi/`, `effects_taa.rs` the TAA of `src/effects/`); a test that checks every layer at once
 //! (a whole run against blessed figures or images) goes to one of the suites, and the checks of the source tree
 //! itself are named after what they read.
 
