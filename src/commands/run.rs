@@ -237,10 +237,16 @@ fn run_blocks(
     manifest.write(out_dir)?;
     job.progress.finish_and_clear();
     output.frames_csv.finish()?;
-    let ceiling = manifest
-        .ceilings
-        .as_deref()
-        .and_then(crate::measure::probe_rounds::triangle_ceiling);
+    let ceiling = manifest.ceilings.as_deref().and_then(|rows| {
+        let readings = manifest.blocks.iter().flat_map(|b| {
+            [b.triangle_rate_before, b.triangle_rate_after]
+                .into_iter()
+                .flatten()
+        });
+        crate::measure::probe_rounds::run_triangle_ceiling(rows, readings)
+    });
+    manifest.triangle_ceiling = ceiling;
+    manifest.write(out_dir)?;
     for s in &mut output.summaries {
         s.set_ceiling(ceiling);
     }

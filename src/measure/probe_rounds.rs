@@ -119,6 +119,22 @@ pub fn clock_changed(before: f64, after: f64) -> bool {
     lo.is_finite() && hi > 0.0 && lo / hi < 0.8
 }
 
+/// The run's triangle ceiling: the highest of the triangle probes' rates at its start ([`triangle_ceiling`] of
+/// `rows`) and of its readings around the blocks (`readings`, [`ClockCheck::triangle_rate`]). A ceiling is a
+/// rate the adapter reaches, and on a shared or throttled adapter a reading errs low, never high: on lavapipe the
+/// start's short probe read 9.05 M triangles a second in one run and 14.1 M in another of the same command, and
+/// the readings around one run's blocks ranged from 10.2 M to 17.4 M (docs/findings/ceilings.md); shares over
+/// the start's alone came out above 1. The highest reading is the steadier denominator.
+pub fn run_triangle_ceiling(
+    rows: &[ProbeRecord],
+    readings: impl IntoIterator<Item = f64>,
+) -> Option<f64> {
+    triangle_ceiling(rows)
+        .into_iter()
+        .chain(readings.into_iter().filter(|r| r.is_finite() && *r > 0.0))
+        .reduce(f64::max)
+}
+
 /// The triangle ceiling of a run's ceilings: the larger of the two triangle probes' rates.
 pub fn triangle_ceiling(rows: &[ProbeRecord]) -> Option<f64> {
     rows.iter()
@@ -338,6 +354,16 @@ fn paired(a: &[f64], b: &[f64]) -> (f64, Option<(f64, f64)>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_run_ceiling_is_the_highest_rate_read() {
+        // No probe rows: the readings alone; NaN and zero readings are no rate.
+        assert_eq!(
+            run_triangle_ceiling(&[], [3.0, f64::NAN, 0.0, 5.0]),
+            Some(5.0)
+        );
+        assert_eq!(run_triangle_ceiling(&[], [f64::NAN]), None);
+    }
 
     #[test]
     fn a_fifth_either_way_is_a_clock_change() {

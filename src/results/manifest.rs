@@ -53,6 +53,10 @@ pub struct RunManifest {
     /// The adapter's ceilings measured before the blocks (`measure::probe_rounds::ceilings`; null with
     /// `--ceilings off`): each probe's rate on its clock. summary.csv's ceiling columns divide by them.
     pub ceilings: Option<Vec<crate::measure::probe_rounds::ProbeRecord>>,
+    /// The triangle ceiling summary.csv's `triangle_ceiling_share` divides by: the highest triangle rate the
+    /// run read, at its start (`ceilings`) or around any block (`triangle_rate_before` / `_after`)
+    /// (`measure::probe_rounds::run_triangle_ceiling`); null with `--ceilings off`.
+    pub triangle_ceiling: Option<f64>,
 }
 
 /// This build's `git describe --always --dirty` (None when not built from a checkout).
@@ -108,6 +112,7 @@ impl RunManifest {
             timing_rounds: Vec::new(),
             peak_resident_bytes: None,
             ceilings: None,
+            triangle_ceiling: None,
         }
     }
 

@@ -150,5 +150,28 @@ fn runs_record_the_ceilings_and_the_rate_around_each_block() {
         let row = summary.records().next().unwrap().unwrap();
         let share = &row[column(&header, "triangle_ceiling_share")];
         assert_eq!(share.parse::<f64>().is_ok_and(|x| x > 0.0), on, "{share:?}");
+        // The share's denominator is the highest triangle rate the run read: at its start or around a block.
+        let ceiling = run["triangle_ceiling"].as_f64();
+        assert_eq!(ceiling.is_some(), on, "{}", run["triangle_ceiling"]);
+        if let Some(ceiling) = ceiling {
+            let start = run["ceilings"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|p| p["unit"] == "triangles")
+                .filter_map(|p| p["rate_median"].as_f64());
+            let around =
+                ["triangle_rate_before", "triangle_rate_after"].map(|k| block[k].as_f64().unwrap());
+            let highest = start.chain(around).fold(0.0, f64::max);
+            assert_eq!(ceiling, highest);
+            let per_s = row[column(&header, "triangles_per_s")]
+                .parse::<f64>()
+                .unwrap();
+            let share = share.parse::<f64>().unwrap();
+            assert!(
+                (share - per_s / ceiling).abs() <= 1e-9 * share,
+                "{share} {per_s} {ceiling}"
+            );
+        }
     }
 }
