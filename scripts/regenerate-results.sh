@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Remakes every folder of results/cpu/ from the code at HEAD, in the order below, one folder at a time:
-#   scripts/regenerate-results.sh [--list] [--force] [--out ROOT] [NAME ...]
+#   scripts/regenerate-results.sh [--list] [--stale] [--force] [--out ROOT] [NAME ...]
 # Each folder is made in results/cpu/.regen/NAME, then pruned to what the committed folder keeps (a file whose name
 # it has, and figures/ where it has figures: frames.csv and frame dumps go unless it kept them) and moved into place. Resumable:
 # a folder already made by this build (results/cpu/.regen/done lists NAME and the build's commit) is skipped
 # unless --force; an interrupted folder is made again from its start. Prints each folder's time and the total.
+# --stale prints each folder's build (the commits its manifests name) and whether the sources (src, shaders, scenes,
+# Cargo.toml, Cargo.lock, build.rs) changed since: `current` when they did not, else how many later commits
+# changed them (a folder made from an uncommitted tree says `dirty`).
 # --out ROOT makes the folders in ROOT instead, whole, leaving results/cpu/ alone (the test that the committed
 # results are today's, scripts/tests/test_results_today.py, compares such a remake with the committed folder).
 #
@@ -20,26 +23,28 @@ cd "$(dirname "$0")/.."
 root=results/cpu
 work=$root/.regen
 list=0
+stale=0
 force=0
 into=
 only=()
 while (($#)); do
     case $1 in
         --list) list=1 ;;
+        --stale) stale=1 ;;
         --force) force=1 ;;
         --out)
             [[ -n ${2:-} ]] || { echo "error: --out needs a folder" >&2; exit 2; }
             into=$2
             shift
             ;;
-        -*) echo "error: unknown option '$1' (--list, --force, --out ROOT, or folder names)" >&2; exit 2 ;;
+        -*) echo "error: unknown option '$1' (--list, --stale, --force, --out ROOT, or folder names)" >&2; exit 2 ;;
         *) only+=("$1") ;;
     esac
     shift
 done
 
 LB=${LODBENCH:-}
-if [[ -z $LB && $list == 0 ]]; then
+if [[ -z $LB && $list == 0 && $stale == 0 ]]; then
     cargo build --release --quiet
     LB=target/release/lodbench
 fi
@@ -182,6 +187,23 @@ for entry in "${folders[@]}"; do
     fi
     if [[ $list == 1 ]]; then
         printf '%-34s %4s min  %-10s %s\n' "$name" "$minutes" "${needs:--}" "$cmd"
+        continue
+    fi
+    if [[ $stale == 1 ]]; then
+        builds=$(find "$root/$name" -name '*.json' -print0 2>/dev/null | xargs -0 -r grep -ho '"git_commit": *"[^"]*"' \
+            | sed 's/.*"\([^"]*\)"$/\1/' | sort -u)
+        [[ -n $builds ]] || { printf '%-34s %s\n' "$name" "no manifest names a build"; continue; }
+        for b in $builds; do
+            c=${b%-dirty}
+            if ! git cat-file -e "$c^{commit}" 2>/dev/null; then
+                state="not a commit of this repository"
+            else
+                n=$(git rev-list --count "$c..HEAD" -- src shaders scenes Cargo.toml Cargo.lock build.rs)
+                state=$([[ $n == 0 ]] && echo current || echo "sources changed by $n later commits")
+                [[ $b == *-dirty ]] && state="$state, dirty"
+            fi
+            printf '%-34s %-20s %s\n' "$name" "$b" "$state"
+        done
         continue
     fi
     missing=()
