@@ -2,7 +2,8 @@
 # Remakes every folder of results/cpu/ from the code at HEAD, in the order below, one folder at a time:
 #   scripts/regenerate-results.sh [--list] [--stale] [--force] [--out ROOT] [NAME ...]
 # Each folder is made in results/cpu/.regen/NAME, then pruned to what the committed folder keeps (a file whose name
-# it has, and figures/ where it has figures: frames.csv and frame dumps go unless it kept them) and moved into place. Resumable:
+# it has, and figures/ where it has figures: frames.csv and frame dumps go unless it kept them) and moved into place;
+# a top-level subfolder of the committed folder that the command does not make is kept. Resumable:
 # a folder already made by this build (results/cpu/.regen/done lists NAME and the build's commit) is skipped
 # unless --force; an interrupted folder is made again from its start. Prints each folder's time and the total.
 # --stale prints each folder's build (the commits its manifests name) and whether the sources (src, shaders, scenes,
@@ -74,7 +75,7 @@ folders=(
 "timing-aa-bunny-grid-ci|17||\$LB experiment $E/aa-bunny-grid-ci.toml --out \$D"
 "timing-ratios-ci|3||\$LB run --scene bunny-sweep,windmills --method discrete,alpha,fsi --profile ci --out \$D/ratios-sweep-windmills && \$LB run --scene bunny-grid --method discrete,alpha,fsi --profile ci --count 50,500 --out \$D/ratios-grid"
 "timing-quality-cost|6||\$LB run --scene bunny-sweep --method reference,discrete,alpha,fsi --profile ci --out \$D/after && \$LB run --scene bunny-sweep --method reference,discrete,alpha,fsi --profile ci --metrics rmse,pop,de2000 --out \$D/after-de2000 && \$LB run --scene bunny-sweep --method reference,discrete,alpha,fsi --profile ci --metric-reduction workgroup --out \$D/after-workgroup"
-"quality-cost-ci|10||\$LB run --scene bunny-sweep,simple --profile ci --out \$D/run-a && \$LB run --scene bunny-sweep,simple --profile ci --out \$D/run-b"
+"quality-cost-ci|10||\$LB run --scene bunny-sweep,simple --profile ci --out \$D/run-n && \$LB run --scene bunny-sweep,simple --profile ci --out \$D/run-o"
 "lodpop-bunny-sweep-ci|15||\$LB run --scene bunny-sweep --profile ci --dump-frames --dump-transitions --out \$D && \$LB perceptual \$D && $PLOT \$D"
 "lodpop-trees-ci|9||\$LB run --scene trees --profile ci --dump-frames --dump-transitions --out \$D && \$LB perceptual \$D && $PLOT \$D"
 "lodpop-bunny-sweep-paper|70||\$LB run --scene bunny-sweep --profile paper --out \$D && $PLOT \$D"
@@ -235,6 +236,13 @@ for entry in "${folders[@]}"; do
     total=$((total + secs))
     if [[ -z $into ]]; then
         prune "$D" "$root/$name"
+        # A top-level folder the committed one has and this command does not make (a run of an earlier build that
+        # a page quotes, quality-cost-ci's run-a to run-m) is kept; --stale then names both builds.
+        for old in "$root/$name"/*/; do
+            [[ -d $old ]] || continue
+            sub=$(basename "$old")
+            [[ -e $D/$sub ]] || cp -a "$old" "$D/$sub"
+        done
         rm -rf "${root:?}/$name"
         mv "$D" "$root/$name"
         echo "$name $build" >>"$work/done"
