@@ -237,14 +237,7 @@ fn run_blocks(
     manifest.write(out_dir)?;
     job.progress.finish_and_clear();
     output.frames_csv.finish()?;
-    let ceiling = manifest.ceilings.as_deref().and_then(|rows| {
-        let readings = manifest.blocks.iter().flat_map(|b| {
-            [b.triangle_rate_before, b.triangle_rate_after]
-                .into_iter()
-                .flatten()
-        });
-        crate::measure::probe_rounds::run_triangle_ceiling(rows, readings)
-    });
+    let ceiling = run_triangle_ceiling(manifest);
     manifest.triangle_ceiling = ceiling;
     manifest.write(out_dir)?;
     for s in &mut output.summaries {
@@ -255,6 +248,19 @@ fn run_blocks(
     write_rounds(out_dir, &output.rounds)?;
     write_pairs(out_dir, &output.pairs)?;
     Ok((output.summaries, output.pairs))
+}
+
+/// The run's triangle ceiling (run.json's `triangle_ceiling`): the highest triangle rate of its start's probes and
+/// of the readings around its blocks; None with `--ceilings off`.
+fn run_triangle_ceiling(manifest: &RunManifest) -> Option<f64> {
+    manifest.ceilings.as_deref().and_then(|rows| {
+        let readings = manifest.blocks.iter().flat_map(|b| {
+            [b.triangle_rate_before, b.triangle_rate_after]
+                .into_iter()
+                .flatten()
+        });
+        crate::measure::probe_rounds::run_triangle_ceiling(rows, readings)
+    })
 }
 
 /// The frames the progress bar counts: per block, every method's warm-up, timed and quality frames (with the
