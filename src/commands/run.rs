@@ -234,12 +234,11 @@ fn run_blocks(
             }
         }
     }
-    manifest.write(out_dir)?;
-    job.progress.finish_and_clear();
-    output.frames_csv.finish()?;
     let ceiling = run_triangle_ceiling(manifest);
     manifest.triangle_ceiling = ceiling;
     manifest.write(out_dir)?;
+    job.progress.finish_and_clear();
+    output.frames_csv.finish()?;
     for s in &mut output.summaries {
         s.set_ceiling(ceiling);
     }

@@ -573,11 +573,17 @@ impl SceneGpu {
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        self.apply_view(&mut pass, view);
+        pass
+    }
+
+    /// Sets `view` on a colour pass begun elsewhere than [`SceneGpu::begin_pass`] (a method's own attachments):
+    /// the camera bind group of its shadow map, and its scissor.
+    pub fn apply_view(&self, pass: &mut wgpu::RenderPass<'_>, view: View) {
         pass.set_bind_group(0, self.camera_group(view.shadow), &[]);
         if let Some([x, y, w, h]) = view.scissor {
             pass.set_scissor_rect(x, y, w, h);
         }
-        pass
     }
 
     /// Draws `count` instances from absolute instance `first` of `buffer` at (model, LOD) with `pipeline`;

@@ -382,10 +382,7 @@ impl Method for AlphaSorted {
                         occlusion_query_set: None,
                         multiview_mask: None,
                     });
-                    pass.set_bind_group(0, gpu.camera_group(input.view.shadow), &[]);
-                    if let Some([x, y, w, h]) = input.view.scissor {
-                        pass.set_scissor_rect(x, y, w, h);
-                    }
+                    gpu.apply_view(&mut pass, input.view);
                     let previous = if layer == 0 { 0 } else { 1 + (1 - cur) };
                     pass.set_bind_group(1, &self.peel_groups[previous], &[]);
                     stats += gpu.draw(
