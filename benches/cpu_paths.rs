@@ -111,6 +111,7 @@ fn csv_export(c: &mut Criterion) {
             merges: None,
             select_cpu_ms: None,
             round: f / 360,
+            fragments: None,
         })
         .collect();
     let dir = tempfile::tempdir().unwrap();

@@ -7,8 +7,11 @@
 # the papers' scenes, instance counts and viewports, with FRAMES timed frames (default 150; the papers' 3,600
 # would take hours) and 10 warm-up frames per block, into results/gpu/<adapter>/<experiment>/, draws the
 # figures (scripts/plot.py), writes each experiment's wall time to results/gpu/<adapter>/times.txt and prints
-# the claims that need a GPU (docs/claims.md) to read the figures against. It stops at once when the best
-# adapter is a software one. LODBENCH names a lodbench binary to use instead of building one.
+# the claims that need a GPU (docs/claims.md) to read the figures against. terrain-equal-error runs twice, with
+# the GPU clock's warm-up before each timed segment (--clock-warmup, on by default on a GPU) and without it
+# (terrain-equal-error-no-warmup/), and scripts/clock_drops.py lists the blocks whose speed changed in each
+# (clock_drops.md): whether the warm-up prevents the H200's slow pixel-error-0.5 block. It stops at once when the
+# best adapter is a software one. LODBENCH names a lodbench binary to use instead of building one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${1:-${FRAMES:-150}}
@@ -73,6 +76,15 @@ for exp in "${experiments[@]}"; do
         python3 scripts/equal_error.py "$out/$exp"
     fi
     echo "$exp: $(($(date +%s) - start)) s ($frames frames)" | tee -a "$out/times.txt"
+    if [[ $exp == terrain-equal-error ]]; then
+        # The same without the clock's warm-up (each warm-up takes at most a quarter of a second, one per method
+        # and round; run.json's clock_warmup_ms says what they took), then the blocks whose rate changed in each.
+        start=$(date +%s)
+        "$lodbench" experiment "scenes/experiments/$exp.toml" --set "frames=$frames" --set warmup=10 \
+            --set clock-warmup=off --out "$out/$exp-no-warmup"
+        python3 scripts/clock_drops.py "$out/$exp" "$out/$exp-no-warmup" | tee "$out/clock_drops.md"
+        echo "$exp without the clock warm-up: $(($(date +%s) - start)) s ($frames frames)" | tee -a "$out/times.txt"
+    fi
 done
 echo
 echo "The claims that need a GPU (docs/claims.md); read them against the figures in $out:"

@@ -50,7 +50,8 @@ READS = {
         "pop_max", "pop_p95", "lodpop_max", "lodpop_p95", "lodpop_sum", "shadow_lodpop_max",
         "triangles_mean", "draw_calls_mean", "t_instances_mean", "units_drawn_mean", "uncovered_px_mean",
         "crack_px_mean", "crack_px_max", "extra_target_bytes", "tri_alternation_max",
-        "triangles_per_s", "triangle_ceiling_share", "bound",
+        "triangles_per_s", "triangle_ceiling_share", "fragments_mean", "fragments_per_s", "fragment_ceiling_share",
+        "bound",
     ),
     TRANSITIONS_CSV: (
         "scene", "method", "count", "transition", "first_frame", "last_frame", "lods", "lodpop_max",

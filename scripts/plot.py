@@ -325,17 +325,25 @@ def cost(scene, summary, path):
 
 
 def ceilings_figure(scene, summary, path):
-    """Each block's triangles a second as a share of the adapter's triangle ceiling (run.json's ceilings,
-    `lodbench probe`): near 1, the block is bound by triangles; far below, by something else (fill, the
-    harness, the CPU)."""
-    rows = [r for r in summary if r.get("triangle_ceiling_share")]
+    """Each block's triangles a second as a share of the adapter's triangle ceiling, and its fragments a second
+    (counted in the quality pass) as a share of its fill ceiling (run.json's ceilings, `lodbench probe`): near 1,
+    the block is bound by that; far below both, by something else (the harness, the CPU, a stage not probed)."""
+    rows = [r for r in summary if r.get("triangle_ceiling_share") or r.get("fragment_ceiling_share")]
     labels = [f"{r['method']} n={r['count']}" if len({x['count'] for x in rows}) > 1 else r["method"] for r in rows]
+    fragments = any(r.get("fragment_ceiling_share") for r in rows)
+    width = 0.4 if fragments else 0.8
+    x = np.arange(len(rows))
     fig, ax = plt.subplots(figsize=(max(6, 0.5 * len(rows) + 2), 3.6))
-    ax.bar(range(len(rows)), [num(r["triangle_ceiling_share"]) for r in rows], color="tab:blue")
-    ax.axhline(0.8, color="tab:orange", ls="--", lw=1, label="0.8: bound by triangles")
-    ax.set_xticks(range(len(rows)), labels, rotation=30, ha="right", fontsize=8)
-    ax.set_ylabel("triangles a second / ceiling")
-    ax.set_title(f"{scene}: triangle rate against the adapter's ceiling")
+    shift = -width / 2 if fragments else 0.0
+    ax.bar(x + shift, [num(r.get("triangle_ceiling_share", "")) for r in rows], width, color="tab:blue",
+           label="triangles")
+    if fragments:
+        ax.bar(x + width / 2, [num(r.get("fragment_ceiling_share", "")) for r in rows], width, color="tab:green",
+               label="fragments")
+    ax.axhline(0.8, color="tab:orange", ls="--", lw=1, label="0.8: bound")
+    ax.set_xticks(x, labels, rotation=30, ha="right", fontsize=8)
+    ax.set_ylabel("rate / the adapter's ceiling")
+    ax.set_title(f"{scene}: rates against the adapter's ceilings")
     ax.legend(fontsize=7)
     save(fig, path)
 
@@ -644,9 +652,10 @@ def report(folder: Path, transition: str = "worst") -> list:
         if any(r["rmse_mean"] != "" for r in scene_summary):
             cost(scene, scene_summary, figs / f"cost_{scene}.png")
             made.append((f"cost_{scene}.png", f"{scene}: error against cost"))
-        if any(r.get("triangle_ceiling_share") for r in scene_summary):
+        if any(r.get("triangle_ceiling_share") or r.get("fragment_ceiling_share") for r in scene_summary):
             ceilings_figure(scene, scene_summary, figs / f"ceilings_{scene}.png")
-            made.append((f"ceilings_{scene}.png", f"{scene}: triangles a second against the adapter's ceiling"))
+            made.append((f"ceilings_{scene}.png", f"{scene}: triangles and fragments a second against the "
+                                                  "adapter's ceilings"))
     lead = variables + (["adapter"] if len(adapters) > 1 else []) + ["scene", "method", "count"]
     # The tables once, as (heading, rows, columns): report.md and report.html render the same ones.
     sections = [(f"Summary: {what}", summary, lead + cols) for what, cols in summary_groups(header, lead)] \
@@ -697,11 +706,12 @@ SUMMARY_GROUPS = (
     ("popping", ("pop_max", "pop_p95", "lodpop_max", "lodpop_p95", "lodpop_sum", "shadow_lodpop_max")),
     ("geometry", ("triangles_mean", "draw_calls_mean", "t_instances_mean", "units_drawn_mean", "uncovered_px_mean",
                   "crack_px_mean", "crack_px_max", "extra_target_bytes", "tri_alternation_max")),
-    ("ceilings", ("triangles_per_s", "triangle_ceiling_share", "bound")),
+    ("ceilings", ("triangles_per_s", "triangle_ceiling_share", "fragments_mean", "fragments_per_s",
+                  "fragment_ceiling_share", "bound")),
 )
 # Counts, shown with thousands separators.
-COUNT_COLUMNS = {"frames", "rounds", "triangles_mean", "draw_calls_mean", "units_drawn_mean", "crack_px_max",
-                 "extra_target_bytes", "uncovered_px_mean", "crack_px_mean"}
+COUNT_COLUMNS = {"frames", "rounds", "triangles_mean", "fragments_mean", "draw_calls_mean", "units_drawn_mean",
+                 "crack_px_max", "extra_target_bytes", "uncovered_px_mean", "crack_px_mean"}
 
 
 def summary_groups(header, lead):

@@ -18,10 +18,11 @@ from conftest import ROOT, lodbench_binary
 
 # The cheapest folders with image figures: a glTF scene with its materials, and a unified scene's blocks and seams.
 FOLDERS = ["report-fox-quick", "unified-bunny-halves-ci"]
-# Figures of the images and of what was drawn (CPU counts); everything else is time or its ratios.
+# Figures of the images and of what was drawn (CPU counts, and the fragments the adapter counted: exact on the
+# same adapter and driver); everything else is time or its ratios.
 IMAGE = re.compile(
     r"rmse|pop|de2000|flip|uncovered|crack|^(scene|method|count|frames|triangles_mean|draw_calls_mean|"
-    r"t_instances_mean|units_drawn_mean|first_frame|last_frame|lods|transition)$"
+    r"t_instances_mean|units_drawn_mean|first_frame|last_frame|lods|transition|fragments|fragments_mean)$"
 )
 MANIFESTS = ("run.json", "probe.json", "overhead.json", "tune.json")
 

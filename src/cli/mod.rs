@@ -430,9 +430,16 @@ pub struct RunArgs {
     pub budget_lodpop: Option<f64>,
     /// Measure the adapter's ceilings before the blocks (`lodbench probe`'s rates, each probe's base alone, a
     /// fraction of a second on a CPU adapter) into run.json, and fill summary.csv's triangles_per_s,
-    /// triangle_ceiling_share and bound.
+    /// triangle_ceiling_share, fragments_per_s, fragment_ceiling_share and bound.
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     pub ceilings: OnOff,
+    /// Before each method's timed segment of a round, keep the GPU busy with the triangle probe until it reads
+    /// nine tenths of the highest triangle rate the run has read (at most a quarter of a second), so that a GPU
+    /// clock dropped while the GPU idled (a CPU-heavy method's selection) is back up before the next method is
+    /// timed. `auto`: on, but on a CPU adapter (no GPU clock). Needs `--ceilings on`. Recorded per method in
+    /// run.json (`clock_warmup_*`).
+    #[arg(long, value_enum, default_value_t = ClockWarmup::Auto)]
+    pub clock_warmup: ClockWarmup,
     #[command(flatten)]
     #[serde(flatten)]
     pub method_options: MethodOptions,
@@ -564,6 +571,27 @@ pub struct ExportArgs {
     pub frame: u32,
     #[command(flatten)]
     pub scene_args: SceneArgs,
+}
+
+/// `--clock-warmup`.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    clap::ValueEnum,
+    serde::Serialize,
+    serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum ClockWarmup {
+    /// On where the adapter is a GPU, off on a CPU rasteriser.
+    #[default]
+    Auto,
+    On,
+    Off,
 }
 
 /// Whether to write MP4s with ffmpeg.

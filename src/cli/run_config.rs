@@ -156,6 +156,8 @@ pub struct RunConfig {
     pub budget_lodpop: Option<f64>,
     /// `--ceilings`: measure the adapter's ceilings before the blocks.
     pub ceilings: OnOff,
+    /// `--clock-warmup`: warm the GPU's clock before each timed segment.
+    pub clock_warmup: super::ClockWarmup,
     /// Every method's flags (recorded whether or not the method runs).
     #[serde(flatten)]
     pub method_options: MethodOptions,
@@ -275,6 +277,13 @@ fn check_budget_and_outputs(a: &RunArgs) -> Result<()> {
                 .into(),
         ));
     }
+    if a.clock_warmup == super::ClockWarmup::On && a.ceilings == OnOff::Off {
+        return Err(Error::Config(
+            "--clock-warmup on warms the GPU with the ceilings' triangle probe, and --ceilings off skips it: \
+             drop one of the two"
+                .into(),
+        ));
+    }
     if a.quality == OnOff::Off {
         let needs = if a.dump_frames {
             Some(("--dump-frames", "it writes the quality pass's frames"))
@@ -334,6 +343,7 @@ impl RunConfig {
             baseline,
             budget_lodpop: a.budget_lodpop,
             ceilings: a.ceilings,
+            clock_warmup: a.clock_warmup,
             method_options: a.method_options,
             metrics: a.metrics.clone(),
             metric_reduction: a.metric_reduction,

@@ -181,17 +181,8 @@ fn run_blocks(
     out_dir: &Path,
     manifest: &mut RunManifest,
 ) -> Result<(Vec<SummaryRecord>, Vec<PairRecord>)> {
-    let ctx = GpuContext::new(cfg.adapter.as_deref())?;
-    manifest.adapter = Some(ctx.info.clone());
-    manifest.timing_source = Some(ctx.timing);
-    manifest.timestamp_period_ns = Some(ctx.timestamp_period_ns);
-    let clock = match cfg.ceilings {
-        crate::effects::OnOff::On => Some(crate::measure::probe_rounds::ClockCheck::new(&ctx)?),
-        crate::effects::OnOff::Off => None,
-    };
-    if let Some(c) = &clock {
-        manifest.ceilings = Some(crate::measure::probe_rounds::ceilings(&ctx, c, cfg.seed)?);
-    }
+    let (ctx, clock, warm_on) = open_adapter(cfg, manifest)?;
+    let warm = clock.as_ref().filter(|_| warm_on);
     manifest.write(out_dir)?;
 
     let dumper = if cfg.dump_frames {
@@ -223,7 +214,7 @@ fn run_blocks(
                 .as_ref()
                 .map(|c| c.triangle_rate(&job.ctx))
                 .transpose()?;
-            job.run_block(def, count, block_index, manifest, &mut output)?;
+            job.run_block((def, count, block_index), warm, manifest, &mut output)?;
             let after = clock
                 .as_ref()
                 .map(|c| c.triangle_rate(&job.ctx))
@@ -236,17 +227,56 @@ fn run_blocks(
     }
     let ceiling = run_triangle_ceiling(manifest);
     manifest.triangle_ceiling = ceiling;
+    let fragment_ceiling = manifest
+        .ceilings
+        .as_deref()
+        .and_then(crate::measure::probe_rounds::fragment_ceiling);
+    manifest.fragment_ceiling = fragment_ceiling;
     manifest.write(out_dir)?;
     job.progress.finish_and_clear();
     output.frames_csv.finish()?;
     for s in &mut output.summaries {
-        s.set_ceiling(ceiling);
+        s.set_ceiling(ceiling, fragment_ceiling);
     }
     write_summary(out_dir, &output.summaries)?;
     write_transitions(out_dir, &output.transitions)?;
     write_rounds(out_dir, &output.rounds)?;
     write_pairs(out_dir, &output.pairs)?;
     Ok((output.summaries, output.pairs))
+}
+
+/// The adapter the run draws on, recorded in the manifest with its ceilings (`--ceilings on`: measured now, and
+/// the probe that reads the triangle rate around each block), and whether that probe warms the GPU's clock
+/// before each timed segment (`--clock-warmup`; auto: not on a CPU adapter, which has no GPU clock).
+fn open_adapter(
+    cfg: &RunConfig,
+    manifest: &mut RunManifest,
+) -> Result<(
+    GpuContext,
+    Option<crate::measure::probe_rounds::ClockCheck>,
+    bool,
+)> {
+    let ctx = GpuContext::new(cfg.adapter.as_deref())?;
+    manifest.adapter = Some(ctx.info.clone());
+    manifest.timing_source = Some(ctx.timing);
+    manifest.timestamp_period_ns = Some(ctx.timestamp_period_ns);
+    let clock = match cfg.ceilings {
+        crate::effects::OnOff::On => Some(crate::measure::probe_rounds::ClockCheck::new(&ctx)?),
+        crate::effects::OnOff::Off => None,
+    };
+    if let Some(c) = &clock {
+        let rows = crate::measure::probe_rounds::ceilings(&ctx, c, cfg.seed)?;
+        c.note_ceilings(&rows);
+        manifest.ceilings = Some(rows);
+    }
+    let warm_on = clock.is_some()
+        && match cfg.clock_warmup {
+            crate::cli::ClockWarmup::On => true,
+            crate::cli::ClockWarmup::Auto => ctx.info.device_type != "Cpu",
+            crate::cli::ClockWarmup::Off => false,
+        };
+    manifest.clock_warmup = Some(warm_on);
+    Ok((ctx, clock, warm_on))
 }
 
 /// The run's triangle ceiling (run.json's `triangle_ceiling`): the highest triangle rate of its start's probes and
@@ -340,9 +370,8 @@ impl RunJob<'_> {
     /// then quality pass, round by round), their summaries and rounds.
     fn run_block(
         &self,
-        def: &SceneDef,
-        count: u32,
-        block_index: u64,
+        (def, count, block_index): (&SceneDef, u32, u64),
+        warm: Option<&crate::measure::probe_rounds::ClockCheck>,
         manifest: &mut RunManifest,
         output: &mut RunOutput,
     ) -> Result<()> {
@@ -360,6 +389,7 @@ impl RunJob<'_> {
         let mut block =
             BlockRunner::new(&self.ctx, &scene, setup, self.dumper.is_some(), &quality)?;
         block.dump_transitions_only(cfg.dump_transitions);
+        block.warm_clock_with(warm);
         let stage = match cfg.quality_pass() {
             true => "timing and quality rounds",
             false => "timing rounds",

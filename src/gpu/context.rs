@@ -152,11 +152,10 @@ impl GpuContext {
         let adapter = adapters[index].clone();
         let info = adapter.get_info();
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let required_features = if timestamps {
-            wgpu::Features::TIMESTAMP_QUERY
-        } else {
-            wgpu::Features::empty()
-        };
+        // Pipeline statistics count the fragment shader invocations of the quality pass's method frames
+        // (summary.csv's `fragments_*` columns); never used in a timed frame.
+        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::PIPELINE_STATISTICS_QUERY;
+        let required_features = adapter.features() & wanted;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("lodbench device"),
             required_features,

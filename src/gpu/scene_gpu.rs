@@ -2,6 +2,7 @@
 //! scene's surface (flat, or its materials: textures, samplers and a bind group each), the shared opaque
 //! pipeline, render passes and instanced draws, part by part where a mesh has materials.
 
+use super::fragments::Pass;
 use crate::error::{Error, Result};
 use crate::gpu::context::GpuContext;
 use crate::gpu::draw_list::{DrawList, DrawStats, PipelineIndex};
@@ -155,6 +156,9 @@ pub struct SceneGpu {
     pub uploads: UploadCounters,
     /// The deformed models' LODs as the last [`SceneGpu::write_pose`] posed them (empty when nothing deforms).
     posed: std::cell::RefCell<Posed>,
+    /// Counts the fragments of the passes begun while the quality pass counts a method's frame (None where the
+    /// device has no pipeline statistics queries).
+    pub fragments: Option<super::fragments::FragmentQueries>,
     /// Scratch for their vertices, reused every frame.
     pose_vertices: std::cell::RefCell<Vec<Vertex>>,
     /// Scratch for their surface vertices (their tangents turn with the pose), reused every frame.
@@ -332,6 +336,7 @@ impl SceneGpu {
             cull,
             uploads: UploadCounters::default(),
             posed: Default::default(),
+            fragments: super::fragments::FragmentQueries::new(device),
             pose_vertices: Default::default(),
             pose_surface: Default::default(),
         };
@@ -485,6 +490,15 @@ impl SceneGpu {
         texture
     }
 
+    /// `pass` with a fragment query in it while the quality pass counts the method's frame
+    /// ([`FragmentQueries`](super::fragments::FragmentQueries)): for a pass a method begins itself.
+    pub fn counted<'e>(&self, pass: wgpu::RenderPass<'e>) -> Pass<'e> {
+        match &self.fragments {
+            Some(f) => f.wrap(pass),
+            None => Pass::plain(pass),
+        }
+    }
+
     /// Begins a pass of `view` that clears `target` to the background and its depth to 1.
     pub fn begin_clear_pass<'e>(
         &self,
@@ -492,7 +506,7 @@ impl SceneGpu {
         target: &RenderTarget,
         view: View,
         label: &str,
-    ) -> wgpu::RenderPass<'e> {
+    ) -> Pass<'e> {
         let views = (&target.color_view, &target.depth_view);
         self.begin_pass(encoder, views, view, label, true)
     }
@@ -505,8 +519,8 @@ impl SceneGpu {
         depth: &wgpu::TextureView,
         map: ShadowMap,
         label: &str,
-    ) -> wgpu::RenderPass<'e> {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+    ) -> Pass<'e> {
+        let mut pass = self.counted(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
@@ -520,7 +534,7 @@ impl SceneGpu {
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
-        });
+        }));
         pass.set_bind_group(0, self.camera_group(map), &[]);
         pass
     }
@@ -534,7 +548,7 @@ impl SceneGpu {
         view: View,
         label: &str,
         clear: bool,
-    ) -> wgpu::RenderPass<'e> {
+    ) -> Pass<'e> {
         let [r, g, b] = BACKGROUND;
         let color_load = if clear {
             wgpu::LoadOp::Clear(wgpu::Color {
@@ -546,7 +560,7 @@ impl SceneGpu {
         } else {
             wgpu::LoadOp::Load
         };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        let mut pass = self.counted(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: color,
@@ -572,7 +586,7 @@ impl SceneGpu {
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
-        });
+        }));
         self.apply_view(&mut pass, view);
         pass
     }

@@ -81,6 +81,11 @@ impl<'a> BlockRunner<'a> {
         })
     }
 
+    /// Warm the GPU's clock with `clock` before each timed segment (`--clock-warmup`; None: not).
+    pub fn warm_clock_with(&mut self, clock: Option<&'a crate::measure::probe_rounds::ClockCheck>) {
+        self.base.clock = clock;
+    }
+
     /// Dump only frames with an instance in transition (of those, still every `dump_every`-th frame).
     pub fn dump_transitions_only(&mut self, on: bool) {
         self.dumps.transitions_only = on;
@@ -316,6 +321,7 @@ impl<'a> BlockRunner<'a> {
                 merges: timed.stats[f].selection.map(|s| s.merges),
                 select_cpu_ms: timed.stats[f].selection.map(|s| s.cpu_ns as f64 * 1e-6),
                 round: timed.round[f],
+                fragments: quality.and_then(|q| q.fragments.get(f).copied().flatten()),
             })
             .collect()
     }
@@ -362,6 +368,10 @@ impl<'a> BlockRunner<'a> {
             instance_bytes_written_per_frame: timed.uploads.written as f64 / frames,
             triangle_rate_before: None,
             triangle_rate_after: None,
+            clock_warmup_ms: (!timed.clock_warmups.is_empty())
+                .then(|| timed.clock_warmups.iter().map(|w| w.ms).sum()),
+            clock_warmups_short: (!timed.clock_warmups.is_empty())
+                .then(|| timed.clock_warmups.iter().filter(|w| !w.reached).count() as u32),
         }
     }
 }

@@ -37,6 +37,8 @@ pub struct BlockGpu<'a> {
     pub timing_target: RenderTarget,
     /// `--shadows on`: the shadow pass and the frames' lights.
     pub shadows: Option<Shadows>,
+    /// `--clock-warmup`: the probe that warms the GPU's clock before each timed segment (None: no warm-up).
+    pub clock: Option<&'a crate::measure::probe_rounds::ClockCheck>,
 }
 
 impl<'a> BlockGpu<'a> {
@@ -52,6 +54,7 @@ impl<'a> BlockGpu<'a> {
             gpu,
             setup,
             timing_target,
+            clock: None,
         })
     }
 

@@ -81,16 +81,103 @@ pub fn ceilings(ctx: &GpuContext, clock: &ClockCheck, seed: u64) -> Result<Vec<P
 /// each block, the triangle probe's base variant 3 times, at a tenth of the default work on a 256 x 256 target (a
 /// few milliseconds on lavapipe, well under one on a GPU).
 /// A block whose rate after differs from its rate before by more than a fifth ran while the adapter changed
-/// speed (the H200's GPU clock dropping while ROAM's selection kept it idle): detected and said, not prevented.
+/// speed (the H200's GPU clock dropping while ROAM's selection kept it idle): detected and said. With
+/// `--clock-warmup`, [`ClockCheck::warm`] before every timed segment works to prevent it.
 pub struct ClockCheck {
     probes: Probes,
+    /// The highest triangle rate read so far (the start's probes and every reading since).
+    best: std::cell::Cell<f64>,
+}
+
+/// A warm-up's target: this share of the highest triangle rate the run has read.
+pub const WARM_TARGET: f64 = 0.9;
+/// A warm-up's longest time, ms: a GPU's clock ramps up within tens of milliseconds of steady work.
+pub const WARM_CAP_MS: f64 = 250.0;
+/// The busy work between two readings of a warm-up, ms at the best rate read.
+const WARM_BATCH_MS: f64 = 5.0;
+
+/// What one warm-up before a timed segment did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WarmUp {
+    /// Wall time, ms.
+    pub ms: f64,
+    /// Readings taken (each after a batch of busy work).
+    pub readings: u32,
+    /// The last reading reached the target (else the cap ended it).
+    pub reached: bool,
+}
+
+/// Busy work and a reading (`busy_then_read`), repeated until a reading reaches `target` or `elapsed_ms()`
+/// passes `cap_ms`; at least one reading.
+pub fn warm_until(
+    mut busy_then_read: impl FnMut() -> Result<f64>,
+    target: f64,
+    cap_ms: f64,
+    elapsed_ms: impl Fn() -> f64,
+) -> Result<WarmUp> {
+    let mut readings = 0;
+    loop {
+        let rate = busy_then_read()?;
+        readings += 1;
+        let reached = rate >= target;
+        if reached || elapsed_ms() >= cap_ms {
+            return Ok(WarmUp {
+                ms: elapsed_ms(),
+                readings,
+                reached,
+            });
+        }
+    }
 }
 
 impl ClockCheck {
     pub fn new(ctx: &GpuContext) -> Result<ClockCheck> {
         Ok(ClockCheck {
             probes: Probes::new(ctx, (256, 256), Amounts::at(0.1))?,
+            best: std::cell::Cell::new(0.0),
         })
+    }
+
+    /// Counts the start's ceilings into the highest rate read ([`ClockCheck::warm`]'s target).
+    pub fn note_ceilings(&self, rows: &[ProbeRecord]) {
+        if let Some(t) = triangle_ceiling(rows) {
+            self.note(t);
+        }
+    }
+
+    fn note(&self, rate: f64) {
+        if rate.is_finite() && rate > self.best.get() {
+            self.best.set(rate);
+        }
+    }
+
+    /// Keeps the adapter busy with the triangle probe until it reads [`WARM_TARGET`] of the highest triangle
+    /// rate read so far, or [`WARM_CAP_MS`] has passed: before a timed segment, so that a clock that dropped
+    /// while the GPU idled (a CPU-heavy method's frames, the harness between blocks) is up again. Each round of
+    /// it submits about [`WARM_BATCH_MS`] of the probe without waiting, then reads the rate
+    /// ([`ClockCheck::triangle_rate`]).
+    pub fn warm(&self, ctx: &GpuContext) -> Result<WarmUp> {
+        let start = Instant::now();
+        let item = (Probe::Triangles, Variant::Base);
+        let q = self.probes.quantity(item.0, item.1);
+        let best = self.best.get();
+        let batch = match best > 0.0 && q > 0.0 {
+            true => (WARM_BATCH_MS / 1e3 * best / q).ceil().clamp(1.0, 256.0) as u32,
+            false => 1,
+        };
+        warm_until(
+            || {
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                for _ in 0..batch {
+                    self.probes.record(&mut encoder, item.0, item.1);
+                }
+                ctx.queue.submit([encoder.finish()]);
+                self.triangle_rate(ctx)
+            },
+            WARM_TARGET * best,
+            WARM_CAP_MS,
+            || start.elapsed().as_secs_f64() * 1e3,
+        )
     }
 
     /// Triangles a second now: one untimed submission (after a block, the probe's first reading was slower
@@ -109,7 +196,9 @@ impl ClockCheck {
         };
         let ms = if gpu.len() == 5 { gpu } else { cpu };
         let q = self.probes.quantity(Probe::Triangles, Variant::Base);
-        Ok(q / (percentile(&ms, 50.0).unwrap_or(f64::NAN) / 1e3))
+        let rate = q / (percentile(&ms, 50.0).unwrap_or(f64::NAN) / 1e3);
+        self.note(rate);
+        Ok(rate)
     }
 }
 
@@ -132,6 +221,18 @@ pub fn run_triangle_ceiling(
     triangle_ceiling(rows)
         .into_iter()
         .chain(readings.into_iter().filter(|r| r.is_finite() && *r > 0.0))
+        .reduce(f64::max)
+}
+
+/// The fragment ceiling of a run's ceilings: the faster of the two fill probes (full-screen quads, opaque and
+/// blended), in fragments a second. Their quads cover whole tiles and quads, so the fragment shader invocations
+/// an adapter counts for them are the fragments they name; a method's count (`fragments`) includes what the
+/// adapter shades around a triangle's edges besides, which is work of the same kind. The depth probe has no
+/// fragment shader and is not a fill rate of shaded fragments.
+pub fn fragment_ceiling(rows: &[ProbeRecord]) -> Option<f64> {
+    rows.iter()
+        .filter(|r| r.probe.starts_with("fill-") && r.rate_median.is_finite())
+        .map(|r| r.rate_median)
         .reduce(f64::max)
 }
 
@@ -354,6 +455,44 @@ fn paired(a: &[f64], b: &[f64]) -> (f64, Option<(f64, f64)>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_warm_up_reads_until_the_clock_is_up_or_the_cap_passes() {
+        use std::cell::Cell;
+        // A clock that ramps: each reading 20 % faster than the one before, from a fifth of full speed.
+        let ramp = |rates: &Cell<f64>| {
+            let r = rates.get();
+            rates.set(r * 1.2);
+            Ok(r)
+        };
+        let (rate, t) = (Cell::new(2.0), Cell::new(0.0));
+        let tick = || {
+            t.set(t.get() + 10.0);
+            t.get()
+        };
+        let w = warm_until(|| ramp(&rate), 0.9 * 10.0, WARM_CAP_MS, tick).unwrap();
+        // 2 * 1.2^k >= 9 first at k = 9: the tenth reading.
+        assert_eq!((w.readings, w.reached), (10, true));
+        // A clock that stays down: the cap ends it, the target not reached.
+        let (t, tick) = (Cell::new(0.0), |t: &Cell<f64>| {
+            t.set(t.get() + 10.0);
+            t.get()
+        });
+        let w = warm_until(|| Ok(2.0), 9.0, 100.0, || tick(&t)).unwrap();
+        assert_eq!((w.readings, w.reached), (10, false));
+        assert!(w.ms >= 100.0);
+        // Already up: one reading.
+        let w = warm_until(|| Ok(10.0), 9.0, 100.0, || 0.0).unwrap();
+        assert_eq!((w.readings, w.reached), (1, true));
+        // A failing reading is the warm-up's error.
+        assert!(warm_until(
+            || Err(crate::error::Error::Gpu("lost".into())),
+            9.0,
+            100.0,
+            || 0.0
+        )
+        .is_err());
+    }
 
     #[test]
     fn the_run_ceiling_is_the_highest_rate_read() {

@@ -9,7 +9,9 @@
 //!   of the machine's speed falls on all methods alike and each round pairs the methods on the same frames.
 //!   Nothing but the method's own work is in a timed frame (no metric, no read-back, no stage timestamps). Each
 //!   frame is submitted and waited for, so `cpu_ms` is a true encode-to-completion time and frames never
-//!   overlap; GPU timestamps are resolved into one buffer per method and read once after the rounds.
+//!   overlap; GPU timestamps are resolved into one buffer per method and read once after the rounds. With
+//!   `--clock-warmup`, the GPU is kept busy before each segment until its clock is up
+//!   (`probe_rounds::ClockCheck::warm`), outside the segment's time.
 
 use super::block_gpu::BlockGpu;
 use super::driver::check_interrupt;
@@ -55,6 +57,8 @@ pub struct TimedMethod<'s> {
     pub(super) uploads: Uploads,
     /// `--warmup` (the frames of the path rendered untimed first; [`WarmUpPlan`] adds transition frames).
     pub(super) warmup: u32,
+    /// `--clock-warmup`: the GPU clock's warm-up before each of its timed segments.
+    pub(super) clock_warmups: Vec<crate::measure::probe_rounds::WarmUp>,
 }
 
 impl TimedMethod<'_> {
@@ -181,6 +185,10 @@ impl<'a> BlockGpu<'a> {
         let (lo, hi) = round_frames(r, rounds, self.scene.frames);
         let order = shuffled_order(p.methods.len(), rng);
         for &i in &order {
+            if let Some(clock) = self.clock {
+                let warm = clock.warm(self.ctx)?;
+                p.methods[i].clock_warmups.push(warm);
+            }
             self.time_segment(&mut p.methods[i], r, lo..hi, progress)?;
         }
         p.info.rounds.push(Round {
@@ -220,6 +228,7 @@ impl<'a> BlockGpu<'a> {
             segment_ms: Vec::new(),
             uploads: Uploads::default(),
             warmup,
+            clock_warmups: Vec::new(),
         })
     }
 

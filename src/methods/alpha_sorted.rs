@@ -359,29 +359,32 @@ impl Method for AlphaSorted {
                 );
                 {
                     // The layer cleared to no colour and no alpha; the depth as copied.
-                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some("alpha-sorted peel"),
-                        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                            view: &self.layer_view,
-                            depth_slice: None,
-                            resolve_target: None,
-                            ops: wgpu::Operations {
-                                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                                store: wgpu::StoreOp::Store,
-                            },
-                        })],
-                        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                            view: &self.peel_depth_views[cur],
-                            depth_ops: Some(wgpu::Operations {
-                                load: wgpu::LoadOp::Load,
-                                store: wgpu::StoreOp::Store,
-                            }),
-                            stencil_ops: None,
-                        }),
-                        timestamp_writes: None,
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    });
+                    let mut pass =
+                        gpu.counted(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                            label: Some("alpha-sorted peel"),
+                            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                                view: &self.layer_view,
+                                depth_slice: None,
+                                resolve_target: None,
+                                ops: wgpu::Operations {
+                                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                                    store: wgpu::StoreOp::Store,
+                                },
+                            })],
+                            depth_stencil_attachment: Some(
+                                wgpu::RenderPassDepthStencilAttachment {
+                                    view: &self.peel_depth_views[cur],
+                                    depth_ops: Some(wgpu::Operations {
+                                        load: wgpu::LoadOp::Load,
+                                        store: wgpu::StoreOp::Store,
+                                    }),
+                                    stencil_ops: None,
+                                },
+                            ),
+                            timestamp_writes: None,
+                            occlusion_query_set: None,
+                            multiview_mask: None,
+                        }));
                     gpu.apply_view(&mut pass, input.view);
                     let previous = if layer == 0 { 0 } else { 1 + (1 - cur) };
                     pass.set_bind_group(1, &self.peel_groups[previous], &[]);

@@ -57,6 +57,12 @@ pub struct RunManifest {
     /// run read, at its start (`ceilings`) or around any block (`triangle_rate_before` / `_after`)
     /// (`measure::probe_rounds::run_triangle_ceiling`); null with `--ceilings off`.
     pub triangle_ceiling: Option<f64>,
+    /// The fragment ceiling summary.csv's `fragment_ceiling_share` divides by: the faster of the start's two
+    /// fill probes (`measure::probe_rounds::fragment_ceiling`); null with `--ceilings off`.
+    pub fragment_ceiling: Option<f64>,
+    /// Whether the GPU's clock was warmed before each timed segment (`--clock-warmup`, resolved: `auto` is off
+    /// on a CPU adapter and with `--ceilings off`); null before the adapter was opened.
+    pub clock_warmup: Option<bool>,
 }
 
 /// This build's `git describe --always --dirty` (None when not built from a checkout).
@@ -113,6 +119,8 @@ impl RunManifest {
             peak_resident_bytes: None,
             ceilings: None,
             triangle_ceiling: None,
+            fragment_ceiling: None,
+            clock_warmup: None,
         }
     }
 

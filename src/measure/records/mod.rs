@@ -51,7 +51,46 @@ pub(crate) mod tests {
             merges: None,
             select_cpu_ms: None,
             round: 0,
+            fragments: None,
         }
+    }
+
+    #[test]
+    fn the_ceiling_columns_name_what_bounds_a_block() {
+        // 4 frames of 100-103 triangles and 1,000-4,000 fragments, 2 ms each on the GPU's clock.
+        let rows: Vec<FrameRecord> = (0..4)
+            .map(|f| FrameRecord {
+                fragments: Some(1000 * (f as u64 + 1)),
+                ..row(f, Some(2.0), 0.0, 0.0)
+            })
+            .collect();
+        let s = |rows: &[FrameRecord], t: Option<f64>, fr: Option<f64>| {
+            let mut s = SummaryRecord::from_frames(rows, 0, 1, Clock::GpuMs).unwrap();
+            s.set_ceiling(t, fr);
+            s
+        };
+        let a = s(&rows, Some(101_500.0 / 0.8), Some(1_250_000.0 / 0.5));
+        assert_eq!(a.fragments_mean, Some(2500.0));
+        assert_eq!(a.triangles_per_s, Some(50_750.0));
+        assert_eq!(a.fragments_per_s, Some(1_250_000.0));
+        assert!((a.triangle_ceiling_share.unwrap() - 0.4).abs() < 1e-12);
+        assert!((a.fragment_ceiling_share.unwrap() - 0.5).abs() < 1e-12);
+        assert_eq!(a.bound, None, "neither share reaches {BOUND_SHARE}");
+        let b = s(&rows, Some(100_000.0), Some(1_300_000.0));
+        assert_eq!(b.bound.as_deref(), Some("fragments"));
+        let c = s(&rows, Some(55_000.0), Some(1_300_000.0));
+        assert_eq!(c.bound.as_deref(), Some("triangles+fragments"));
+        // A frame not counted: the block's fragments are not known, nor their share.
+        let mut gap = rows.clone();
+        gap[2].fragments = None;
+        let d = s(&gap, Some(55_000.0), Some(1_300_000.0));
+        assert_eq!((d.fragments_mean, d.fragments_per_s), (None, None));
+        assert_eq!(d.bound.as_deref(), Some("triangles"));
+        // No ceiling read (--ceilings off): rates, but no share and no bound.
+        let e = s(&rows, None, None);
+        assert!(
+            e.fragments_per_s.is_some() && e.fragment_ceiling_share.is_none() && e.bound.is_none()
+        );
     }
 
     /// Rows of `rounds` rounds of `per_round` frames, frame f in transition when `transition(f)`, timed

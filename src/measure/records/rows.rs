@@ -69,6 +69,10 @@ pub struct FrameRecord {
     pub select_cpu_ms: Option<f64>,
     /// The timing round the frame was timed in (0-based; `--rounds`).
     pub round: u32,
+    /// Fragment shader invocations of the method's frame, counted in the quality pass with pipeline statistics
+    /// queries (its own passes: not the shadow maps, TAA's resolve or compute passes; empty with `--quality
+    /// off` or where the adapter has no such queries).
+    pub fragments: Option<u64>,
 }
 
 /// Per (scene, count, method) block: sizes and the cost of the two passes.
@@ -138,6 +142,11 @@ pub struct BlockInfo {
     /// the adapter changed speed during the block (a GPU's clock), and its times are suspect.
     pub triangle_rate_before: Option<f64>,
     pub triangle_rate_after: Option<f64>,
+    /// `--clock-warmup`: the warm-ups before the method's timed segments (one per round): their total wall
+    /// time, ms, and how many ended at the cap short of the target (the clock did not come up; null without
+    /// warm-ups).
+    pub clock_warmup_ms: Option<f64>,
+    pub clock_warmups_short: Option<u32>,
 }
 
 /// The timing rounds of one scene block, as run.json records them (`timing_rounds`).
@@ -202,6 +211,7 @@ impl FrameTimes {
             splits: None,
             merges: None,
             select_cpu_ms: None,
+            fragments: None,
         })
     }
 }

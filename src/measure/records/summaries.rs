@@ -77,28 +77,47 @@ pub struct SummaryRecord {
     /// `triangles_per_s` over the adapter's triangle ceiling measured at the start of the run (run.json's
     /// `ceilings`, `measure::probe_rounds::triangle_ceiling`).
     pub triangle_ceiling_share: Option<f64>,
-    /// `triangles` where that share is 0.8 or more: the block draws near the adapter's triangle rate.
+    /// Mean over the frames the quality pass counted of `fragments` (fragment shader invocations of the
+    /// method's frame; empty with `--quality off`, on an adapter without pipeline statistics queries, or where a
+    /// frame was not counted).
+    pub fragments_mean: Option<f64>,
+    /// `fragments_mean` over the median frame time (the block's clock), a second.
+    pub fragments_per_s: Option<f64>,
+    /// `fragments_per_s` over the run's fragment ceiling (run.json's `fragment_ceiling`: the faster of the
+    /// start's two fill probes, whose full-screen quads shade every fragment they count).
+    pub fragment_ceiling_share: Option<f64>,
+    /// What the block draws near the adapter's rate of: `triangles` and/or `fragments`, where that share is
+    /// 0.8 or more (joined by `+`).
     pub bound: Option<String>,
 }
 
+/// A share of a ceiling at or above which the block is said to be bound by it (`bound`).
+pub const BOUND_SHARE: f64 = 0.8;
+
 impl SummaryRecord {
-    /// Fills the ceiling columns from the run's triangle ceiling (triangles a second).
-    pub fn set_ceiling(&mut self, triangle_ceiling: Option<f64>) {
+    /// Fills the ceiling columns from the run's triangle and fragment ceilings (a second each).
+    pub fn set_ceiling(&mut self, triangle_ceiling: Option<f64>, fragment_ceiling: Option<f64>) {
         let ms = match self.clock {
             Clock::GpuMs => self.gpu_ms_median,
             Clock::CpuMs => Some(self.cpu_ms_median),
         };
-        self.triangles_per_s = ms
-            .filter(|ms| *ms > 0.0)
-            .map(|ms| self.triangles_mean / (ms / 1e3));
-        self.triangle_ceiling_share = self
-            .triangles_per_s
-            .zip(triangle_ceiling.filter(|c| *c > 0.0))
-            .map(|(r, c)| r / c);
-        self.bound = self
-            .triangle_ceiling_share
-            .filter(|s| *s >= 0.8)
-            .map(|_| "triangles".to_string());
+        let per_s = |amount: f64| ms.filter(|ms| *ms > 0.0).map(|ms| amount / (ms / 1e3));
+        let share = |rate: Option<f64>, ceiling: Option<f64>| {
+            rate.zip(ceiling.filter(|c| *c > 0.0)).map(|(r, c)| r / c)
+        };
+        self.triangles_per_s = per_s(self.triangles_mean);
+        self.triangle_ceiling_share = share(self.triangles_per_s, triangle_ceiling);
+        self.fragments_per_s = self.fragments_mean.and_then(per_s);
+        self.fragment_ceiling_share = share(self.fragments_per_s, fragment_ceiling);
+        let bound: Vec<&str> = [
+            ("triangles", self.triangle_ceiling_share),
+            ("fragments", self.fragment_ceiling_share),
+        ]
+        .into_iter()
+        .filter(|(_, s)| s.is_some_and(|s| s >= BOUND_SHARE))
+        .map(|(name, _)| name)
+        .collect();
+        self.bound = (!bound.is_empty()).then(|| bound.join("+"));
     }
 
     /// Summarises one block's rows (all of the same scene, method and count); `seed` drives the bootstrap,
@@ -145,6 +164,12 @@ impl SummaryRecord {
         self.gpu_ms_p95 = percentile(&gpu, 95.0);
         self.cpu_ms_median = percentile(&cpu, 50.0).unwrap_or(f64::NAN);
         self.triangles_mean = mean(rows.iter().map(|r| r.triangles as f64));
+        // Counted on every frame, or not known.
+        let fragments: Option<Vec<f64>> =
+            rows.iter().map(|r| r.fragments.map(|n| n as f64)).collect();
+        self.fragments_mean = fragments
+            .filter(|v| !v.is_empty())
+            .map(|v| mean(v.into_iter()));
         self.draw_calls_mean = mean(rows.iter().map(|r| r.draw_calls as f64));
         self.t_instances_mean = mean(rows.iter().map(|r| r.t_instances as f64));
         self.units_drawn_mean = mean(rows.iter().map(|r| r.units_drawn as f64));

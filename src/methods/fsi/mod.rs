@@ -341,7 +341,7 @@ impl Fsi {
         first: u32,
     ) -> DrawStats {
         let [r, g, bl] = crate::scene::BACKGROUND;
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        let mut pass = gpu.counted(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("fsi LOD buffer pass"),
             color_attachments: &[
                 Some(wgpu::RenderPassColorAttachment {
@@ -379,7 +379,7 @@ impl Fsi {
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
-        });
+        }));
         pass.set_bind_group(0, gpu.camera_group(shadow), &[]);
         pass.set_bind_group(1, &self.vis_group, &[]);
         gpu.draw(
