@@ -4,29 +4,31 @@
 //!
 //! The quality pass turns counting on around the method's own frame ([`FragmentQueries::start`] ..
 //! [`FragmentQueries::resolve`]) and never in a timed frame, so the timing rounds hold no query. A pass begun while
-//! counting gets a query of its own (one slot of a query set reused every frame, like the timer's ring), ended
-//! when the pass ends ([`Pass`]); the frame's slots are resolved into the frame's row of a buffer and summed when
-//! read. Passes a method begins without [`SceneGpu::begin_pass`](super::SceneGpu::begin_pass) and its
-//! siblings are counted by [`SceneGpu::counted`](super::SceneGpu::counted). Not counted: shadow maps, TAA's
-//! resolve and compute passes (not the method's frame, or not fragments).
+//! counting gets a query of its own, ended when the pass ends ([`Pass`]). The queries live in query sets of
+//! [`SET_QUERIES`] each, reused every frame (like the timer's ring) and added as a frame needs more (alpha-2pass
+//! begins two passes per instance in transition: hundreds on a grid of bunnies); at the frame's end each set's
+//! used range is resolved into the pass's [`FragmentRows`], and the rows are summed per frame when read. Passes a
+//! method begins without [`SceneGpu::begin_pass`](super::SceneGpu::begin_pass) and its siblings are counted by
+//! [`SceneGpu::counted`](super::SceneGpu::counted). Not counted: shadow maps, TAA's resolve and compute passes
+//! (not the method's frame, or not fragments).
 
-use std::cell::Cell;
+use crate::error::Result;
+use crate::gpu::context::GpuContext;
+use std::cell::{Cell, RefCell};
 use std::ops::{Deref, DerefMut};
 
-/// Queries a frame may use: more passes than this and the frame's count is unknown.
-pub const SLOTS: u32 = 64;
-/// Bytes of a frame's row in a resolve buffer (a multiple of the resolve alignment).
-pub const ROW: u64 = {
-    let bytes = SLOTS as u64 * 8;
-    bytes.div_ceil(wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT) * wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT
-};
+/// Queries in one query set.
+pub const SET_QUERIES: u32 = 32;
+/// Bytes of one chunk of a [`FragmentRows`] resolve buffer.
+const CHUNK_BYTES: u64 = 1 << 20;
+const ALIGN: u64 = wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT;
 
-/// The query set and the state of the frame being counted.
+/// The query sets and the state of the frame being counted.
 pub struct FragmentQueries {
-    set: wgpu::QuerySet,
+    device: wgpu::Device,
+    sets: RefCell<Vec<wgpu::QuerySet>>,
     counting: Cell<bool>,
     used: Cell<u32>,
-    overflow: Cell<bool>,
 }
 
 impl FragmentQueries {
@@ -39,16 +41,10 @@ impl FragmentQueries {
             return None;
         }
         Some(FragmentQueries {
-            set: device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("fragment counts"),
-                ty: wgpu::QueryType::PipelineStatistics(
-                    wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS,
-                ),
-                count: SLOTS,
-            }),
+            device: device.clone(),
+            sets: RefCell::new(Vec::new()),
             counting: Cell::new(false),
             used: Cell::new(0),
-            overflow: Cell::new(false),
         })
     }
 
@@ -56,40 +52,140 @@ impl FragmentQueries {
     pub fn start(&self) {
         self.counting.set(true);
         self.used.set(0);
-        self.overflow.set(false);
     }
 
-    /// Ends counting: resolves the frame's queries into row `row` of `buffer` (`ROW` bytes a row) and returns how
-    /// many it used (None where the frame began more passes than [`SLOTS`]).
-    pub fn resolve(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        buffer: &wgpu::Buffer,
-        row: u32,
-    ) -> Option<u32> {
+    /// Ends counting: resolves the frame's queries into `rows` as frame `frame`'s.
+    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder, rows: &mut FragmentRows, frame: u32) {
         self.counting.set(false);
         let used = self.used.get();
-        if used > 0 {
-            encoder.resolve_query_set(&self.set, 0..used, buffer, row as u64 * ROW);
+        let sets = self.sets.borrow();
+        let mut spans = Vec::new();
+        for (k, set) in sets.iter().enumerate() {
+            let first = k as u32 * SET_QUERIES;
+            if first >= used {
+                break;
+            }
+            let n = (used - first).min(SET_QUERIES);
+            let (chunk, offset) = rows.place(&self.device, n);
+            encoder.resolve_query_set(set, 0..n, &rows.chunks[chunk], offset);
+            spans.push(Span { chunk, offset, n });
         }
-        (!self.overflow.get()).then_some(used)
+        rows.set_frame(frame, spans);
     }
 
     /// `pass` with a query begun in it when counting is on.
     pub fn wrap<'e>(&self, mut pass: wgpu::RenderPass<'e>) -> Pass<'e> {
-        let mut counted = false;
-        if self.counting.get() {
-            let slot = self.used.get();
-            if slot < SLOTS {
-                pass.begin_pipeline_statistics_query(&self.set, slot);
-                self.used.set(slot + 1);
-                counted = true;
-            } else {
-                self.overflow.set(true);
-            }
+        if !self.counting.get() {
+            return Pass::plain(pass);
         }
-        Pass { pass, counted }
+        let slot = self.used.get();
+        let k = (slot / SET_QUERIES) as usize;
+        let mut sets = self.sets.borrow_mut();
+        while sets.len() <= k {
+            sets.push(self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("fragment counts"),
+                ty: wgpu::QueryType::PipelineStatistics(
+                    wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS,
+                ),
+                count: SET_QUERIES,
+            }));
+        }
+        pass.begin_pipeline_statistics_query(&sets[k], slot % SET_QUERIES);
+        self.used.set(slot + 1);
+        Pass {
+            pass,
+            counted: true,
+        }
     }
+}
+
+/// One resolved range of a frame's queries: `n` counts at `offset` of chunk `chunk`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Span {
+    pub chunk: usize,
+    pub offset: u64,
+    pub n: u32,
+}
+
+/// Where one quality pass resolves its frames' queries: chunks of resolve buffer (added as they fill) and each
+/// frame's spans in them (None: the frame was not counted).
+pub struct FragmentRows {
+    chunks: Vec<wgpu::Buffer>,
+    /// The next free byte of the last chunk.
+    at: u64,
+    frames: Vec<Option<Vec<Span>>>,
+}
+
+impl FragmentRows {
+    pub fn new(frames: u32) -> FragmentRows {
+        FragmentRows {
+            chunks: Vec::new(),
+            at: 0,
+            frames: vec![None; frames as usize],
+        }
+    }
+
+    /// Room for `n` counts, aligned for a resolve: (chunk, offset).
+    fn place(&mut self, device: &wgpu::Device, n: u32) -> (usize, u64) {
+        let bytes = n as u64 * 8;
+        if self.chunks.is_empty() || self.at + bytes > CHUNK_BYTES {
+            self.chunks
+                .push(device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("fragment counts"),
+                    size: CHUNK_BYTES,
+                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                }));
+            self.at = 0;
+        }
+        let at = self.at;
+        self.at = (at + bytes).div_ceil(ALIGN) * ALIGN;
+        (self.chunks.len() - 1, at)
+    }
+
+    fn set_frame(&mut self, frame: u32, spans: Vec<Span>) {
+        if let Some(f) = self.frames.get_mut(frame as usize) {
+            *f = Some(spans);
+        }
+    }
+
+    /// Each frame's fragments (None where it was not counted), read back once.
+    pub fn read(&self, ctx: &GpuContext) -> Result<Vec<Option<u64>>> {
+        let mut chunks = Vec::with_capacity(self.chunks.len());
+        for chunk in &self.chunks {
+            let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fragment counts read-back"),
+                size: CHUNK_BYTES,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            encoder.copy_buffer_to_buffer(chunk, 0, &readback, 0, None);
+            ctx.queue.submit([encoder.finish()]);
+            chunks.push(ctx.read_buffer(&readback, |bytes| bytes.to_vec())?);
+        }
+        Ok(frame_sums(&chunks, &self.frames))
+    }
+}
+
+/// Each frame's fragments: the sum of the counts of its spans in `chunks` (the chunks' bytes read back).
+pub fn frame_sums(chunks: &[Vec<u8>], frames: &[Option<Vec<Span>>]) -> Vec<Option<u64>> {
+    let count = |s: &Span, q: usize| {
+        let at = s.offset as usize + q * 8;
+        let b = chunks.get(s.chunk)?.get(at..at + 8)?;
+        Some(u64::from_le_bytes(b.try_into().ok()?))
+    };
+    frames
+        .iter()
+        .map(|spans| {
+            spans
+                .as_ref()?
+                .iter()
+                .flat_map(|s| (0..s.n as usize).map(move |q| (s, q)))
+                .map(|(s, q)| count(s, q))
+                .sum::<Option<u64>>()
+        })
+        .collect()
 }
 
 /// A render pass that ends its fragment query, if it has one, when it ends.
@@ -130,47 +226,39 @@ impl Drop for Pass<'_> {
     }
 }
 
-/// The fragments of each frame from a resolve buffer read back (`bytes`, [`ROW`] bytes a frame) and each
-/// frame's query count (None: unknown).
-pub fn frame_sums(bytes: &[u8], used: &[Option<u32>]) -> Vec<Option<u64>> {
-    used.iter()
-        .enumerate()
-        .map(|(f, n)| {
-            let n = (*n)?;
-            let at = f * ROW as usize;
-            (0..n as usize)
-                .map(|q| {
-                    let b = bytes.get(at + q * 8..at + q * 8 + 8)?;
-                    Some(u64::from_le_bytes(b.try_into().ok()?))
-                })
-                .sum::<Option<u64>>()
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn a_frames_queries_are_summed_from_its_own_row() {
-        let mut bytes = vec![0u8; 3 * ROW as usize];
-        let put = |bytes: &mut Vec<u8>, f: usize, q: usize, v: u64| {
-            let at = f * ROW as usize + q * 8;
-            bytes[at..at + 8].copy_from_slice(&v.to_le_bytes());
+    fn a_frames_spans_are_summed_from_their_chunks() {
+        let mut chunks = vec![vec![0u8; 1024], vec![0u8; 512]];
+        let mut put = |c: usize, at: usize, v: u64| {
+            chunks[c][at..at + 8].copy_from_slice(&v.to_le_bytes());
         };
-        put(&mut bytes, 0, 0, 100);
-        put(&mut bytes, 0, 1, 20);
-        put(&mut bytes, 1, 0, 7);
-        put(&mut bytes, 1, 1, 1000); // beyond frame 1's one query: not its own
-        put(&mut bytes, 2, 0, 5);
-        let sums = frame_sums(&bytes, &[Some(2), Some(1), None]);
-        assert_eq!(sums, vec![Some(120), Some(7), None]);
+        put(0, 0, 100);
+        put(0, 8, 20);
+        put(0, 256, 7);
+        put(0, 264, 1000); // beyond frame 1's one count: not its own
+        put(1, 0, 5);
+        put(1, 8, 6);
+        let span = |chunk, offset, n| Span { chunk, offset, n };
+        let frames = vec![
+            Some(vec![span(0, 0, 2)]),
+            Some(vec![span(0, 256, 1)]),
+            // A frame over two query sets: two spans, here in two chunks.
+            Some(vec![span(0, 0, 1), span(1, 0, 2)]),
+            Some(vec![]),
+            None,
+        ];
         assert_eq!(
-            frame_sums(&bytes, &[Some(0)]),
-            vec![Some(0)],
-            "no pass, no fragment"
+            frame_sums(&chunks, &frames),
+            vec![Some(120), Some(7), Some(111), Some(0), None]
         );
-        assert_eq!(ROW % wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT, 0);
+        // A span beyond what was read back is no count.
+        assert_eq!(
+            frame_sums(&chunks, &[Some(vec![span(2, 0, 1)])]),
+            vec![None]
+        );
     }
 }

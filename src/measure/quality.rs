@@ -25,6 +25,7 @@ use super::effects::{Casters, ShadowRole, ShadowShare, Stream, TaaStreams};
 use super::metric_kernel::MetricKernel;
 use super::reference_cache::ReferenceCache;
 use crate::error::{Error, Result};
+use crate::gpu::fragments::FragmentRows;
 use crate::gpu::timestamps::GpuTimer;
 use crate::gpu::{GpuContext, RenderTarget, SceneGpu, TextureReadback};
 use crate::measure::metrics::{FrameMetrics, Metric, MetricReduction, MetricRegion};
@@ -120,9 +121,6 @@ pub struct QualityKernels {
     pub lodpop: DiffKernel,
     /// lag_rmse: (method, now).
     pub lag: DiffKernel,
-    /// The method frame's fragment counts, a row per frame ([`crate::gpu::fragments`]; None where the device
-    /// has no pipeline statistics queries).
-    pub fragments: Option<wgpu::Buffer>,
 }
 
 impl QualityKernels {
@@ -147,14 +145,6 @@ impl QualityKernels {
                 background,
             )?,
             metric_timer: GpuTimer::new(ctx, frames.div_ceil(METRIC_TIMED_EVERY)),
-            fragments: gpu.fragments.as_ref().map(|_| {
-                ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("fragment counts"),
-                    size: frames.max(1) as u64 * crate::gpu::fragments::ROW,
-                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                })
-            }),
         })
     }
 }
@@ -179,7 +169,7 @@ pub struct QualityPass {
     /// so that its timestamps are never inside a timing-pass frame.
     pub stage_ms: Option<Vec<Option<f64>>>,
     /// The fragment shader invocations of the method's frame, per frame (empty where the device has no
-    /// pipeline statistics queries; None for a frame that began more passes than the queries cover).
+    /// pipeline statistics queries).
     pub fragments: Vec<Option<u64>>,
     pub ms_per_frame: f64,
     pub metric_gpu_ms_median: Option<f64>,
@@ -339,8 +329,9 @@ pub struct Walk {
     reference_copied: u32,
     /// The metric timer's slots written in this pass.
     metric_timed: Vec<u32>,
-    /// Per frame, the fragment queries its method frame used (None: not counted).
-    fragment_queries: Vec<Option<u32>>,
+    /// The method frames' fragment counts, resolved ([`crate::gpu::fragments`]; empty where the device has no
+    /// pipeline statistics queries).
+    fragments: FragmentRows,
     /// The pass's segments so far.
     segments: Vec<SegmentCost>,
 }
@@ -437,7 +428,7 @@ impl QualityStage {
                 && Self::reference_copyable(&self.taa, &self.shadow_share),
             reference_copied: 0,
             metric_timed: Vec::new(),
-            fragment_queries: vec![None; base.scene.frames as usize],
+            fragments: FragmentRows::new(base.scene.frames),
             segments: Vec::new(),
         };
         walk.coverage.reset();
@@ -498,15 +489,15 @@ impl QualityStage {
         }
         let copy_method = walk.reference_is_method_frame;
         let read_back = dump || self.flip;
-        let (copied, fragment_queries) = self.render_frames(
+        if self.render_frames(
             base,
             (method, cache),
             (&input, f, copy_method),
-            &mut encoder,
+            (&mut encoder, &mut walk.fragments),
             read_back,
-        );
-        walk.reference_copied += copied as u32;
-        walk.fragment_queries[f as usize] = fragment_queries;
+        ) {
+            walk.reference_copied += 1;
+        }
         let previous = walk.history.previous();
         let shadows = self.shadow_maps(base, method, &input, previous);
         self.apply_effects(base, &input, &mut encoder, (f, previous.is_some()));
@@ -570,16 +561,16 @@ impl QualityStage {
     /// method's frame is the same draw (copied); a drawn or copied reference frame is kept for the next pass
     /// where the cache has room. The method's frame is copied into the reference target only where something
     /// reads that target this frame (a dump or FLIP: the metric kernel skips a frame compared with itself); the
-    /// cache then keeps it from the method's target. The method's frame alone has its fragments counted, where
-    /// the device can: the second value, the frame's query count ([`crate::gpu::fragments`]).
+    /// cache then keeps it from the method's target. The method's frame alone has its fragments counted into
+    /// `fragments`, where the device can ([`crate::gpu::fragments`]).
     fn render_frames(
         &mut self,
         base: &BlockGpu<'_>,
         (method, cache): (&mut dyn Method, Option<&ReferenceCache>),
         (input, f, copy_method): (&FrameInput<'_>, u32, bool),
-        encoder: &mut wgpu::CommandEncoder,
+        (encoder, fragments): (&mut wgpu::CommandEncoder, &mut FragmentRows),
         read_back: bool,
-    ) -> (bool, Option<u32>) {
+    ) -> bool {
         let (gpu, t, reference) = (&base.gpu, &self.targets, &mut self.reference);
         let from_cache = cache.is_some_and(|c| c.restore(encoder, f, &t.reference));
         let from_method = !from_cache && copy_method;
@@ -587,8 +578,7 @@ impl QualityStage {
             let input = input.lit_by(ShadowRole::Reference.map());
             reference.encode(gpu, &input, encoder, &t.reference);
         }
-        let counting = gpu.fragments.as_ref().zip(self.kernels.fragments.as_ref());
-        if let Some((queries, _)) = counting {
+        if let Some(queries) = &gpu.fragments {
             queries.start();
         }
         method.encode(
@@ -597,8 +587,9 @@ impl QualityStage {
             encoder,
             &t.method,
         );
-        let fragment_queries =
-            counting.and_then(|(queries, rows)| queries.resolve(encoder, rows, f));
+        if let Some(queries) = &gpu.fragments {
+            queries.resolve(encoder, fragments, f);
+        }
         if from_method && read_back {
             t.method.copy_color_to(encoder, &t.reference);
         }
@@ -609,7 +600,7 @@ impl QualityStage {
                 if from_method { &t.method } else { &t.reference },
             );
         }
-        (from_cache || from_method, fragment_queries)
+        from_cache || from_method
     }
 
     /// Stage 2 (`--shadows on`): the frame's shadow maps: the reference's LOD0, the method's casters, and, for
@@ -1013,8 +1004,8 @@ impl QualityStage {
             }
             None => None,
         };
-        let fragments = match &k.fragments {
-            Some(rows) => read_fragments(ctx, rows, &walk.fragment_queries)?,
+        let fragments = match &base.gpu.fragments {
+            Some(_) => walk.fragments.read(ctx)?,
             None => Vec::new(),
         };
         Ok(QualityPass {
@@ -1038,26 +1029,6 @@ impl QualityStage {
             segments: walk.segments,
         })
     }
-}
-
-/// Each frame's fragments from the resolved rows (`queries`: each frame's query count).
-fn read_fragments(
-    ctx: &GpuContext,
-    rows: &wgpu::Buffer,
-    queries: &[Option<u32>],
-) -> Result<Vec<Option<u64>>> {
-    let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("fragment counts read-back"),
-        size: rows.size(),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    encoder.copy_buffer_to_buffer(rows, 0, &readback, 0, None);
-    ctx.queue.submit([encoder.finish()]);
-    ctx.read_buffer(&readback, |bytes| {
-        crate::gpu::fragments::frame_sums(bytes, queries)
-    })
 }
 
 #[cfg(test)]

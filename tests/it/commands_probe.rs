@@ -329,3 +329,40 @@ fn the_clock_warmup_runs_before_each_segment_where_asked() {
         &["--clock-warmup on", "--ceilings off"],
     );
 }
+
+/// A frame that begins more passes than one query set holds is counted whole: alpha-2pass begins two passes per
+/// instance in transition, 41 on this static grid of 150 bunnies (20 in transition on every frame) against 32
+/// queries a set. Every frame is counted, the same on every frame (nothing moves), and more than discrete's.
+#[test]
+fn a_frame_of_many_passes_is_counted_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("grid");
+    #[rustfmt::skip]
+    let r = lodbench(&[
+        "run", "--scene", "bunny-grid", "--count", "150", "--method", "discrete,alpha-2pass", "--width", "64",
+        "--height", "48", "--frames", "4", "--warmup", "0", "--rounds", "2", "--out", out.to_str().unwrap(),
+    ], &[]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let mut frames = csv::Reader::from_path(out.join("frames.csv")).unwrap();
+    let header = frames.headers().unwrap().clone();
+    let mut by_method: std::collections::BTreeMap<String, Vec<(u64, u32)>> = Default::default();
+    for row in frames.records() {
+        let row = row.unwrap();
+        let fragments: u64 = row[column(&header, "fragments")]
+            .parse()
+            .unwrap_or_else(|_| panic!("a frame not counted: {row:?}"));
+        let moving: u32 = row[column(&header, "t_instances")].parse().unwrap();
+        by_method
+            .entry(row[column(&header, "method")].to_string())
+            .or_default()
+            .push((fragments, moving));
+    }
+    let (d, a) = (&by_method["discrete"], &by_method["alpha-2pass"]);
+    assert!(
+        a.iter()
+            .all(|&(_, t)| 2 * t + 1 > lodbench::gpu::fragments::SET_QUERIES),
+        "{a:?}"
+    );
+    assert!(a.iter().all(|x| x == &a[0]) && d.iter().all(|x| x == &d[0]));
+    assert!(a[0].0 > d[0].0, "{a:?} {d:?}");
+}
