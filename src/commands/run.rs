@@ -227,10 +227,13 @@ fn run_blocks(
     }
     let ceiling = run_triangle_ceiling(manifest);
     manifest.triangle_ceiling = ceiling;
-    let fragment_ceiling = manifest
-        .ceilings
-        .as_deref()
-        .and_then(crate::measure::probe_rounds::fragment_ceiling);
+    let fill: Vec<_> = [&manifest.ceilings, &manifest.fill_ceilings]
+        .into_iter()
+        .flatten()
+        .flatten()
+        .cloned()
+        .collect();
+    let fragment_ceiling = crate::measure::probe_rounds::fragment_ceiling(&fill);
     manifest.fragment_ceiling = fragment_ceiling;
     manifest.write(out_dir)?;
     job.progress.finish_and_clear();
@@ -268,6 +271,7 @@ fn open_adapter(
         let rows = crate::measure::probe_rounds::ceilings(&ctx, c, cfg.seed)?;
         c.note_ceilings(&rows);
         manifest.ceilings = Some(rows);
+        manifest.fill_ceilings = Some(crate::measure::probe_rounds::fill_ceilings(&ctx, cfg.seed)?);
     }
     let warm_on = clock.is_some()
         && match cfg.clock_warmup {

@@ -77,6 +77,22 @@ pub fn ceilings(ctx: &GpuContext, clock: &ClockCheck, seed: u64) -> Result<Vec<P
     measure_variants(ctx, &clock.probes, 3, seed, &[Variant::Base])
 }
 
+/// The two fill probes at `lodbench probe`'s default size and work (512 x 512, scale 1), base variants, 3 rounds:
+/// what a run's fragment ceiling is read from besides [`ceilings`]. The short probes' quads, a tenth of the work
+/// on 256 x 256, are too little work to fill the adapter: on lavapipe opaque fill read 0.65 G fragments a second
+/// on them against 3.3 G at this size in the same run (docs/measurement.md, run.json). Tens of milliseconds on
+/// lavapipe.
+pub fn fill_ceilings(ctx: &GpuContext, seed: u64) -> Result<Vec<ProbeRecord>> {
+    let probes = Probes::new(ctx, (512, 512), Amounts::at(1.0))?;
+    measure_probes(
+        ctx,
+        (&probes, &[Probe::FillOpaque, Probe::FillBlended]),
+        3,
+        seed,
+        &[Variant::Base],
+    )
+}
+
 /// The probes a run reads the adapter with: its ceilings before the blocks ([`ceilings`]) and its speed around
 /// each block, the triangle probe's base variant 3 times, at a tenth of the default work on a 256 x 256 target (a
 /// few milliseconds on lavapipe, well under one on a GPU).
@@ -224,8 +240,8 @@ pub fn run_triangle_ceiling(
         .reduce(f64::max)
 }
 
-/// The fragment ceiling of a run's ceilings: the faster of the two fill probes (full-screen quads, opaque and
-/// blended), in fragments a second. Their quads cover whole tiles and quads, so the fragment shader invocations
+/// The fragment ceiling of a run's ceilings (`rows`: [`ceilings`]' and [`fill_ceilings`]'): the fastest of the fill
+/// probes (full-screen quads, opaque and blended), in fragments a second. Their quads cover whole tiles and quads, so the fragment shader invocations
 /// an adapter counts for them are the fragments they name; a method's count (`fragments`) includes what the
 /// adapter shades around a triangle's edges besides, which is work of the same kind. The depth probe has no
 /// fragment shader and is not a fill rate of shaded fragments.
@@ -251,13 +267,24 @@ fn measure_variants(
     seed: u64,
     variants: &[Variant],
 ) -> Result<Vec<ProbeRecord>> {
-    let items: Vec<(Probe, Variant)> = PROBES
+    measure_probes(ctx, (probes, &PROBES), rounds, seed, variants)
+}
+
+/// The probes `which` of `probes`, each variant of `variants`, timed over `rounds` rounds.
+fn measure_probes(
+    ctx: &GpuContext,
+    (probes, which): (&Probes, &[Probe]),
+    rounds: u32,
+    seed: u64,
+    variants: &[Variant],
+) -> Result<Vec<ProbeRecord>> {
+    let items: Vec<(Probe, Variant)> = which
         .iter()
         .flat_map(|&p| variants.iter().map(move |&v| (p, v)))
         .collect();
     let rounds = rounds.max(2);
     let times = time_items(ctx, probes, &items, rounds, seed)?;
-    Ok(PROBES
+    Ok(which
         .iter()
         .map(|&p| probe_record(probes, p, &items, &times, rounds))
         .collect())

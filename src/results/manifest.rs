@@ -57,8 +57,11 @@ pub struct RunManifest {
     /// run read, at its start (`ceilings`) or around any block (`triangle_rate_before` / `_after`)
     /// (`measure::probe_rounds::run_triangle_ceiling`); null with `--ceilings off`.
     pub triangle_ceiling: Option<f64>,
-    /// The fragment ceiling summary.csv's `fragment_ceiling_share` divides by: the faster of the start's two
-    /// fill probes (`measure::probe_rounds::fragment_ceiling`); null with `--ceilings off`.
+    /// The two fill probes at `lodbench probe`'s default size and work, measured before the blocks
+    /// (`measure::probe_rounds::fill_ceilings`; null with `--ceilings off`).
+    pub fill_ceilings: Option<Vec<crate::measure::probe_rounds::ProbeRecord>>,
+    /// The fragment ceiling summary.csv's `fragment_ceiling_share` divides by: the fastest fill probe of
+    /// `ceilings` and `fill_ceilings` (`measure::probe_rounds::fragment_ceiling`); null with `--ceilings off`.
     pub fragment_ceiling: Option<f64>,
     /// Whether the GPU's clock was warmed before each timed segment (`--clock-warmup`, resolved: `auto` is off
     /// on a CPU adapter and with `--ceilings off`); null before the adapter was opened.
@@ -119,6 +122,7 @@ impl RunManifest {
             peak_resident_bytes: None,
             ceilings: None,
             triangle_ceiling: None,
+            fill_ceilings: None,
             fragment_ceiling: None,
             clock_warmup: None,
         }

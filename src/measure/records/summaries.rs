@@ -83,8 +83,8 @@ pub struct SummaryRecord {
     pub fragments_mean: Option<f64>,
     /// `fragments_mean` over the median frame time (the block's clock), a second.
     pub fragments_per_s: Option<f64>,
-    /// `fragments_per_s` over the run's fragment ceiling (run.json's `fragment_ceiling`: the faster of the
-    /// start's two fill probes, whose full-screen quads shade every fragment they count).
+    /// `fragments_per_s` over the run's fragment ceiling (run.json's `fragment_ceiling`: the fastest of the fill
+    /// probes read at the run's start, whose full-screen quads shade every fragment they count).
     pub fragment_ceiling_share: Option<f64>,
     /// What the block draws near the adapter's rate of: `triangles` and/or `fragments`, where that share is
     /// 0.8 or more (joined by `+`).
