@@ -61,7 +61,7 @@ PLOT="python3 scripts/plot.py"
 # up (results/cpu/README.md: the folders that quote times were made with nothing else running), to plan a run.
 folders=(
 "probe-lavapipe|1||\$LB probe --rounds 20 --out \$D"
-"ceilings-ci|15||\$LB run --scene simple,windmills,trees,bunny-sweep,bunny-grid,terrain --profile ci --frames 120 --out \$D"
+"ceilings-ci|14||\$LB run --scene simple,windmills,trees,bunny-sweep,bunny-grid,terrain --profile ci --frames 120 --out \$D"
 "overhead-ci|29||\$LB overhead --scene bunny-grid --count 50,500,2000 --profile ci --frames 120 --rounds 20 --out \$D/bunny-grid && \$LB overhead --scene trees --profile ci --count 6,100 --rounds 20 --out \$D/trees"
 "fsi-fig8-cpu|2||\$LB experiment $E/fsi-fig8-cpu.toml --out \$D && $PLOT \$D"
 "fsi-check-cpu|1||\$LB experiment $E/fsi-check-cpu.toml --out \$D && $PLOT \$D"
