@@ -227,19 +227,11 @@ fn run_blocks(
     }
     let ceiling = run_triangle_ceiling(manifest);
     manifest.triangle_ceiling = ceiling;
-    let fill: Vec<_> = [&manifest.ceilings, &manifest.fill_ceilings]
-        .into_iter()
-        .flatten()
-        .flatten()
-        .cloned()
-        .collect();
-    let fragment_ceiling = crate::measure::probe_rounds::fragment_ceiling(&fill);
-    manifest.fragment_ceiling = fragment_ceiling;
     manifest.write(out_dir)?;
     job.progress.finish_and_clear();
     output.frames_csv.finish()?;
     for s in &mut output.summaries {
-        s.set_ceiling(ceiling, fragment_ceiling);
+        s.set_ceiling(ceiling, manifest.fragment_ceiling);
     }
     write_summary(out_dir, &output.summaries)?;
     write_transitions(out_dir, &output.transitions)?;
@@ -270,8 +262,11 @@ fn open_adapter(
     if let Some(c) = &clock {
         let rows = crate::measure::probe_rounds::ceilings(&ctx, c, cfg.seed)?;
         c.note_ceilings(&rows);
+        let fill = crate::measure::probe_rounds::fill_ceilings(&ctx, cfg.seed)?;
+        manifest.fragment_ceiling =
+            crate::measure::probe_rounds::fragment_ceiling(rows.iter().chain(&fill));
         manifest.ceilings = Some(rows);
-        manifest.fill_ceilings = Some(crate::measure::probe_rounds::fill_ceilings(&ctx, cfg.seed)?);
+        manifest.fill_ceilings = Some(fill);
     }
     let warm_on = clock.is_some()
         && match cfg.clock_warmup {

@@ -241,21 +241,26 @@ pub fn run_triangle_ceiling(
 }
 
 /// The fragment ceiling of a run's ceilings (`rows`: [`ceilings`]' and [`fill_ceilings`]'): the fastest of the fill
-/// probes (full-screen quads, opaque and blended), in fragments a second. Their quads cover whole tiles and quads, so the fragment shader invocations
-/// an adapter counts for them are the fragments they name; a method's count (`fragments`) includes what the
-/// adapter shades around a triangle's edges besides, which is work of the same kind. The depth probe has no
-/// fragment shader and is not a fill rate of shaded fragments.
-pub fn fragment_ceiling(rows: &[ProbeRecord]) -> Option<f64> {
-    rows.iter()
-        .filter(|r| r.probe.starts_with("fill-") && r.rate_median.is_finite())
-        .map(|r| r.rate_median)
-        .reduce(f64::max)
+/// probes (full-screen quads, opaque and blended), in fragments a second. Their quads cover whole tiles and quads,
+/// so the fragment shader invocations an adapter counts for them are the fragments they name; a method's count
+/// (`fragments`) includes what the adapter shades around a triangle's edges besides, which is work of the same
+/// kind. The depth probe has no fragment shader and is not a fill rate of shaded fragments.
+pub fn fragment_ceiling<'r>(rows: impl IntoIterator<Item = &'r ProbeRecord>) -> Option<f64> {
+    fastest(rows, |r| r.probe.starts_with("fill-"))
 }
 
 /// The triangle ceiling of a run's ceilings: the larger of the two triangle probes' rates.
 pub fn triangle_ceiling(rows: &[ProbeRecord]) -> Option<f64> {
-    rows.iter()
-        .filter(|r| r.unit == "triangles" && r.rate_median.is_finite())
+    fastest(rows, |r| r.unit == "triangles")
+}
+
+/// The highest finite rate of the rows `keep` keeps.
+fn fastest<'r>(
+    rows: impl IntoIterator<Item = &'r ProbeRecord>,
+    keep: impl Fn(&ProbeRecord) -> bool,
+) -> Option<f64> {
+    rows.into_iter()
+        .filter(|r| keep(r) && r.rate_median.is_finite())
         .map(|r| r.rate_median)
         .reduce(f64::max)
 }

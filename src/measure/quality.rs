@@ -168,8 +168,8 @@ pub struct QualityPass {
     /// The method's own stage per frame (FSI's combination pass), when it has one: timed in the quality pass,
     /// so that its timestamps are never inside a timing-pass frame.
     pub stage_ms: Option<Vec<Option<f64>>>,
-    /// The fragment shader invocations of the method's frame, per frame (empty where the device has no
-    /// pipeline statistics queries).
+    /// The fragment shader invocations of the method's frame, per frame (None on every frame where the device
+    /// has no pipeline statistics queries).
     pub fragments: Vec<Option<u64>>,
     pub ms_per_frame: f64,
     pub metric_gpu_ms_median: Option<f64>,
@@ -329,8 +329,8 @@ pub struct Walk {
     reference_copied: u32,
     /// The metric timer's slots written in this pass.
     metric_timed: Vec<u32>,
-    /// The method frames' fragment counts, resolved ([`crate::gpu::fragments`]; empty where the device has no
-    /// pipeline statistics queries).
+    /// The method frames' fragment counts, resolved ([`crate::gpu::fragments`]; no frame counted where the
+    /// device has no pipeline statistics queries).
     fragments: FragmentRows,
     /// The pass's segments so far.
     segments: Vec<SegmentCost>,
@@ -1004,12 +1004,8 @@ impl QualityStage {
             }
             None => None,
         };
-        let fragments = match &base.gpu.fragments {
-            Some(_) => walk.fragments.read(ctx)?,
-            None => Vec::new(),
-        };
         Ok(QualityPass {
-            fragments,
+            fragments: walk.fragments.read(ctx)?,
             metrics: k.metric.read(ctx, frames)?,
             flip: walk.flip,
             lodpop: k.lodpop.read_parts(ctx, frames)?,

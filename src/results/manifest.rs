@@ -61,7 +61,8 @@ pub struct RunManifest {
     /// (`measure::probe_rounds::fill_ceilings`; null with `--ceilings off`).
     pub fill_ceilings: Option<Vec<crate::measure::probe_rounds::ProbeRecord>>,
     /// The fragment ceiling summary.csv's `fragment_ceiling_share` divides by: the fastest fill probe of
-    /// `ceilings` and `fill_ceilings` (`measure::probe_rounds::fragment_ceiling`); null with `--ceilings off`.
+    /// `ceilings` and `fill_ceilings`, read with them (`measure::probe_rounds::fragment_ceiling`); null with
+    /// `--ceilings off`.
     pub fragment_ceiling: Option<f64>,
     /// Whether the GPU's clock was warmed before each timed segment (`--clock-warmup`, resolved: `auto` is off
     /// on a CPU adapter and with `--ceilings off`); null before the adapter was opened.
