@@ -143,9 +143,12 @@ def figure(scene_curves, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    import method_colours
+
     scenes = list(scene_curves)
     fig, axes = plt.subplots(len(scenes), 4, figsize=(18, 4 * len(scenes)), squeeze=False)
     for row, scene in zip(axes, scenes):
+        colours = method_colours.series_colours(scene_curves[scene])  # as in plot.py's figures
         for m, pts in scene_curves[scene].items():
             x = [p["rmse"] for p in pts]
             for ax, name, label in zip(
@@ -154,7 +157,7 @@ def figure(scene_curves, path):
                 ("triangles (mean)", "cost, GPU clock (x reference, paired)", "cost, CPU clock (x reference, paired)",
                  "largest lodpop"),
             ):
-                ax.plot(x, [p[name] for p in pts], marker="o", label=m)
+                ax.plot(x, [p[name] for p in pts], marker="o", label=m, color=colours[m])
                 ax.set_xlabel("mean rmse against the reference")
                 ax.set_ylabel(label)
                 ax.set_title(f"{scene}: {label}")

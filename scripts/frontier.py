@@ -20,6 +20,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 from matplotlib.lines import Line2D
 
+import method_colours
 from lodbench_results import PERCEPTUAL_CSV, num, read_csv, run_folder_of
 
 LEVELS = (1.0, 0.5, 0.25, 0.125)
@@ -77,24 +78,24 @@ def figure(scene, pts, curve, path):
         panels.append(("jod", "lowest JOD of popping (10: invisible)"))
     panels.append(("rmse", "mean rmse against the reference"))
     fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.4))
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     series = list(OrderedDict.fromkeys(p["series"] for p in pts))
-    for i, s in enumerate(series):
+    colours = method_colours.series_colours(series)
+    for s in series:
         line = sorted((p for p in pts if p["series"] == s), key=lambda p: setting_key(p["setting"]))
         for ax, (col, _) in zip(axes, panels):
             xs = [p["cost"] for p in line]
             ys = [p[col] for p in line]
-            ax.plot(xs, ys, marker="o", color=colours[i % len(colours)], alpha=0.85)
+            ax.plot(xs, ys, marker="o", color=colours[s], alpha=0.85)
             for p in line:
                 if p["cost"] == p["cost"] and p[col] == p[col]:
                     ax.annotate(p["setting"], (p["cost"], p[col]), fontsize=6, xytext=(3, 3),
-                                textcoords="offset points", color=colours[i % len(colours)])
+                                textcoords="offset points", color=colours[s])
     baseline = next((p["baseline"] for p in pts if p["baseline"]), "the baseline")
     for ax, (_, label) in zip(axes, panels):
         ax.set_xlabel(f"cost: time over {baseline}'s, transition frames")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
-    handles = [Line2D([], [], color=colours[i % len(colours)], marker="o", label=s) for i, s in enumerate(series)]
+    handles = [Line2D([], [], color=colours[s], marker="o", label=s) for s in series]
     fig.legend(handles=handles, loc="center right", fontsize=7, frameon=False)
     fig.suptitle(f"{scene}: cost against popping across {curve or 'the run'} (points labelled with {curve})")
     fig.tight_layout(rect=(0, 0, 0.84, 1))

@@ -43,6 +43,8 @@ fig8 and a lone `pixel-error` sweep the unified figure, and their first value in
 `method (variable value, ...)`. A merged folder (`lodbench merge`) has an `adapter` column after it:
 with more than one adapter (`merge --allow-adapters`) each (method, adapter) pair is its own series, labelled
 `method [adapter]`, so no curve mixes two GPUs.
+Every figure draws a method in its one colour (scripts/method_colours.py), the same in all of them, and a method's
+further series (a repeat `NAME#2`, another adapter, other swept values) in shades of it.
 """
 import argparse
 import sys
@@ -55,10 +57,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
 from PIL import Image  # noqa: E402
 
 import answer  # noqa: E402  (scripts/answer.py, beside this file)
 import frontier  # noqa: E402  (scripts/frontier.py, beside this file)
+import method_colours  # noqa: E402  (scripts/method_colours.py, beside this file)
 import report_html  # noqa: E402  (scripts/report_html.py, beside this file)
 from lodbench_results import (  # noqa: E402  (scripts/lodbench_results.py, beside this file)
     FRAMES_CSV,
@@ -73,9 +77,10 @@ from lodbench_results import (  # noqa: E402  (scripts/lodbench_results.py, besi
     run_folder_of,
 )
 
-# Eleven methods and more: matplotlib's ten default colours would give two methods one colour.
-plt.rcParams["axes.prop_cycle"] = matplotlib.cycler(
-    color=list(plt.get_cmap("tab10").colors) + ["black", "gold", "navy", "lime"])
+# Every figure colours a method by method_colours.series_colours (one colour per method across the figures);
+# what is not a method (a budget line, a metric) is grey or told apart by hatching, never a method's colour.
+# Fig. 6's and the ceilings' bars per measure: plain, then hatched.
+HATCHES = ("", "///", "...")
 
 
 def num(v):
@@ -111,12 +116,14 @@ def sweep_figure(scene, by_method, path):
     for f in switch_frames(first):
         for ax in axes:
             ax.axvline(f, color="0.85", lw=0.8, zorder=0)
+    colours = method_colours.series_colours(by_method)
     for method, rows in by_method.items():
         frames = [int(r["frame"]) for r in rows]
-        axes[0].plot(frames, [num(r["rmse"]) for r in rows], lw=0.9, label=method)
-        axes[1].plot(frames, [num(r["pop"]) for r in rows], lw=0.9, label=method)
+        c = colours[method]
+        axes[0].plot(frames, [num(r["rmse"]) for r in rows], lw=0.9, label=method, color=c)
+        axes[1].plot(frames, [num(r["pop"]) for r in rows], lw=0.9, label=method, color=c)
         if has_lodpop:
-            axes[2].plot(frames, [num(r["lodpop"]) for r in rows], lw=0.9, label=method)
+            axes[2].plot(frames, [num(r["lodpop"]) for r in rows], lw=0.9, label=method, color=c)
     axes[0].set_ylabel("rmse (Sheliemietiev et al. 2023 sec. 6)")
     axes[1].set_ylabel("pop (motion included)")
     if has_lodpop:
@@ -125,7 +132,7 @@ def sweep_figure(scene, by_method, path):
         for method in lagged:
             rows = by_method[method]
             axes[-1].plot([int(r["frame"]) for r in rows], [num(r["lag_rmse"]) for r in rows], lw=0.9,
-                          label=method)
+                          label=method, color=colours[method])
         axes[-1].set_ylabel("lag_rmse (fsi*)")
         axes[-1].legend(fontsize=8)
     axes[-1].set_xlabel("frame (grey: discrete LOD switches)")
@@ -141,11 +148,15 @@ def fig6(scene, summary, path):
     bars = [("rmse_mean", "mean rmse"), ("pop_max", "max pop"), ("lodpop_max", "max lodpop")]
     bars = [(c, label) for c, label in bars if c in summary[0]]
     w = 0.8 / len(bars)
-    for i, (c, label) in enumerate(bars):
-        ax.bar(x - 0.4 + (i + 0.5) * w, [num(r[c]) for r in summary], w, label=label)
+    colours = method_colours.series_colours(methods)
+    for i, (c, _) in enumerate(bars):
+        # The method's colour (as in every figure), the measure by its hatching.
+        ax.bar(x - 0.4 + (i + 0.5) * w, [num(r[c]) for r in summary], w, color=[colours[m] for m in methods],
+               hatch=HATCHES[i], edgecolor="white", linewidth=0)
     ax.set_xticks(x, methods, rotation=20)
     ax.set_title(f"{scene}: popping per method (cf. Sheliemietiev et al. 2023 Fig. 6)")
-    ax.legend()
+    ax.legend(handles=[Patch(facecolor="0.6", edgecolor="white", hatch=HATCHES[i], label=label)
+                       for i, (_, label) in enumerate(bars)])
     save(fig, path)
 
 
@@ -218,10 +229,11 @@ def transitions_figure(scene, per_transition, path):
         [(f"max pop within {TRANSITION_WINDOW} frames", None)]
     fig, axes = plt.subplots(len(panels), 1, figsize=(max(8, 1.3 * len(per_transition) + 3), 3.6 * len(panels)),
                              squeeze=False)
+    colours = method_colours.series_colours(methods)
     for ax, (label, k) in zip(axes[:, 0], panels):
         for i, m in enumerate(methods):
             at = x - 0.4 + (i + 0.5) * width
-            colour = f"C{i % 10}"
+            colour = colours[m]
             if k == 0:
                 figures = [p[-1].get(m, missing) for p in per_transition]
                 parts = [stacked_parts(f[0], f[2], f[3]) for f in figures]
@@ -244,12 +256,14 @@ def transitions_figure(scene, per_transition, path):
 
 def fig5(scene, summary, path):
     fig, ax = plt.subplots(figsize=(8, 5))
-    for method, rows in group(summary, "method").items():
+    by_method = group(summary, "method")
+    colours = method_colours.series_colours(m for (m,) in by_method)
+    for (method,), rows in by_method.items():
         rows = sorted(rows, key=lambda r: int(r["count"]))
         n = [int(r["count"]) for r in rows]
         med = np.array([num(r["gpu_ms_median"]) for r in rows])
         # No error bars on absolute times: compare methods by summary.csv's ratio_to_baseline and its interval.
-        ax.plot(n, med, marker="o", label=method[0])
+        ax.plot(n, med, marker="o", label=method, color=colours[method])
     ax.set_xlabel("models")
     ax.set_ylabel("median GPU frame time, ms")
     ax.set_title(f"{scene}: frame time against model count (cf. Sheliemietiev et al. 2023 Fig. 5)")
@@ -259,11 +273,13 @@ def fig5(scene, summary, path):
 
 def fig8(scene, summary, path):
     fig, ax = plt.subplots(figsize=(8, 5))
-    for (method,), rows in group(summary, "method").items():
+    by_method = group(summary, "method")
+    colours = method_colours.series_colours(m for (m,) in by_method)
+    for (method,), rows in by_method.items():
         px = [int(r["viewport"].split(",")[0]) * int(r["viewport"].split(",")[1]) for r in rows]
         order = np.argsort(px)
         ax.plot(np.array(px)[order], np.array([num(r["gpu_ms_median"]) for r in rows])[order], marker="o",
-                label=method)
+                label=method, color=colours[method])
     ax.set_xscale("log")
     ax.set_xlabel("viewport pixels")
     ax.set_ylabel("median GPU frame time, ms")
@@ -275,11 +291,13 @@ def fig8(scene, summary, path):
 def unified(scene, summary, path):
     """Triangles, popping and cracks against the pixel error each method was run at (a `pixel-error` sweep)."""
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
-    for (method,), rows in group(summary, "method").items():
+    by_method = group(summary, "method")
+    colours = method_colours.series_colours(m for (m,) in by_method)
+    for (method,), rows in by_method.items():
         rows = sorted(rows, key=lambda r: float(r["pixel-error"]))
         px = [float(r["pixel-error"]) for r in rows]
         for ax, col in zip(axes, ("triangles_mean", "lodpop_max", "crack_px_mean")):
-            ax.plot(px, [num(r.get(col)) for r in rows], marker="o", label=method)
+            ax.plot(px, [num(r.get(col)) for r in rows], marker="o", label=method, color=colours[method])
     for ax, what in zip(axes, ("mean triangles drawn", "largest lodpop (pose held)", "mean crack pixels")):
         ax.set_xscale("log")
         ax.set_xlabel("--pixel-error (pixels)")
@@ -300,20 +318,18 @@ def cost(scene, summary, path):
     methods = list(OrderedDict.fromkeys(r["method"] for r in summary))
     counts = list(OrderedDict.fromkeys(r["count"] for r in summary))
     markers = "osD^v<>px*"
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colours = method_colours.series_colours(methods)
     for r in summary:
         g = num(r["gpu_ms_median"])
-        mi, ci = methods.index(r["method"]), counts.index(r["count"])
+        ci = counts.index(r["count"])
         for ax, col in zip(axes, ("rmse_mean", "pop_max")):
-            ax.scatter(g, num(r[col]), color=colours[mi % len(colours)], marker=markers[ci % len(markers)],
-                       alpha=0.85)
+            ax.scatter(g, num(r[col]), color=colours[r["method"]], marker=markers[ci % len(markers)], alpha=0.85)
     for ax, col in zip(axes, ("mean rmse", "max pop")):
         ax.set_xlabel("median GPU frame time, ms")
         ax.set_ylabel(col)
         ax.grid(alpha=0.3)
     # Two legends: colour = method, marker = count.
-    handles = [Line2D([], [], color=colours[i % len(colours)], marker="o", linestyle="", label=m)
-               for i, m in enumerate(methods)]
+    handles = [Line2D([], [], color=colours[m], marker="o", linestyle="", label=m) for m in methods]
     if len(counts) > 1:
         handles += [Line2D([], [], color="grey", marker=markers[i % len(markers)], linestyle="", label=f"n={c}")
                     for i, c in enumerate(counts)]
@@ -335,16 +351,21 @@ def ceilings_figure(scene, summary, path):
     x = np.arange(len(rows))
     fig, ax = plt.subplots(figsize=(max(6, 0.5 * len(rows) + 2), 3.6))
     shift = -width / 2 if fragments else 0.0
-    ax.bar(x + shift, [num(r.get("triangle_ceiling_share", "")) for r in rows], width, color="tab:blue",
-           label="triangles")
+    # The method's colour (as in every figure), fragments hatched; the legend's swatches grey.
+    colours = method_colours.series_colours(r["method"] for r in rows)
+    colour = [colours[r["method"]] for r in rows]
+    ax.bar(x + shift, [num(r.get("triangle_ceiling_share", "")) for r in rows], width, color=colour,
+           hatch=HATCHES[0], edgecolor="white", linewidth=0)
+    legend = [Patch(facecolor="0.6", edgecolor="white", hatch=HATCHES[0], label="triangles")]
     if fragments:
-        ax.bar(x + width / 2, [num(r.get("fragment_ceiling_share", "")) for r in rows], width, color="tab:green",
-               label="fragments")
-    ax.axhline(0.8, color="tab:orange", ls="--", lw=1, label="0.8: bound")
+        ax.bar(x + width / 2, [num(r.get("fragment_ceiling_share", "")) for r in rows], width, color=colour,
+               hatch=HATCHES[1], edgecolor="white", linewidth=0)
+        legend.append(Patch(facecolor="0.6", edgecolor="white", hatch=HATCHES[1], label="fragments"))
+    legend.append(ax.axhline(0.8, color="0.3", ls="--", lw=1, label="0.8: bound"))
     ax.set_xticks(x, labels, rotation=30, ha="right", fontsize=8)
     ax.set_ylabel("rate / the adapter's ceiling")
     ax.set_title(f"{scene}: rates against the adapter's ceilings")
-    ax.legend(fontsize=7)
+    ax.legend(handles=legend, fontsize=7)
     save(fig, path)
 
 
@@ -744,20 +765,21 @@ def budget_of(folder: Path, variables, values):
 
 def decision_figure(scene, rows, budget, path):
     """Each method's cost (time over the baseline's, all frames, with its 95 % interval) against its largest
-    lodpop, the budget of the answer drawn across: the answer's two sentences at a glance."""
+    lodpop, the budget of the answer drawn across: the answer's two sentences at a glance. The methods are named in
+    the legend only: labels at the points pile up where methods cost and pop alike."""
     fig, ax = plt.subplots(figsize=(9, 4.4))
     hard = answer.hard_switch(rows, next((r["baseline"] for r in rows if r.get("baseline")), None))
     level = budget if budget is not None else (num(hard["lodpop_max"]) / 2 if hard else None)
-    for i, r in enumerate(rows):
+    colours = method_colours.series_colours(r["method"] for r in rows)
+    for r in rows:
         x, lo, hi, y = (num(r.get(c)) for c in ("ratio_to_baseline", "ratio_to_baseline_ci95_lo",
                                                   "ratio_to_baseline_ci95_hi", "lodpop_max"))
         if x != x or y != y:
             continue
         err = [[x - lo], [hi - x]] if lo == lo and hi == hi else None
-        ax.errorbar([x], [y], xerr=err, fmt="o", color=f"C{i % 10}", capsize=3, label=r["method"])
-        ax.annotate(r["method"], (x, y), fontsize=7, xytext=(4, 4), textcoords="offset points")
+        ax.errorbar([x], [y], xerr=err, fmt="o", color=colours[r["method"]], capsize=3, label=r["method"])
     if level is not None:
-        ax.axhline(level, color="tab:orange", lw=1.2, ls="--",
+        ax.axhline(level, color="0.3", lw=1.2, ls="--",
                    label=f"budget {answer.sig3(level)}" + (" (--budget-lodpop)" if budget is not None else
                                                             f" (half of {hard['method']}'s)"))
     baseline = next((r["baseline"] for r in rows if r.get("baseline")), "the baseline")
