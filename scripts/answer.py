@@ -7,6 +7,7 @@ The rule and the words are those of the summary `lodbench run` prints (src/resul
 do:
   - candidates: every method but the references (`reference`, `reference-flat`, ...), with a largest lodpop;
   - the hard switch: `discrete` where it ran, else the baseline;
+  - no method is named where a transition spans fewer than 2 frames (transition_frames_min): one sentence says so;
   - the budget: the run's --budget-lodpop (run.json), else half the hard switch's largest lodpop;
   - costs: the all-frames paired ratios (summary.csv's ratio_to_baseline, pairs.csv's ratio); a cost is called
     different only where its 95 % interval excludes 1.
@@ -20,6 +21,9 @@ import math
 import re
 
 from lodbench_results import PAIRS_CSV, RUN_JSON, SUMMARY_CSV, num
+
+# The fewest frames a transition must span for a blending method to act (src/results/answer.rs).
+MIN_TRANSITION_FRAMES = 2
 
 # summary.csv's columns that name a row besides the swept variables (and a merged folder's adapter).
 KEY = ("scene", "method", "count")
@@ -170,6 +174,13 @@ def sentences(name, rows, pairs, budget, variables):
         return [[f"{name}: no popping measured (--quality off, or no method with LOD transitions ran)."]]
 
     hard = hard_switch(cands, baseline)
+    room = next((int(num(r["transition_frames_min"])) for r in rows
+                 if num(r.get("transition_frames_min")) == num(r.get("transition_frames_min"))), None)
+    if room is not None and room < MIN_TRANSITION_FRAMES and \
+            any(hard is None or r["method"] != hard["method"] for r in cands):
+        return [[f"{name}: a transition here lasts {room} frame (the camera crosses a switch's band within it), too "
+                 "few for a blending method to act, so this run cannot say which method pops least; give the "
+                 "transitions room with --fade time --fade-frames 8, or a slower path."]]
     # Least lodpop as the sentence shows it (3 figures), the cheaper of a tie.
     least = min(cands, key=lambda r: (float(sig3(num(r["lodpop_max"]))), cost(r), num(r["lodpop_max"])))
     out = []

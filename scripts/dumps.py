@@ -11,6 +11,12 @@ def load_rgb(path: Path) -> np.ndarray:
         return np.asarray(im.convert("RGB"), dtype=np.float64) / 255.0
 
 
+def dump_path(run: Path, scene: str, method: str, count: int, frame: int, kind: str) -> Path:
+    """The dump of `kind` (method, reference, error, ...) of a frame: `frames/{scene}_{method}_c{count}_f{frame:05}_
+    {kind}.png` (src/results/files.rs names it)."""
+    return run / "frames" / f"{scene}_{method}_c{count}_f{frame:05d}_{kind}.png"
+
+
 def parse_stem(name: str):
     """`{scene}_{method}_c{count}_f{frame:05}_method.png` -> (scene, method, count, frame) as frames.csv writes
     them (strings, the frame without leading zeros); None for another name."""

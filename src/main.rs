@@ -1,6 +1,5 @@
 //! The `lodbench` binary: parse flags, dispatch to `lodbench::commands`, print one line on error.
 
-use clap::Parser;
 use lodbench::cli::{Cli, Command};
 use lodbench::commands::{
     clips, compare, describe, experiment, export, list, merge, overhead, perceptual, probe, run,
@@ -10,7 +9,8 @@ use lodbench::Error;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // Cli::parse, and the flags a subcommand hides refused (tune's, `Cli::try_parse_checked_from`).
+    let cli = Cli::parse_checked();
     quiet_wayland_probe();
     let result = match cli.command {
         Command::Run(args) => run::execute(&args),

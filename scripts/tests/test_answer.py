@@ -172,3 +172,19 @@ def test_a_lone_method_is_not_said_to_pop_least():
         "baseline (discrete)."]
     (_, _, _, said), = answer.answers(rows, [], 0.005)
     assert len(said) == 2
+
+
+def test_a_transition_of_one_frame_names_no_method():
+    """The case of answer.rs's a_transition_of_one_frame_names_no_method, word for word."""
+    def rows(frames):
+        return [dict(row(m, 0.004, 1.0, 1.0, 1.0), transition_frames_min=str(frames))
+                for m in ("discrete", "alpha", "dither")]
+    (_, _, _, said), = answer.answers(rows(1), [], None)
+    assert [answer.text(s) for s in said] == [
+        "s: a transition here lasts 1 frame (the camera crosses a switch's band within it), too few for a blending "
+        "method to act, so this run cannot say which method pops least; give the transitions room with --fade time "
+        "--fade-frames 8, or a slower path."]
+    (_, _, _, said), = answer.answers(rows(answer.MIN_TRANSITION_FRAMES), [], None)
+    assert "pops least" in answer.text(said[0])
+    (_, _, _, said), = answer.answers(rows(1)[:1], [], None)
+    assert "the only method" in answer.text(said[0])

@@ -63,3 +63,40 @@ def test_paths_look_at_the_centre_in_geometric_steps(tmp_path):
     assert all((float(r["target_x"]), float(r["target_y"]), float(r["target_z"])) == (1.0, 2.0, 3.0) for r in rows)
     # Along the direction given (normalised): x stays, y and z grow 3:4.
     assert abs((float(rows[1]["y"]) - 2.0) / (float(rows[1]["z"]) - 3.0) - 0.75) < 1e-4
+
+
+THREE = SCRIPTS / "threejs" / "node_modules" / "three"
+
+# Loads engines/threejs-lod.js with Node's require beside the pinned three.js, builds every model's THREE.LOD
+# from placeholder levels and prints what three.js holds: its levels' distances and the offset of level 0.
+BUILD_LODS = """
+const THREE = require(process.argv[2]);
+const { lodbenchModels, lodbenchLod } = require(process.argv[3]);
+const out = {};
+for (const name of Object.keys(lodbenchModels)) {
+  const n = lodbenchModels[name].distances.length;
+  const lod = lodbenchLod(THREE, name, Array.from({ length: n }, () => new THREE.Object3D()));
+  out[name] = { isLOD: lod.isLOD === true, revision: THREE.REVISION,
+                distances: lod.levels.map((l) => l.distance), offset: lod.levels[0].object.position.toArray() };
+}
+process.stdout.write(JSON.stringify(out));
+"""
+
+
+@pytest.mark.skipif(not THREE.is_dir(), reason="three.js is installed by .ci/setup-tests (npm ci --prefix "
+                    "scripts/threejs)")
+def test_the_threejs_file_builds_a_lod_with_the_tuned_distances(tuned, tmp_path):
+    check = tmp_path / "build_lods.js"
+    check.write_text(BUILD_LODS)
+    r = subprocess.run(["node", str(check), str(THREE), str(tuned / "engines" / "threejs-lod.js")],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    built = json.loads(r.stdout)
+    pinned = json.loads((SCRIPTS / "threejs" / "package.json").read_text())["dependencies"]["three"]
+    engines = json.loads((tuned / "tune.json").read_text())["engines"]
+    assert sorted(built) == sorted(m["name"] for m in engines)
+    for m in engines:
+        b = built[m["name"]]
+        assert b["isLOD"] and b["revision"] == pinned.split(".")[1], b
+        assert b["distances"] == pytest.approx([0.0] + m["switches"], rel=1e-6)
+        assert b["offset"] == pytest.approx([-c for c in m["center"]], abs=1e-6)

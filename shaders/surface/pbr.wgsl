@@ -38,9 +38,11 @@ struct VertexIn {
 struct MorphIn {
     @location(8) target_position: vec3<f32>,
     @location(9) target_normal: vec3<f32>,
-    // The texture coordinates and tangent at the target on the coarser LOD.
+    // The texture coordinates at the target on the coarser LOD, and its tangent and colour packed
+    // (SurfaceTarget in src/gpu/pipelines.rs): the tangent's xyz as 16-bit snorm in x and y's low half, the
+    // linear RGBA colour as 16-bit unorm in z and w.
     @location(14) target_tex: vec4<f32>,
-    @location(15) target_tangent: vec4<f32>,
+    @location(15) target_packed: vec4<u32>,
 };
 
 struct VsOut {
@@ -102,8 +104,10 @@ fn vertex(v: VertexIn, inst: InstanceIn) -> VsOut {
     return out;
 }
 
-// Geomorphing: position, normal, texture coordinates and tangent move together towards the target.
+// Geomorphing: position, normal, texture coordinates, tangent and colour move together towards the target.
 fn morph_vertex(v: VertexIn, inst: InstanceIn, m: MorphIn) -> VsOut {
+    let target_tangent = vec3<f32>(unpack2x16snorm(m.target_packed.x), unpack2x16snorm(m.target_packed.y).x);
+    let target_color = vec4<f32>(unpack2x16unorm(m.target_packed.z), unpack2x16unorm(m.target_packed.w));
     let t = inst.params.x;
     let n = mix(v.normal, m.target_normal, t);
     var normal = v.normal;
@@ -114,12 +118,12 @@ fn morph_vertex(v: VertexIn, inst: InstanceIn, m: MorphIn) -> VsOut {
     let model = mat4x4<f32>(inst.model_0, inst.model_1, inst.model_2, inst.model_3);
     out.tex = mix(v.tex, m.target_tex, t);
     var tangent = v.tangent.xyz;
-    let tm = mix(v.tangent.xyz, m.target_tangent.xyz, t);
+    let tm = mix(v.tangent.xyz, target_tangent, t);
     if (length(tm) > 1e-6) {
         tangent = normalize(tm);
     }
     out.tangent = vec4<f32>((model * vec4<f32>(tangent, 0.0)).xyz, v.tangent.w);
-    out.vcolor = v.vcolor;
+    out.vcolor = mix(v.vcolor, target_color, t);
     return out;
 }
 

@@ -3,10 +3,17 @@
 //! `RunArgs` and `SceneArgs` are also what an experiment file's `[run]` table deserialises into (kebab-case
 //! keys, the flags' names without dashes); a key it leaves out takes the flag's default
 //! (`crate::defaults::clap_defaults`), so a file and a command line with the same settings are the same run.
+//!
+//! Help texts: `-h` and `--help` print the same summary, one line a flag, grouped under `help_heading`s
+//! (`crate::defaults::heading`). A doc comment on a flag is therefore one paragraph of one line or two, for
+//! users: no source path, no rustdoc link (clap prints it verbatim); the details go to docs/flags.md, and notes
+//! for developers to `//` comments. An enum flag takes `value_parser = names_only::<E>()`, so that its values'
+//! doc comments stay out of the help. The tests below check all three.
 
 pub mod experiment_file;
 pub mod run_config;
 
+use crate::defaults::{heading, names_only};
 use crate::effects::OnOff;
 use crate::geometry::blocks::PartitionMode;
 use crate::measure::metrics::{Metric, MetricReduction, MetricRegion};
@@ -14,7 +21,7 @@ use crate::measure::QualitySchedule;
 use crate::methods::MethodOptions;
 use crate::scene::schedule::FadeMode;
 use crate::scene::{CameraMode, Profile, SweepStart};
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use serde::Deserialize;
 use std::path::PathBuf;
 
@@ -23,11 +30,95 @@ use std::path::PathBuf;
     name = "lodbench",
     version,
     about = "Measures what smooth LOD-transition methods cost and how much they pop",
-    long_about = None
+    long_about = None,
+    mut_subcommands = numbers_may_be_negative,
 )]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+}
+
+/// Every flag that takes a value takes a negative number as its value (`--budget-lodpop -1`, read as -1 and
+/// refused with its range by the command's validation, not as an unknown flag `-1`).
+fn numbers_may_be_negative(cmd: clap::Command) -> clap::Command {
+    cmd.mut_args(|a| {
+        if a.get_action().takes_values() {
+            a.allow_negative_numbers(true)
+        } else {
+            a
+        }
+    })
+}
+
+impl Cli {
+    /// The command line of this process, parsed as [`Cli::try_parse_checked_from`] does; on an error, clap's
+    /// message and exit code 2.
+    pub fn parse_checked() -> Cli {
+        Self::try_parse_checked_from(std::env::args_os()).unwrap_or_else(|e| e.exit())
+    }
+
+    /// `args` parsed, with the flags a subcommand hides refused: `tune` takes `SceneArgs` whole, and the flags
+    /// of it that change nothing for tune are hidden from `tune -h` and refused here, naming the flag
+    /// ([`NOT_FOR_TUNE`]).
+    pub fn try_parse_checked_from<I, T>(args: I) -> Result<Cli, clap::Error>
+    where
+        I: IntoIterator<Item = T>,
+        T: Into<std::ffi::OsString> + Clone,
+    {
+        let mut cmd = Cli::command();
+        let matches = cmd.try_get_matches_from_mut(args)?;
+        if let Some(("tune", m)) = matches.subcommand() {
+            let given = NOT_FOR_TUNE
+                .iter()
+                .find(|id| m.value_source(id) == Some(clap::parser::ValueSource::CommandLine));
+            if let (Some(id), Some(tune)) = (given, cmd.find_subcommand_mut("tune")) {
+                let flag = tune
+                    .get_arguments()
+                    .find(|a| a.get_id() == *id)
+                    .and_then(|a| a.get_long())
+                    .unwrap_or(id)
+                    .to_string();
+                return Err(tune.error(
+                    clap::error::ErrorKind::ArgumentConflict,
+                    format!(
+                        "--{flag} changes nothing for tune, which draws each model alone, at rest, from its own \
+                         views; `lodbench tune -h` lists the flags it reads"
+                    ),
+                ));
+            }
+        }
+        Cli::from_arg_matches(&matches).map_err(|e| e.format(&mut cmd))
+    }
+}
+
+/// The scene flags (`SceneArgs`, by clap id) that change nothing for `tune`: it refuses the unified scenes
+/// (blocks), draws each model's first instance alone and at rest from its own views at its own distances
+/// (instance counts, switches, the fade, the camera), without TAA or shadow maps, and compares images (the
+/// shader work leaves them unchanged). Hidden from `tune -h`, refused by [`Cli::try_parse_checked_from`].
+pub const NOT_FOR_TUNE: &[&str] = &[
+    "partition",
+    "blocks",
+    "count",
+    "switch_distances",
+    "switch_screen_sizes",
+    "fade",
+    "fade_frames",
+    "hysteresis",
+    "max_transitions",
+    "camera",
+    "shader_work",
+    "taa",
+    "taa_alpha",
+    "taa_samples",
+    "taa_clamp",
+    "shadows",
+    "shadow_size",
+    "shadow_lod",
+];
+
+fn hide_if_not_for_tune(a: clap::Arg) -> clap::Arg {
+    let hide = NOT_FOR_TUNE.contains(&a.get_id().as_str());
+    a.hide(hide)
 }
 
 #[derive(Debug, Subcommand)]
@@ -79,28 +170,28 @@ pub struct OverheadArgs {
     #[command(flatten)]
     pub scene_args: SceneArgs,
     /// Untimed frames rendered before the timed ones (default: the profile's).
-    #[arg(long)]
+    #[arg(long, help_heading = heading::MEASUREMENT)]
     pub warmup: Option<u32>,
-    /// Timing rounds: each round times every method and bare draw over the round's frames, in an order shuffled
-    /// from --seed.
-    #[arg(long, default_value_t = 20)]
+    /// Timing rounds: each times every method and the bare draw, in an order shuffled from --seed.
+    #[arg(long, default_value_t = 20, help_heading = heading::MEASUREMENT)]
     pub rounds: u32,
     /// Seed of the rounds' order (recorded in overhead.json).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, help_heading = heading::MEASUREMENT)]
     pub seed: u64,
-    /// Output folder (default results/overhead-<time>/).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
     /// GPU adapter, by index or name substring (`lodbench list`).
-    #[arg(long)]
+    #[arg(long, help_heading = heading::MEASUREMENT)]
     pub adapter: Option<String>,
+    /// Output folder (default results/overhead-<time>/).
+    #[arg(long, help_heading = heading::OUTPUT)]
+    pub out: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Args)]
 pub struct ProbeArgs {
-    /// The target's width and height in pixels (the geometry probes' control draws into twice the width).
+    /// The target's width in pixels (the geometry probes' control draws into twice the width).
     #[arg(long, default_value_t = 512)]
     pub width: u32,
+    /// The target's height in pixels.
     #[arg(long, default_value_t = 512)]
     pub height: u32,
     /// Timing rounds: each round times every variant of every probe once, in an order shuffled from --seed.
@@ -121,48 +212,47 @@ pub struct ProbeArgs {
 }
 
 #[derive(Debug, Clone, Args)]
+#[command(mut_args = hide_if_not_for_tune)]
 pub struct TuneArgs {
     /// The scene whose models to tune: a built-in scene's name or a glTF file.
     #[arg(long)]
     pub scene: String,
     #[command(flatten)]
     pub scene_args: SceneArgs,
-    /// The budget as lodpop: the largest RMS change over the frame (sRGB-encoded, in [0, 1]) a switch may
-    /// cause, at the run's viewport.
-    #[arg(long, conflicts_with = "budget_jod")]
+    /// The budget as lodpop: the largest RMS change over the frame (sRGB, in (0, 1)) a switch may cause.
+    #[arg(long, conflicts_with = "budget_jod", help_heading = TUNING)]
     pub budget_lodpop: Option<f64>,
-    /// The budget as ColorVideoVDP's JOD between the two frames (10: no visible difference): the least a switch
-    /// may score.
-    #[arg(long)]
+    /// The budget as ColorVideoVDP's JOD between the two frames: the least a switch may score (10: invisible).
+    #[arg(long, help_heading = TUNING)]
     pub budget_jod: Option<f64>,
-    /// View directions per LOD pair: the scene's own (+z) and the rest from a seeded Fibonacci sphere (32: with
-    /// 8, a direction between them broke the budget by 12 % on a scan, docs/findings/tune.md).
-    #[arg(long, default_value_t = 32)]
+    /// View directions per LOD pair: the scene's own (+z) and the rest from a seeded Fibonacci sphere.
+    #[arg(long, default_value_t = 32, help_heading = TUNING)]
     pub views: u32,
-    /// Distances per view, evenly spaced in log distance from where the model fits the view to where it is two
-    /// pixels across.
-    #[arg(long, default_value_t = 24)]
+    /// Distances per view, log-spaced from where the model fits the view to where it is two pixels across.
+    #[arg(long, default_value_t = 24, help_heading = TUNING)]
     pub distances: u32,
-    /// The camera's speed in world units per second: with it, the narrowest band (`--band`) alpha, dither and
-    /// geomorph need for every frame's change to stay within a lodpop budget.
-    #[arg(long)]
+    /// The camera's speed (world units a second): with it, the narrowest --band blending methods need.
+    #[arg(long, help_heading = TUNING)]
     pub speed: Option<f32>,
     /// Frames per second the speed is measured at.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, help_heading = TUNING)]
     pub fps: f32,
     /// Seed of the view directions (recorded in tune.json).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, help_heading = TUNING)]
     pub seed: u64,
     /// ColorVideoVDP display model of --budget-jod.
-    #[arg(long, default_value = "standard_fhd")]
+    #[arg(long, default_value = "standard_fhd", help_heading = TUNING)]
     pub display: String,
-    /// Output folder (default results/tune-<scene>-<time>/).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
     /// GPU adapter, by index or name substring (`lodbench list`).
-    #[arg(long)]
+    #[arg(long, help_heading = heading::MEASUREMENT)]
     pub adapter: Option<String>,
+    /// Output folder (default results/tune-<scene>-<time>/).
+    #[arg(long, help_heading = heading::OUTPUT)]
+    pub out: Option<PathBuf>,
 }
+
+/// `tune`'s own heading: the budget and the search.
+const TUNING: &str = "Budget and search";
 
 #[derive(Debug, Clone, Args)]
 pub struct ClipsArgs {
@@ -174,12 +264,10 @@ pub struct ClipsArgs {
     /// Tiles per row.
     #[arg(long, default_value_t = 4)]
     pub columns: u32,
-    /// Nearest-neighbour upscaling factor (default: the smallest that makes the shown part at least 200
-    /// pixels high, and no wider than 480 or the run's width).
+    /// Nearest-neighbour upscaling factor (default: the smallest that shows at least 200 pixels high).
     #[arg(long)]
     pub scale: Option<u32>,
-    /// Show the whole frame (default: the box around everything the clip's pictures draw, with 8 pixels
-    /// around it, or the whole frame when that box covers more than half of it).
+    /// Show the whole frame (default: the box around what the clip's pictures draw, with 8 pixels around).
     #[arg(long)]
     pub full_frame: bool,
     /// Frames per second of the GIF and MP4.
@@ -195,7 +283,7 @@ pub struct ClipsArgs {
     #[arg(long)]
     pub gif: bool,
     /// MP4s with ffmpeg: auto (when ffmpeg is on the PATH), on (an error without it), off.
-    #[arg(long, value_enum, default_value = "auto")]
+    #[arg(long, value_enum, value_parser = names_only::<Mp4>(), default_value = "auto")]
     pub mp4: Mp4,
 }
 
@@ -221,24 +309,19 @@ pub struct ExperimentArgs {
     /// Validate the file and print the planned runs without rendering.
     #[arg(long)]
     pub check: bool,
-    /// Print the planned runs with the shard each belongs to under `--shard i/N` (N from --shard, else 1),
-    /// without rendering.
+    /// Print the planned runs with the shard each belongs to under `--shard i/N`, without rendering.
     #[arg(long)]
     pub list: bool,
-    /// Run only part i of n of the planned runs (run k goes to shard k mod n + 1), e.g. a Slurm array task's
-    /// `--shard $((SLURM_ARRAY_TASK_ID + 1))/$SLURM_ARRAY_TASK_COUNT`; merge the shards' folders with
-    /// `lodbench merge`.
-    #[arg(long)]
+    /// Run only part i of n of the planned runs (run k goes to shard k mod n + 1); `lodbench merge` joins them.
+    #[arg(long, value_name = "I/N")]
     pub shard: Option<String>,
-    /// Skip the runs whose run.json in the output folder says complete with the same flags, and run the rest
-    /// (an interrupted or failed experiment, rerun).
+    /// Skip the runs whose run.json in the output folder says complete with the same flags; run the rest.
     #[arg(long)]
     pub resume: bool,
-    /// Run every run on this adapter (overrides the file's `adapter`): an index, 0-based in the order `lodbench
-    /// list` prints, or a part of its name (case-insensitive); one GPU per shard on a machine with several.
+    /// Run every run on this adapter (overrides the file's `adapter`): an index or a part of its name.
     #[arg(long, value_name = "INDEX|NAME")]
     pub adapter: Option<String>,
-    /// Override a `[run]` key of the file in every run: `--set frames=300` (VALUE in TOML syntax; repeatable).
+    /// Override a key of the file's run table in every run: `--set frames=300` (TOML syntax; repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
 }
@@ -254,12 +337,10 @@ pub struct MergeArgs {
     /// Merge the complete runs when some are missing, failed or were interrupted (listed either way).
     #[arg(long)]
     pub allow_partial: bool,
-    /// Merge runs made on different adapters (name, driver): shards on different GPUs. Every merged CSV has
-    /// the `adapter` column, which keeps their rows apart; nothing is averaged across adapters.
+    /// Merge runs made on different adapters (shards on different GPUs); no figure is averaged across them.
     #[arg(long)]
     pub allow_adapters: bool,
-    /// Merge runs built from uncommitted changes (git_commit ending in -dirty) even where their changes differ
-    /// or cannot be told apart (no `source_diff_hash` in run.json). Better: commit, rebuild and rerun.
+    /// Merge runs built from uncommitted changes even where their changes differ or cannot be told apart.
     #[arg(long)]
     pub allow_dirty: bool,
 }
@@ -280,106 +361,90 @@ pub struct CompareArgs {
     pub count: Option<u32>,
 }
 
-/// Flags that change what a scene is (shared by `run` and `describe`).
+/// Flags that change what a scene is (shared by `run`, `describe`, `export`, `tune` and `overhead`).
+// The fields are in the order `-h` lists them, a heading's flags together (clap orders the headings by their
+// first flag); docs/flags.md has each flag's whole text.
 #[derive(Debug, Clone, Args, Deserialize)]
 #[serde(default, rename_all = "kebab-case")]
 pub struct SceneArgs {
-    /// Size preset; explicit flags override it.
-    #[arg(long, value_enum, default_value_t = Profile::Quick)]
+    /// Size preset (viewport, frames, counts, warm-up); explicit flags override it.
+    #[arg(long, value_enum, value_parser = names_only::<Profile>(), default_value_t = Profile::Quick)]
     pub profile: Profile,
-    /// Viewport width in pixels.
-    #[arg(long)]
+    /// Viewport width in pixels (default: the profile's).
+    #[arg(long, help_heading = heading::SCENE)]
     pub width: Option<u32>,
-    /// Viewport height in pixels.
-    #[arg(long)]
+    /// Viewport height in pixels (default: the profile's).
+    #[arg(long, help_heading = heading::SCENE)]
     pub height: Option<u32>,
     /// Timed frames (also the length of the quality pass; for bunny-sweep the whole path out and back).
-    #[arg(long)]
+    #[arg(long, help_heading = heading::SCENE)]
     pub frames: Option<u32>,
-    /// Mesh file (.obj, .gltf or .glb) that replaces the Stanford bunny in the bunny scenes.
-    #[arg(long)]
-    pub mesh: Option<PathBuf>,
-    /// A camera path, CSV (time or frame; x, y, z; target_x, target_y, target_z or qx, qy, qz, qw; optional
-    /// fov_deg), resampled to --frames: it replaces every scene's own camera (docs/methods.md, "Camera paths").
-    #[arg(long)]
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 60.0, help_heading = heading::SCENE)]
+    pub fov: f32,
+    /// Camera motion: the scene's own path, an orbit around what it looks at, or bunny-sweep's dolly.
+    #[arg(long, value_enum, value_parser = names_only::<CameraMode>(), default_value_t = CameraMode::Fixed,
+          help_heading = heading::SCENE)]
+    pub camera: CameraMode,
+    /// A camera path (CSV) that replaces every scene's own camera, resampled to --frames.
+    #[arg(long, value_name = "CSV", help_heading = heading::SCENE)]
     pub camera_path: Option<PathBuf>,
-    /// Screen-space error, in pixels at the viewport's height, at which each LOD is switched in. A smaller value
-    /// moves every switch farther from the camera, a larger one nearer. Default: for the bunny scenes one pixel
-    /// at the paper's 600-pixel height (height / 600), so every profile has the paper's switch distances and
-    /// path; 1 for the other scenes.
-    #[arg(long)]
-    pub pixel_error: Option<f32>,
-    /// Where the bunny scenes' path starts: `fit` (where the model's bounding sphere fits the view, so the camera
-    /// is never inside the model; switches nearer than that are not reached) or `close-up` (just before the
-    /// first switch, even inside the bounding sphere; `--pixel-error` 1 by default). Default: the profile's
-    /// (`close-up` for regress, `fit` otherwise).
-    #[arg(long, value_enum)]
+    /// Mesh file (.obj, .gltf or .glb) that replaces the Stanford bunny in the bunny scenes.
+    #[arg(long, value_name = "FILE", help_heading = heading::BUILT_IN)]
+    pub mesh: Option<PathBuf>,
+    /// Where the bunny scenes' path starts (default: the profile's: close-up for regress, else fit).
+    #[arg(long, value_enum, value_parser = names_only::<SweepStart>(), help_heading = heading::BUILT_IN)]
     pub sweep_start: Option<SweepStart>,
-    /// Explicit switch distances for LOD1, LOD2, ... (world units), overriding --pixel-error.
-    #[arg(long, value_delimiter = ',')]
-    pub switch_distances: Option<Vec<f32>>,
-    /// Switches in engine terms: LOD1, LOD2, ... come in where the model's bounding sphere's projected diameter
-    /// over the viewport's height falls below each value (Unreal's screen size, Unity's screen-relative
-    /// transition height, MSFT_screencoverage), decreasing; converted per model to d = radius / (size *
-    /// tan(fov_y / 2)). Overrides --pixel-error; not with --switch-distances.
-    #[arg(long, value_delimiter = ',', conflicts_with = "switch_distances")]
-    pub switch_screen_sizes: Option<Vec<f32>>,
-    /// How bunny-halves and terrain divide their mesh into blocks: `clip` (triangles clipped at the block
-    /// faces) or `bin` (each triangle whole into the block of its barycentre).
-    #[arg(long, value_enum, default_value_t = PartitionMode::Clip)]
+    /// How bunny-halves and terrain divide their mesh into blocks.
+    #[arg(long, value_enum, value_parser = names_only::<PartitionMode>(), default_value_t = PartitionMode::Clip,
+          help_heading = heading::BUILT_IN)]
     pub partition: PartitionMode,
-    /// terrain: blocks along the mesh's longest side (cubic blocks). Default: the profile's (4 at regress, 16 at
-    /// paper, 8 otherwise).
-    #[arg(long)]
+    /// terrain: blocks along the mesh's longest side (default: 4 at regress, 16 at paper, 8 otherwise).
+    #[arg(long, help_heading = heading::BUILT_IN)]
     pub blocks: Option<u32>,
     /// bunny-grid instance counts; each count is its own block of rows.
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', help_heading = heading::BUILT_IN)]
     #[serde(deserialize_with = "one_or_many")]
     pub count: Vec<u32>,
-    /// How a user's mesh (`--scene FILE.glb`, `--mesh`) is simplified into its LOD chain: `attributes`
-    /// (meshoptimizer's attribute-aware simplifier, normals and texture coordinates weighted, hard edges
-    /// collapsible, texture seams protected) or `positions` (positions alone: split vertices keep their seams).
-    #[arg(long, value_enum, default_value_t = crate::geometry::lod::Simplify::Attributes)]
+    /// How a user's mesh (--scene FILE.glb, --mesh) is simplified into its LOD chain.
+    #[arg(long, value_enum, value_parser = names_only::<crate::geometry::lod::Simplify>(),
+          default_value_t = crate::geometry::lod::Simplify::Attributes, help_heading = heading::FILE)]
     pub simplify: crate::geometry::lod::Simplify,
-    /// glTF scenes (`--scene FILE.glb`): `full` draws the file's materials (metallic-roughness, textures, normal
-    /// maps, alpha modes, vertex colours); `flat` draws each model in one colour, Lambert and ambient, reading no
-    /// texture (the built-in scenes' look: the silhouette's popping alone).
-    #[arg(long, value_enum, default_value_t = crate::geometry::material::MaterialMode::Full)]
+    /// The file's materials (full), or one colour per model as the built-in scenes draw (flat).
+    #[arg(long, value_enum, value_parser = names_only::<crate::geometry::material::MaterialMode>(),
+          default_value_t = crate::geometry::material::MaterialMode::Full, help_heading = heading::FILE)]
     pub materials: crate::geometry::material::MaterialMode,
-    /// glTF scenes (`--scene FILE.glb`): the animation that plays over the frames, by index or name, or `none`
-    /// (the scene at rest). Default: the file's first animation, 60 frames a second of clip time, looped.
-    #[arg(long)]
+    /// The animation played over the frames, by index or name, or none (default: the file's first).
+    #[arg(long, help_heading = heading::FILE)]
     pub animation: Option<String>,
-    /// Vertical field of view in degrees.
-    #[arg(long, default_value_t = 60.0)]
-    pub fov: f32,
-    /// Extra work per shaded fragment, for every method and the reference: N dependent ALU iterations (a
-    /// multiply-add and a fract each) whose result is added with a weight of 0, so the image is unchanged while
-    /// no shader compiler can drop the loop (the weight is a uniform). A stand-in for an expensive material: what
-    /// drawing both LODs of a blend costs when fragments are dear (Scherzer & Wimmer 2008 section 2).
-    #[arg(long, default_value_t = 0)]
-    pub shader_work: u32,
-    /// How k advances through a transition.
-    #[arg(long, value_enum, default_value_t = FadeMode::Distance)]
-    pub fade: FadeMode,
-    /// Half-width of the transition band as a fraction of the switch distance (Sheliemietiev et al. 2023 section 8).
-    #[arg(long, default_value_t = 0.05)]
+    /// Screen-space error in pixels (at the viewport's height) at which each LOD is switched in.
+    #[arg(long, value_name = "PIXELS", help_heading = heading::SWITCHES)]
+    pub pixel_error: Option<f32>,
+    /// Explicit switch distances for LOD1, LOD2, ... (world units), overriding --pixel-error.
+    #[arg(long, value_delimiter = ',', value_name = "D1,D2,..", help_heading = heading::SWITCHES)]
+    pub switch_distances: Option<Vec<f32>>,
+    /// Switches as engines' screen sizes for LOD1, LOD2, ... (decreasing), overriding --pixel-error.
+    #[arg(long, value_delimiter = ',', value_name = "S1,S2,..", conflicts_with = "switch_distances",
+          help_heading = heading::SWITCHES)]
+    pub switch_screen_sizes: Option<Vec<f32>>,
+    /// How k advances through a transition (default: distance on the built-in scenes, time on a glTF file).
+    #[arg(long, value_enum, value_parser = names_only::<FadeMode>(), help_heading = heading::SWITCHES)]
+    pub fade: Option<FadeMode>,
+    /// Half-width of the transition band as a fraction of the switch distance.
+    #[arg(long, default_value_t = 0.05, help_heading = heading::SWITCHES)]
     pub band: f32,
-    /// Length of a time-based fade in frames (--fade time).
-    #[arg(long, default_value_t = 30)]
-    pub fade_frames: u32,
+    /// Length of a time-based fade in frames (default: 30 on the built-in scenes, 8 on a glTF file).
+    #[arg(long, help_heading = heading::SWITCHES)]
+    pub fade_frames: Option<u32>,
     /// Hysteresis margin as a fraction of the switch distance.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, help_heading = heading::SWITCHES)]
     pub hysteresis: f32,
-    /// At most this many instances in transition at once (0: no cap; needs --fade time): an instance whose LOD
-    /// should change waits, keeping its LOD, until a fade ends (run.json: wait_instance_frames).
-    #[arg(long, default_value_t = 0)]
+    /// At most this many instances in transition at once (0: no cap; needs --fade time).
+    #[arg(long, default_value_t = 0, help_heading = heading::SWITCHES)]
     pub max_transitions: u32,
-    /// Camera motion: `fixed` (the scene's own path) or `orbit` (the camera swings around what it looks at,
-    /// +-30 degrees over 240 frames, keeping its distance: every pixel moves, which exercises FSI's
-    /// reprojection).
-    #[arg(long, value_enum, default_value_t = CameraMode::Fixed)]
-    pub camera: CameraMode,
+    /// Extra ALU work per shaded fragment that leaves the image unchanged: an expensive material's cost.
+    #[arg(long, default_value_t = 0, value_name = "N", help_heading = heading::EFFECTS)]
+    pub shader_work: u32,
     #[command(flatten)]
     #[serde(flatten)]
     pub taa: crate::effects::taa::TaaArgs,
@@ -408,88 +473,70 @@ pub struct RunArgs {
     #[command(flatten)]
     #[serde(flatten)]
     pub scene_args: SceneArgs,
-    /// Untimed frames rendered before the timed ones.
-    #[arg(long)]
-    pub warmup: Option<u32>,
-    /// Seed of every random choice (recorded in run.json).
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Timing rounds: the timed frames are cut into this many consecutive segments, and round r times every
-    /// method of the block over segment r, in an order shuffled from --seed (recorded in run.json), so drift
-    /// of the machine falls on every method alike. The paired ratios and their intervals are over rounds.
-    #[arg(long, default_value_t = 20)]
-    pub rounds: u32,
-    /// The method every method's time is divided by, round by round (summary.csv `ratio_to_baseline`);
-    /// default `discrete` when it is run. A name repeated in --method is `NAME#2`, `NAME#3`, ...
-    #[arg(long)]
+    // The methods' flags before the measurement's, so that `-h` lists them in that order.
+    /// The method every method's time is divided by, round by round (default: discrete when it is run).
+    #[arg(long, value_name = "METHOD", help_heading = heading::METHODS)]
     pub baseline: Option<String>,
-    /// The popping budget the answer under the summary table (and at the top of report.html) is stated within:
-    /// the largest lodpop a method may show to count (`lodbench tune --budget-lodpop`'s budget, say). Default:
-    /// half the hard switch's (discrete's) largest lodpop. Changes no measurement.
-    #[arg(long)]
-    pub budget_lodpop: Option<f64>,
-    /// Measure the adapter's ceilings before the blocks (`lodbench probe`'s rates, each probe's base alone, a
-    /// fraction of a second on a CPU adapter) into run.json, and fill summary.csv's triangles_per_s,
-    /// triangle_ceiling_share, fragments_per_s, fragment_ceiling_share and bound.
-    #[arg(long, value_enum, default_value_t = OnOff::On)]
-    pub ceilings: OnOff,
-    /// Before each method's timed segment of a round, keep the GPU busy with the triangle probe until it reads
-    /// nine tenths of the highest triangle rate the run has read (at most a quarter of a second), so that a GPU
-    /// clock dropped while the GPU idled (a CPU-heavy method's selection) is back up before the next method is
-    /// timed. `auto`: on, but on a CPU adapter (no GPU clock). Needs `--ceilings on`. Recorded per method in
-    /// run.json (`clock_warmup_*`).
-    #[arg(long, value_enum, default_value_t = ClockWarmup::Auto)]
-    pub clock_warmup: ClockWarmup,
     #[command(flatten)]
     #[serde(flatten)]
     pub method_options: MethodOptions,
-    /// Image metrics per frame (rmse, pop and lodpop are always computed; de2000 adds CIEDE2000 to the metric
-    /// kernel; flip adds NVIDIA FLIP, on the CPU).
-    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Metric::Rmse, Metric::Pop])]
+    /// Untimed frames rendered before the timed ones (default: the profile's).
+    #[arg(long, help_heading = heading::MEASUREMENT)]
+    pub warmup: Option<u32>,
+    /// Seed of every random choice (recorded in run.json).
+    #[arg(long, default_value_t = 1, help_heading = heading::MEASUREMENT)]
+    pub seed: u64,
+    /// Timing rounds: consecutive segments of the timed frames, each timing every method in a shuffled order.
+    #[arg(long, default_value_t = 20, help_heading = heading::MEASUREMENT)]
+    pub rounds: u32,
+    /// The popping budget the printed answer is stated within (default: half discrete's largest lodpop).
+    #[arg(long, help_heading = heading::MEASUREMENT)]
+    pub budget_lodpop: Option<f64>,
+    /// Measure the adapter's ceilings (`lodbench probe`'s rates) before the blocks, for summary.csv's bound.
+    #[arg(long, value_enum, default_value_t = OnOff::On, help_heading = heading::MEASUREMENT)]
+    pub ceilings: OnOff,
+    /// Before each method's timed segment, bring a GPU's clock back up with the triangle probe.
+    #[arg(long, value_enum, value_parser = names_only::<ClockWarmup>(), default_value_t = ClockWarmup::Auto,
+          help_heading = heading::MEASUREMENT)]
+    pub clock_warmup: ClockWarmup,
+    /// Image metrics per frame (rmse, pop and lodpop always; de2000: CIEDE2000; flip: NVIDIA FLIP, on the CPU).
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Metric::Rmse, Metric::Pop],
+          help_heading = heading::MEASUREMENT)]
     #[serde(deserialize_with = "one_or_many")]
     pub metrics: Vec<Metric>,
-    /// How the metric kernel sums a row: per-invocation atomics (default) or a workgroup-memory reduction.
-    #[arg(long, value_enum, default_value_t = MetricReduction::Atomics)]
+    /// How the metric kernel sums a row: per-invocation atomics or a workgroup-memory reduction.
+    #[arg(long, value_enum, value_parser = names_only::<MetricReduction>(),
+          default_value_t = MetricReduction::Atomics, help_heading = heading::MEASUREMENT)]
     pub metric_reduction: MetricReduction,
-    /// Which pixels the quality pass reads: `covered` (default) only those the instances can cover, where a
-    /// bound holds (no TAA, no shadows, methods that draw only their meshes), and lodpop's counterfactual only
-    /// where the instances whose state changed reach; `full` every pixel. The figures are the same.
-    #[arg(long, value_enum, default_value_t = MetricRegion::Covered)]
+    /// Which pixels the quality pass reads: those the instances can cover, or every one (same figures).
+    #[arg(long, value_enum, value_parser = names_only::<MetricRegion>(), default_value_t = MetricRegion::Covered,
+          help_heading = heading::MEASUREMENT)]
     pub metric_region: MetricRegion,
-    /// Output folder (default results/<scene>-<time>/).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// The adapter to run on: an index (0-based, in the order `lodbench list` prints them, best first), which
-    /// tells identical GPUs apart, or a part of its name (case-insensitive); the best one when absent.
-    #[arg(long, value_name = "INDEX|NAME")]
+    /// The quality pass; off: the warm-up and the timing rounds only, every image figure left empty.
+    #[arg(long, value_enum, default_value_t = OnOff::On, help_heading = heading::MEASUREMENT)]
+    pub quality: OnOff,
+    /// When the quality pass is made: a segment after each timing round, or after every round.
+    #[arg(long, value_enum, value_parser = names_only::<QualitySchedule>(),
+          default_value_t = QualitySchedule::Rounds, help_heading = heading::MEASUREMENT)]
+    pub quality_schedule: QualitySchedule,
+    /// GPU memory a scene block may keep of the reference's frames, copied instead of drawn again (0: none).
+    #[arg(long, default_value_t = 1024, value_name = "MIB", help_heading = heading::MEASUREMENT)]
+    pub reference_cache_mib: u64,
+    /// The adapter: an index as `lodbench list` prints them (0-based) or a part of its name (default: the best).
+    #[arg(long, value_name = "INDEX|NAME", help_heading = heading::MEASUREMENT)]
     #[serde(deserialize_with = "name_or_index")]
     pub adapter: Option<String>,
-    /// The quality pass: `off` runs the warm-up and the timing rounds only, for runs that only time (an A/A
-    /// check, cost figures); every image figure of the CSVs (rmse, pop, lodpop, de2000, FLIP, uncovered and
-    /// crack pixels, lag, shadow, FSI's combine time) is then empty, never 0, and run.json's quality-pass
-    /// times null. Refused with --dump-frames and --metrics de2000/flip, which need the pass.
-    #[arg(long, value_enum, default_value_t = OnOff::On)]
-    pub quality: OnOff,
-    /// When the quality pass is made: `rounds` (default) a segment of every method's pass right after each
-    /// timing round, over the same frames, so that quality_to_renders_ratio is paired round by round; `after`
-    /// every timing round first, back to back as with --quality off, then the quality segments (the timing
-    /// rounds then have no quality work between them; docs/measurement.md, "Quality pass").
-    #[arg(long, value_enum, default_value_t = QualitySchedule::Rounds)]
-    pub quality_schedule: QualitySchedule,
-    /// GPU memory (MiB) a scene block may keep of the reference's frames, so that its second and later methods
-    /// copy the reference frame instead of drawing it again (every figure is the same; the first frames that
-    /// fit are kept). 0 draws it in every method's pass. Not used under TAA or with shadows.
-    #[arg(long, default_value_t = 1024, value_name = "MIB")]
-    pub reference_cache_mib: u64,
+    /// Output folder (default results/<scene>-<time>/).
+    #[arg(long, help_heading = heading::OUTPUT)]
+    pub out: Option<PathBuf>,
     /// Write PNGs of the method frame, the reference frame and an error heat-map.
-    #[arg(long)]
+    #[arg(long, help_heading = heading::OUTPUT)]
     pub dump_frames: bool,
     /// With --dump-frames: every k-th frame only.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_name = "K", help_heading = heading::OUTPUT)]
     pub dump_every: u32,
-    /// With --dump-frames: only frames with an instance in transition (of those, every k-th frame with
-    /// --dump-every), so a long run's dumps land where methods differ.
-    #[arg(long)]
+    /// With --dump-frames: only frames with an instance in transition (of those, every --dump-every-th).
+    #[arg(long, help_heading = heading::OUTPUT)]
     pub dump_transitions: bool,
 }
 
@@ -543,16 +590,13 @@ pub struct DescribeArgs {
     #[command(flatten)]
     pub scene_args: SceneArgs,
     /// Machine-readable output.
-    #[arg(long)]
+    #[arg(long, help_heading = heading::OUTPUT)]
     pub json: bool,
-    /// Also measure each LOD against LOD0: the largest and the mean distance from LOD0's vertices to the LOD's
-    /// surface (object-space units), a measure independent of the simplifier's own error.
-    #[arg(long)]
+    /// Also measure each LOD against LOD0: the largest and the mean distance from LOD0's vertices to its surface.
+    #[arg(long, help_heading = heading::OUTPUT)]
     pub deviation: bool,
-    /// Print instead the camera of frame F as JSON: eye, the view matrix (world to camera, column-major),
-    /// the vertical field of view, near and far planes and the viewport (what another renderer needs to draw
-    /// lodbench's view; the projection is glam's right-handed one with depth in 0..1).
-    #[arg(long, value_name = "F")]
+    /// Print instead the camera of frame F as JSON: eye, view matrix, field of view, clip planes, viewport.
+    #[arg(long, value_name = "F", help_heading = heading::OUTPUT)]
     pub camera_json: Option<u32>,
 }
 
@@ -561,16 +605,14 @@ pub struct ExportArgs {
     /// The scene to export (the unified scenes are not exported; a glTF scene only as .obj).
     #[arg(long)]
     pub scene: String,
-    /// The file to write: `.glb`, a built-in scene with its LOD chains and camera; `.obj`, the geometry
-    /// lodbench draws on `--frame`, every instance at LOD0 in world space, a group per instance (for a glTF scene
-    /// named by its node: `node<N>`, `node<N>.<I>`).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// The frame `--out FILE.obj` shows (its animation's pose, its camera ignored).
-    #[arg(long, default_value_t = 0)]
-    pub frame: u32,
     #[command(flatten)]
     pub scene_args: SceneArgs,
+    /// The file to write: .glb (a built-in scene, its LOD chains and camera) or .obj (the geometry of --frame).
+    #[arg(long, value_name = "FILE", help_heading = heading::OUTPUT)]
+    pub out: PathBuf,
+    /// The frame `--out FILE.obj` shows (its animation's pose, its camera ignored).
+    #[arg(long, default_value_t = 0, help_heading = heading::OUTPUT)]
+    pub frame: u32,
 }
 
 /// `--clock-warmup`.
@@ -607,11 +649,129 @@ pub enum Mp4 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clap::CommandFactory;
 
     #[test]
     fn cli_is_consistent() {
         Cli::command().debug_assert();
+    }
+
+    /// `lodbench` and every subcommand, built (the help flags and the `help` subcommand added).
+    fn every_command() -> Vec<clap::Command> {
+        let mut cmd = Cli::command();
+        cmd.build();
+        let mut all: Vec<clap::Command> = cmd.get_subcommands().cloned().collect();
+        all.push(cmd);
+        all
+    }
+
+    /// clap prints `--help` as the long listing (a flag's whole doc comment, each value of an enum on a line
+    /// of its own) when anything has a long text; nothing has, so `--help` is `-h`'s summary.
+    #[test]
+    fn help_has_one_paragraph_a_flag_and_no_value_texts() {
+        for cmd in every_command() {
+            let name = cmd.get_name().to_string();
+            assert!(
+                cmd.get_long_about().is_none(),
+                "{name}: a doc comment of more than one paragraph"
+            );
+            for a in cmd.get_arguments() {
+                let flag = a.get_long().unwrap_or(a.get_id().as_str());
+                assert!(
+                    a.get_long_help().is_none(),
+                    "{name} --{flag}: a doc comment of more than one paragraph (the rest goes to docs/flags.md)"
+                );
+                for v in a.get_possible_values() {
+                    assert!(
+                        v.get_help().is_none(),
+                        "{name} --{flag} {}: a value with a help text (value_parser = names_only::<E>())",
+                        v.get_name()
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn every_flag_with_a_value_takes_a_negative_number() {
+        for cmd in every_command() {
+            for a in cmd.get_arguments() {
+                if a.get_action().takes_values() {
+                    assert!(
+                        a.is_allow_negative_numbers_set(),
+                        "{} --{:?}",
+                        cmd.get_name(),
+                        a.get_long()
+                    );
+                }
+            }
+        }
+        let parse = |args: &[&str]| Cli::try_parse_checked_from(args).map(|c| c.command);
+        let Ok(Command::Tune(t)) =
+            parse(&["lodbench", "tune", "--scene", "x", "--budget-lodpop", "-1"])
+        else {
+            panic!("tune --budget-lodpop -1 does not parse")
+        };
+        assert_eq!(t.budget_lodpop, Some(-1.0));
+        let Ok(Command::Run(r)) = parse(&["lodbench", "run", "--hysteresis", "-0.1"]) else {
+            panic!("run --hysteresis -0.1 does not parse")
+        };
+        assert_eq!(r.scene_args.hysteresis, -0.1);
+    }
+
+    #[test]
+    fn tune_hides_and_refuses_the_scene_flags_it_does_not_read() {
+        let cmd = Cli::command();
+        let tune = cmd.find_subcommand("tune").unwrap();
+        for id in NOT_FOR_TUNE {
+            let a = tune
+                .get_arguments()
+                .find(|a| a.get_id() == *id)
+                .unwrap_or_else(|| panic!("{id} is not a flag of tune"));
+            assert!(a.is_hide_set(), "{id} shows in tune -h");
+            let flag = format!("--{}", a.get_long().unwrap());
+            // A value the flag takes: its default, else its first value, else a number.
+            let value = a
+                .get_default_values()
+                .first()
+                .map(|v| v.to_string_lossy().into_owned())
+                .or_else(|| {
+                    a.get_possible_values()
+                        .first()
+                        .map(|v| v.get_name().to_string())
+                })
+                .unwrap_or_else(|| "1".to_string());
+            let mut args = vec!["lodbench", "tune", "--scene", "x", flag.as_str()];
+            if a.get_action().takes_values() {
+                args.push(&value);
+            }
+            let err = Cli::try_parse_checked_from(&args)
+                .err()
+                .unwrap_or_else(|| panic!("{args:?} parses"));
+            assert_eq!(err.kind(), clap::error::ErrorKind::ArgumentConflict);
+            assert!(
+                err.to_string()
+                    .contains(&format!("{flag} changes nothing for tune")),
+                "{err}"
+            );
+        }
+        // The rest of tune's flags show and parse; every flag of run shows.
+        assert!(tune
+            .get_arguments()
+            .filter(|a| !NOT_FOR_TUNE.contains(&a.get_id().as_str()))
+            .all(|a| !a.is_hide_set()));
+        let run = cmd.find_subcommand("run").unwrap();
+        assert!(run.get_arguments().all(|a| !a.is_hide_set()));
+        let args = [
+            "lodbench",
+            "tune",
+            "--scene",
+            "x",
+            "--band",
+            "0.1",
+            "--pixel-error",
+            "2",
+        ];
+        assert!(Cli::try_parse_checked_from(args).is_ok());
     }
 
     #[test]

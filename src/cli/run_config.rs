@@ -53,14 +53,24 @@ impl SceneConfig {
             return Err(Error::Config("--count values must be at least 1".into()));
         }
         check_switches(a)?;
-        let schedule = ScheduleParams {
-            fade: a.fade,
+        // The built-in scenes fade as their papers do; a user's file by time (ScheduleParams::FOR_USER_FILES).
+        let schedule_of = |defaults: ScheduleParams| ScheduleParams {
+            fade: a.fade.unwrap_or(defaults.fade),
             band: a.band,
-            fade_frames: a.fade_frames,
+            fade_frames: a.fade_frames.unwrap_or(defaults.fade_frames),
             hysteresis: a.hysteresis,
             max_transitions: a.max_transitions,
         };
-        schedule.validate()?;
+        let schedule = schedule_of(ScheduleParams::default());
+        let user_schedule = schedule_of(ScheduleParams::FOR_USER_FILES);
+        user_schedule.validate()?;
+        // --max-transitions needs a time fade, which a built-in scene has only with --fade time: that is checked
+        // where a built-in scene takes its schedule (SceneConfig::schedule), so a user's file takes the flag alone.
+        ScheduleParams {
+            max_transitions: 0,
+            ..schedule
+        }
+        .validate()?;
         let camera_path = match &a.camera_path {
             Some(p) => Some(crate::scene::camera_path::CameraPath::load(p)?),
             None => None,
@@ -98,6 +108,7 @@ impl SceneConfig {
             materials: a.materials,
             shader_work: a.shader_work,
             schedule,
+            user_schedule,
             camera: a.camera,
             taa: a.taa.resolve()?,
             shadows: a.shadow.resolve()?,

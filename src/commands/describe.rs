@@ -51,7 +51,7 @@ pub fn execute(args: &DescribeArgs) -> Result<()> {
         d.profile,
         d.width,
         d.height,
-        d.fov_y_deg,
+        crate::results::answer::sig3(Some(d.fov_y_deg as f64)),
         d.frames,
         d.instance_counts
     );
@@ -207,6 +207,23 @@ fn print_models(d: &SceneDescription) {
 /// The pixel error, the camera path, the motion and the notes.
 fn print_path(d: &SceneDescription) -> Result<()> {
     outln!("pixel error: {}", d.pixel_error);
+    let s = &d.schedule;
+    outln!(
+        "transitions: {}{}",
+        match s.fade {
+            crate::scene::schedule::FadeMode::Time =>
+                format!("a time fade over {} frames", s.fade_frames),
+            crate::scene::schedule::FadeMode::Distance => format!(
+                "a distance fade over +-{} % of each switch distance",
+                crate::results::answer::sig3(Some(s.band as f64 * 100.0))
+            ),
+        },
+        if s.hysteresis > 0.0 {
+            format!(", hysteresis {}", s.hysteresis)
+        } else {
+            String::new()
+        }
+    );
     if let Some(p) = &d.path {
         outln!(
             "path: from {:.3} to {:.3} (the bounding sphere fits the view from {:.3})",

@@ -409,6 +409,7 @@ impl RunJob<'_> {
         let measured = record_outputs(outputs, &methods, manifest, output)?;
         // The block's one clock.
         let clock = Clock::of(measured.iter().flat_map(|m| &m.rows));
+        let first_summary = output.summaries.len();
         summarise(
             cfg,
             baseline.as_deref(),
@@ -416,6 +417,10 @@ impl RunJob<'_> {
             clock,
             &mut output.summaries,
         );
+        let room = crate::measure::shortest_transition(&scene);
+        for s in &mut output.summaries[first_summary..] {
+            s.transition_frames_min = room;
+        }
         let block_rows: Vec<Vec<FrameRecord>> = measured.into_iter().map(|m| m.rows).collect();
         output.rounds.extend(round_records(
             &block_rows,
@@ -507,11 +512,15 @@ pub fn summary_table(s: &RunSummary) -> String {
     }
     let baseline = s.summaries.iter().find_map(|r| r.baseline.clone());
     out.push_str(&format!(
-        "gpu ms and cpu ms are medians; q/r = quality-pass time per frame / the timing-pass time of the \
-         renders it makes (method, reference where drawn, lodpop's counterfactual where drawn), paired by round \
-         (geometric mean; its interval in run.json); time / baseline = time over {}'s, paired by timing round, \
-         geometric mean and 95 % t interval over rounds (every other pair: pairs.csv, lodbench compare DIR A B); \
-         '-' = not measured (no timestamps; --quality off: no image figures); full precision in summary.csv\n",
+        "lodpop max is the popping: the largest change LOD switching alone makes to a frame, the pose held \
+         (root mean square over the frame of the sRGB values, 0 to 1); rmse is the error against the \
+         high-poly reference in the same unit, pop max its largest change from one frame to the next. \
+         Per frame: gpu ms and cpu ms are medians, triangles a mean. q/r = quality-pass time per frame / the \
+         timing-pass time of the renders it makes (method, reference where drawn, lodpop's counterfactual where \
+         drawn), paired by round (geometric mean; its interval in run.json); time / baseline = time over {}'s, \
+         paired by timing round, geometric mean and 95 % t interval over rounds (every other pair: pairs.csv, \
+         lodbench compare DIR A B); '-' = not measured (no timestamps; --quality off: no image figures); figures \
+         rounded to 3 significant figures, full precision in summary.csv\n",
         baseline.as_deref().unwrap_or("the baseline (none run)")
     ));
     push_notes(&mut out, s);
@@ -526,10 +535,10 @@ fn summary_rows(s: &RunSummary) -> Vec<Vec<String>> {
         "method",
         "count",
         "frames",
-        "gpu ms",
-        "cpu ms",
-        "triangles",
-        "rmse",
+        "gpu ms median",
+        "cpu ms median",
+        "triangles mean",
+        "rmse mean",
         "rmse max",
         "pop max",
         "lodpop max",
@@ -687,7 +696,7 @@ mod tests {
         {
             assert_eq!(line.find(method), Some(method_at), "{text}");
         }
-        let gpu_end = lines[0].find("gpu ms").expect("the header") + "gpu ms".len();
+        let gpu_end = lines[0].find("gpu ms median").expect("the header") + "gpu ms median".len();
         for (line, ms) in lines[1..].iter().zip(["1.00", "1.23", "1.00", "12.3"]) {
             assert!(line[..gpu_end].ends_with(ms), "{text}");
         }

@@ -103,6 +103,13 @@ fn engine_model(m: &ModelSwitches, blend: Option<&str>) -> EngineModel {
         center: m.center,
         switches: usable.iter().map(|p| of(p).0).collect(),
         bands: usable.iter().map(|p| of(p).1).collect(),
+        triangles: m
+            .pairs
+            .first()
+            .map(|p| p.triangles_from as u32)
+            .into_iter()
+            .chain(usable.iter().map(|p| p.triangles_to as u32))
+            .collect(),
     }
 }
 
@@ -131,7 +138,13 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
     let mut jod = jod_of(args, &settings, scene.width, scene.height)?;
     let (models, samples) = tune_models(&ctx, &scene, &settings, &views, &mut jod)?;
     write_samples(&out, &samples)?;
-    let engine_models = write_engine_tables(&out, &models, &settings, scene.fov_y)?;
+    let viewing = Viewing {
+        width: scene.width,
+        height: scene.height,
+        fov_y: scene.fov_y,
+        budget: settings.budget,
+    };
+    let engine_models = write_engine_tables(&out, &models, &settings, &viewing)?;
     let tuned = tuned_scene(&scene, &models);
     let glb = crate::scene::export_glb::glb_with(&tuned, false)?;
     write(&out.join("tuned.glb"), &glb)?;
@@ -146,14 +159,14 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
         settings: &settings,
         views: views.iter().map(|v| v.to_array()).collect(),
         models: &models,
-        engines: engine_models,
+        engines: engine_models.clone(),
     };
     write(
         &out.join("tune.json"),
         serde_json::to_string_pretty(&manifest)?.as_bytes(),
     )?;
     write_rules(&out, &models)?;
-    print_results(&out, &models, settings.budget);
+    print_results(&out, &models, &engine_models, &viewing);
     Ok(())
 }
 
@@ -196,10 +209,11 @@ fn write_engine_tables(
     out: &Path,
     models: &[ModelSwitches],
     settings: &TuneSettings,
-    fov_y: f32,
+    viewing: &Viewing,
 ) -> Result<Vec<EngineModel>> {
+    let fov_y = viewing.fov_y;
     let engine_models: Vec<EngineModel> = models.iter().map(|m| engine_model(m, None)).collect();
-    write_engines(out, &engine_models, fov_y)?;
+    write_engines(out, &engine_models, viewing)?;
     if settings.speed.is_some() {
         // The engines that cross-fade: Unity and Bevy dither (LOD cross-fade shaders, Bevy's visibility-range
         // fade), Godot blends (its fade modes change the node's transparency).
@@ -211,17 +225,85 @@ fn write_engine_tables(
     Ok(engine_models)
 }
 
-/// Prints the switches' and the rules' tables, where the results are, and the commands that use them.
-fn print_results(out: &Path, models: &[ModelSwitches], budget: Budget) {
-    out!("{}", table(models, budget));
-    out!("{}", rules_table(models));
+/// What the switches were chosen for: the viewport, the vertical field of view and the budget.
+struct Viewing {
+    width: u32,
+    height: u32,
+    fov_y: f32,
+    budget: Budget,
+}
+
+impl Viewing {
+    /// The budget as the tables name their figure.
+    fn figure(&self) -> &'static str {
+        match self.budget {
+            Budget::Lodpop(_) => "lodpop",
+            Budget::Jod(_) => "JOD",
+        }
+    }
+
+    /// What every engine file's distances hold for, in sentences: the budget, the viewport and field of view,
+    /// and the chain of each model (its triangles per level).
+    fn about(&self, models: &[EngineModel]) -> Vec<String> {
+        let budget = match self.budget {
+            Budget::Lodpop(x) => format!("a largest lodpop of {x}"),
+            Budget::Jod(j) => format!("ColorVideoVDP's JOD of at least {j}"),
+        };
+        let mut out = vec![
+            format!(
+                "These switches keep each switch within {budget} at {}x{} pixels with a {} degree vertical field \
+                 of view; at another viewport or field of view the same switch pops differently: tune there.",
+                self.width,
+                self.height,
+                crate::results::answer::sig3(Some(self.fov_y.to_degrees() as f64)),
+            ),
+            "They hold for the LOD chain lodbench drew: a glTF file's authored chain (MSFT_lod), else the one \
+             lodbench generated with meshoptimizer, which tuned.glb holds. Use those levels, or a chain with these \
+             triangle counts:"
+                .to_string(),
+        ];
+        for m in models {
+            let tris: Vec<String> = m
+                .triangles
+                .iter()
+                .map(|&t| crate::results::answer::thousands(Some(t as f64)))
+                .collect();
+            out.push(format!("  {}: {} triangles", m.name, tris.join(" -> ")));
+        }
+        out
+    }
+}
+
+/// Prints the switches' and the rules' tables with what their columns mean, what the switches hold for, where
+/// the results and the engine files are, and the commands that use them.
+fn print_results(out: &Path, models: &[ModelSwitches], engines: &[EngineModel], viewing: &Viewing) {
+    let figure = viewing.figure();
+    out!("{}", table(models, viewing.budget));
+    out!("{}", rules_table(models, figure));
+    outln!(
+        "switch (d): the distance from the model's bounding-sphere centre (world units) beyond which the next LOD \
+         is drawn; screen size: that sphere's projected diameter over the viewport's height there; worst {figure}: \
+         the largest over the views of the change the switch makes to the frame; error px: the coarser LOD's \
+         simplification error projected there. Second table: where tune and each engine's own rule (Unreal's auto \
+         screen size, Godot's 1 pixel, meshoptimizer's error) would switch, as (distance, worst {figure}); * = \
+         over the budget."
+    );
+    for line in viewing.about(engines) {
+        outln!("{line}");
+    }
     outln!("results in {}", out.display());
+    outln!(
+        "engine settings in {}: Unity, Unreal, Godot, Bevy and three.js; how to enter each: {} (also \
+         docs/engines.md)",
+        out.join(ENGINES_DIR).display(),
+        out.join(ENGINES_DIR).join("README.md").display()
+    );
     outln!(
         "figures: python3 scripts/plot.py {}; the rules along a path: python3 scripts/tune_rules.py {}",
         out.display(),
         out.display()
     );
-    if let Budget::Lodpop(x) = budget {
+    if let Budget::Lodpop(x) = viewing.budget {
         outln!(
             "every method with these switches, answered within the budget: lodbench run --scene {} \
              --budget-lodpop {x}",
@@ -325,7 +407,7 @@ fn write_fading(
     blended: &[EngineModel],
     fov_y: f32,
 ) -> Result<()> {
-    let dir = out.join("engines");
+    let dir = out.join(ENGINES_DIR);
     let unity: Vec<_> = dithered.iter().map(|m| engines::unity(m, fov_y)).collect();
     let bevy: Vec<_> = dithered
         .iter()
@@ -350,8 +432,13 @@ fn write_fading(
     )
 }
 
-fn write_engines(out: &Path, models: &[EngineModel], fov_y: f32) -> Result<()> {
-    let dir: PathBuf = out.join("engines");
+/// The folder of the engine files, and its README (docs/engines.md, after what the switches hold for).
+const ENGINES_DIR: &str = "engines";
+const ENGINES_README: &str = include_str!("../../docs/engines.md");
+
+fn write_engines(out: &Path, models: &[EngineModel], viewing: &Viewing) -> Result<()> {
+    let fov_y = viewing.fov_y;
+    let dir: PathBuf = out.join(ENGINES_DIR);
     std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     let json = |v: &dyn erased::Json| v.text();
     let unity: Vec<_> = models.iter().map(|m| engines::unity(m, fov_y)).collect();
@@ -377,8 +464,22 @@ fn write_engines(out: &Path, models: &[EngineModel], fov_y: f32) -> Result<()> {
         &dir.join("bevy-visibility-ranges.json"),
         json(&bevy).as_bytes(),
     )?;
-    let three: String = models.iter().map(engines::threejs).collect();
-    write(&dir.join("threejs-lod.js"), three.as_bytes())
+    let about = viewing.about(models);
+    let mut header = vec![
+        "lodbench tune: switch distances for three.js (THREE.LOD), from each model's bounding-sphere centre."
+            .to_string(),
+    ];
+    header.extend(about.iter().cloned());
+    header.push(
+        "Usage: const lod = lodbenchLod(THREE, \"NAME\", [level0, level1, ...]); scene.add(lod);"
+            .to_string(),
+    );
+    write(
+        &dir.join("threejs-lod.js"),
+        engines::threejs(models, &header).as_bytes(),
+    )?;
+    let readme = format!("{}\n\n{ENGINES_README}", about.join("\n\n"));
+    write(&dir.join("README.md"), readme.as_bytes())
 }
 
 /// Serialising what `write_engines` writes, whatever its type.
@@ -440,7 +541,7 @@ pub fn table(models: &[ModelSwitches], budget: Budget) -> String {
 
 /// The second table printed: per model and pair, where tune and each engine's rule switch, and the budget's figure
 /// there (`*`: breaks the budget).
-pub fn rules_table(models: &[ModelSwitches]) -> String {
+pub fn rules_table(models: &[ModelSwitches], figure: &str) -> String {
     let name_w = models
         .iter()
         .map(|m| m.name.len())
@@ -449,7 +550,7 @@ pub fn rules_table(models: &[ModelSwitches]) -> String {
         .max(5);
     let mut out = format!("{:<name_w$}  {:>5}", "model", "LODs");
     for rule in std::iter::once("tune").chain(RULES.iter().map(|r| r.name())) {
-        out.push_str(&format!("  {:>20}", format!("{rule} (d, figure)")));
+        out.push_str(&format!("  {:>20}", format!("{rule} (d, {figure})")));
     }
     out.push('\n');
     let fig = |d: Option<f32>, v: Option<f64>, within: bool| match (d, v) {

@@ -32,15 +32,15 @@ pub const BIAS_OF_RADIUS: f32 = 0.02;
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args, Deserialize, Serialize)]
 #[serde(default, rename_all = "kebab-case")]
 pub struct ShadowArgs {
-    /// One directional shadow map in every scene but the unified ones: on or off.
-    #[arg(long, value_enum, default_value_t = crate::effects::OnOff::Off)]
+    /// One directional shadow map in every scene but the unified ones.
+    #[arg(long, value_enum, default_value_t = crate::effects::OnOff::Off,
+          help_heading = crate::defaults::heading::EFFECTS)]
     pub shadows: crate::effects::OnOff,
     /// With --shadows on: the shadow map's side in texels.
-    #[arg(long, default_value_t = 1024)]
+    #[arg(long, default_value_t = 1024, help_heading = crate::defaults::heading::EFFECTS)]
     pub shadow_size: u32,
-    /// With --shadows on: what a t-instance casts: `follow` (what the method draws: dithered LODs for the
-    /// blending methods, discrete's shown LOD, FSI's buffer's LODs), `lod-from` or `lod-to`.
-    #[arg(long, value_enum, default_value_t = ShadowLod::Follow)]
+    /// With --shadows on: what a t-instance casts (follow: what the method draws).
+    #[arg(long, value_enum, default_value_t = ShadowLod::Follow, help_heading = crate::defaults::heading::EFFECTS)]
     pub shadow_lod: ShadowLod,
 }
 

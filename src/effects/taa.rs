@@ -21,17 +21,17 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args, Deserialize, Serialize)]
 #[serde(default, rename_all = "kebab-case")]
 pub struct TaaArgs {
-    /// Temporal anti-aliasing after every frame of every method and the reference: on or off.
-    #[arg(long, value_enum, default_value_t = OnOff::Off)]
+    /// Temporal anti-aliasing after every frame of every method and the reference.
+    #[arg(long, value_enum, default_value_t = OnOff::Off, help_heading = crate::defaults::heading::EFFECTS)]
     pub taa: OnOff,
-    /// With --taa on: the current frame's weight in the history (default 0.1, O3DE's).
-    #[arg(long, default_value_t = 0.1)]
+    /// With --taa on: the current frame's weight in the history (0.1 is O3DE's).
+    #[arg(long, default_value_t = 0.1, help_heading = crate::defaults::heading::EFFECTS)]
     pub taa_alpha: f32,
-    /// With --taa on: length of the Halton (2, 3) jitter sequence (default 8, Unreal Engine 4's).
-    #[arg(long, default_value_t = 8)]
+    /// With --taa on: length of the Halton (2, 3) jitter sequence (8 is Unreal Engine 4's).
+    #[arg(long, default_value_t = 8, help_heading = crate::defaults::heading::EFFECTS)]
     pub taa_samples: u32,
-    /// With --taa on: clamp the history to the current frame's 3x3 neighbourhood (min/max), on or off.
-    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    /// With --taa on: clamp the history to the current frame's 3x3 neighbourhood (min/max).
+    #[arg(long, value_enum, default_value_t = OnOff::On, help_heading = crate::defaults::heading::EFFECTS)]
     pub taa_clamp: OnOff,
 }
 

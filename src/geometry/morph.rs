@@ -24,6 +24,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 )]
 #[serde(rename_all = "lowercase")]
 pub enum Correspondence {
+    /// `surface` on a user's glTF file, `nearest` (the paper's) on the built-in scenes.
+    Auto,
     /// Nearest coarse vertex, normals in the distance (Sheliemietiev et al. 2023 section 11).
     Nearest,
     /// Nearest coarse vertex by position alone (lambda = 0): the ablation of the normal term, which section 11
@@ -31,6 +33,19 @@ pub enum Correspondence {
     NearestPosition,
     /// Closest point on the coarse surface.
     Surface,
+}
+
+impl Correspondence {
+    /// `auto` resolved for a scene: `surface` on a user's file (`user_file`), whose textured, hard-edged models
+    /// the nearest vertex folds (on Avocado, DamagedHelmet and Fox `surface` pops least: docs/methods.md,
+    /// "geomorph"), else `nearest`, the paper's, which the bunny experiments reproduce.
+    pub fn resolve(self, user_file: bool) -> Correspondence {
+        match self {
+            Correspondence::Auto if user_file => Correspondence::Surface,
+            Correspondence::Auto => Correspondence::Nearest,
+            other => other,
+        }
+    }
 }
 
 /// Per fine vertex: where it goes on the coarse LOD, and the normal it has there.
@@ -42,6 +57,10 @@ pub struct MorphTargets {
     /// with weight 1; a surface point: its triangle's corners with barycentric weights), so that a target
     /// follows the coarse mesh when it deforms ([`MorphTargets::follow`]).
     pub sources: Vec<[(u32, f32); 3]>,
+    /// Per fine vertex, the coarse vertices its texture coordinates, tangent and colour go to, and their
+    /// weights: from the fine vertex's own texture chart ([`surface_sources`]); `sources` where the meshes have
+    /// no texture coordinates.
+    pub surface: Vec<[(u32, f32); 3]>,
 }
 
 impl MorphTargets {
@@ -80,11 +99,13 @@ pub fn morph_targets(fine: &Mesh, coarse: &Mesh, how: Correspondence) -> Arc<Mor
     if let Some(t) = cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
         return t;
     }
-    let t = Arc::new(match how {
-        Correspondence::Nearest => nearest_vertex(fine, coarse),
+    let mut t = match how {
+        Correspondence::Nearest | Correspondence::Auto => nearest_vertex(fine, coarse),
         Correspondence::NearestPosition => nearest_vertex_weighted(fine, coarse, 0.0),
         Correspondence::Surface => closest_surface(fine, coarse),
-    });
+    };
+    t.surface = surface_sources(fine, coarse, &t);
+    let t = Arc::new(t);
     if let Ok(mut c) = cache.lock() {
         c.insert(key, t.clone());
     }
@@ -107,6 +128,7 @@ pub fn morph_targets_by_material(
         positions: fine.positions.clone(),
         normals: fine.normals.clone(),
         sources: vec![[(0, 0.0); 3]; fine.positions.len()],
+        surface: vec![[(0, 0.0); 3]; fine.positions.len()],
     };
     for part in &fine.parts {
         let (sub_fine, fine_order) = sub_mesh(fine, part.material);
@@ -121,6 +143,7 @@ pub fn morph_targets_by_material(
             out.positions[v] = t.positions[k];
             out.normals[v] = t.normals[k];
             out.sources[v] = t.sources[k].map(|(i, w)| (coarse_order[i as usize], w));
+            out.surface[v] = t.surface[k].map(|(i, w)| (coarse_order[i as usize], w));
         }
     }
     Arc::new(out)
@@ -149,7 +172,10 @@ fn sub_mesh(mesh: &Mesh, material: u32) -> (Mesh, Vec<u32>) {
         normals: pick(&mesh.normals),
         indices,
         aux: order.iter().map(|&i| mesh.aux[i as usize]).collect(),
-        data: Default::default(),
+        data: crate::geometry::attributes::VertexData {
+            deform: None,
+            ..mesh.data.gather(&order)
+        },
         parts: Vec::new(),
     };
     (sub, order)
@@ -160,6 +186,11 @@ fn mesh_hash(m: &Mesh) -> u64 {
     bytemuck::cast_slice::<_, u8>(&m.positions).hash(&mut h);
     bytemuck::cast_slice::<_, u8>(&m.normals).hash(&mut h);
     m.indices.hash(&mut h);
+    for uv in [&m.data.uv0, &m.data.uv1] {
+        uv.as_deref()
+            .map(bytemuck::cast_slice::<_, u8>)
+            .hash(&mut h);
+    }
     h.finish()
 }
 
@@ -184,32 +215,273 @@ pub fn nearest_vertex(fine: &Mesh, coarse: &Mesh) -> MorphTargets {
 }
 
 /// Nearest coarse vertex under `|p - q|^2 + (lambda |n_p - n_q|)^2` for a given `lambda` (0: position alone).
+///
+/// The search is over positions, not vertices: where a mesh splits a position into several vertices (its
+/// wedges: a texture seam, a hard edge), the wedges of a fine position all take one target position, the
+/// coarse position nearest under the metric with each side's normal the mean of its wedges', so the morph opens
+/// no crack along a seam. Which coarse wedge at that position each fine wedge takes its normal (and texture
+/// coordinates) from is then [`nearest_wedge`]'s choice.
 pub fn nearest_vertex_weighted(fine: &Mesh, coarse: &Mesh, lambda: f32) -> MorphTargets {
-    let pts: Vec<Vec3> = coarse.positions.iter().map(v).collect();
-    let nrm: Vec<Vec3> = coarse.normals.iter().map(v).collect();
+    let coarse_points = Points::of(coarse);
+    let fine_points = Points::of(fine);
+    let pts = &coarse_points.positions;
+    let nrm = &coarse_points.normals;
     let mut idx: Vec<u32> = (0..pts.len() as u32).collect();
-    kd_build(&pts, &mut idx, 0);
+    kd_build(pts, &mut idx, 0);
+    // Per fine position, the coarse position it goes to.
+    let goes_to: Vec<u32> = fine_points
+        .positions
+        .iter()
+        .zip(&fine_points.normals)
+        .map(|(&p, &n)| {
+            let metric = |j: u32| {
+                let j = j as usize;
+                pts[j].distance_squared(p) + lambda * lambda * nrm[j].distance_squared(n)
+            };
+            let mut best = (f32::INFINITY, u32::MAX);
+            kd_search(pts, &idx, 0, p, &metric, &mut best);
+            best.1
+        })
+        .collect();
     let mut positions = Vec::with_capacity(fine.positions.len());
     let mut normals = Vec::with_capacity(fine.positions.len());
     let mut sources = Vec::with_capacity(fine.positions.len());
-    for (p, n) in fine.positions.iter().zip(&fine.normals) {
-        let (p, n) = (v(p), v(n));
-        let metric = |j: u32| {
-            let j = j as usize;
-            pts[j].distance_squared(p) + lambda * lambda * nrm[j].distance_squared(n)
-        };
-        let mut best = (f32::INFINITY, u32::MAX);
-        kd_search(&pts, &idx, 0, p, &metric, &mut best);
-        let j = best.1 as usize;
-        positions.push(coarse.positions[j]);
-        normals.push(coarse.normals[j]);
-        sources.push([(j as u32, 1.0), (j as u32, 0.0), (j as u32, 0.0)]);
+    for k in 0..fine.vertex_count() {
+        let point = goes_to[fine_points.of_vertex[k] as usize] as usize;
+        let j = nearest_wedge(fine, k, coarse, &coarse_points.wedges[point]);
+        positions.push(coarse.positions[j as usize]);
+        normals.push(coarse.normals[j as usize]);
+        sources.push([(j, 1.0), (j, 0.0), (j, 0.0)]);
     }
     MorphTargets {
         positions,
         normals,
         sources,
+        surface: Vec::new(),
     }
+}
+
+/// Per fine vertex, the coarse vertices its texture coordinates, tangent and colour go to (with weights), from
+/// the fine vertex's own texture chart.
+///
+/// A chart ([`charts`]) is a part of the surface whose texture coordinates are continuous. The attribute-aware
+/// simplifier keeps charts apart, so each chart of the fine mesh has one on the coarse mesh: the coarse chart
+/// holding the most of its vertices that the coarse mesh kept with the same texture coordinates (or, for a chart
+/// with none kept, the charts of the wedges nearest in attributes at its vertices' targets). A target's source
+/// at a position where its chart has a wedge is that wedge (the nearest in attributes of the chart's); where the
+/// target position lies in another chart (across a seam: its chart ends short of it on the coarse mesh), the
+/// attributes are those of the closest point to the target on the chart's own coarse triangles. Either way the
+/// texture coordinates stay in the vertex's part of the texture, so the morph does not sweep them across the
+/// atlas; the price at such a vertex is that its position and texture coordinates come from points up to a
+/// seam's width apart. Meshes without texture coordinates keep the targets' own sources.
+pub fn surface_sources(fine: &Mesh, coarse: &Mesh, t: &MorphTargets) -> Vec<[(u32, f32); 3]> {
+    if fine.data.uv0.is_none() || coarse.data.uv0.is_none() {
+        return t.sources.clone();
+    }
+    let (fine_chart, fine_charts) = charts(fine);
+    let (coarse_chart, _) = charts(coarse);
+    let points = Points::of(coarse);
+    let at = |p: &[f32; 3]| {
+        let key = p.map(f32::to_bits);
+        points.index.get(&key).copied()
+    };
+    // The coarse chart of each fine chart: kept vertices' votes first, the targets' nearest wedges otherwise.
+    let mut kept: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut near: HashMap<(u32, u32), u32> = HashMap::new();
+    for (k, &fc) in fine_chart.iter().enumerate() {
+        if let Some(pt) = at(&fine.positions[k]) {
+            let j = nearest_wedge(fine, k, coarse, &points.wedges[pt as usize]);
+            if attribute_distance(fine, k, coarse, j as usize) < 1e-10 {
+                *kept.entry((fc, coarse_chart[j as usize])).or_default() += 1;
+            }
+        }
+        let (i, _) = main_source(&t.sources[k]);
+        let pt = points.of_vertex[i as usize] as usize;
+        let j = nearest_wedge(fine, k, coarse, &points.wedges[pt]);
+        *near.entry((fc, coarse_chart[j as usize])).or_default() += 1;
+    }
+    let vote = |votes: &HashMap<(u32, u32), u32>| {
+        let mut best: Vec<Option<(u32, u32)>> = vec![None; fine_charts];
+        let mut keys: Vec<_> = votes.iter().collect();
+        keys.sort();
+        for (&(fc, cc), &n) in keys {
+            let b = &mut best[fc as usize];
+            if b.is_none_or(|(_, m)| n > m) {
+                *b = Some((cc, n));
+            }
+        }
+        best
+    };
+    let (by_kept, by_near) = (vote(&kept), vote(&near));
+    let chart_of = |fc: u32| by_kept[fc as usize].or(by_near[fc as usize]).map(|b| b.0);
+    let mut bvhs: HashMap<u32, (Mesh, Bvh)> = HashMap::new();
+    (0..fine.vertex_count())
+        .map(|k| {
+            let Some(chart) = chart_of(fine_chart[k]) else {
+                return t.sources[k];
+            };
+            let own = |i: u32| -> Option<u32> {
+                let pt = points.of_vertex[i as usize] as usize;
+                let mine: Vec<u32> = points.wedges[pt]
+                    .iter()
+                    .copied()
+                    .filter(|&j| coarse_chart[j as usize] == chart)
+                    .collect();
+                (!mine.is_empty()).then(|| nearest_wedge(fine, k, coarse, &mine))
+            };
+            let within: Option<Vec<(u32, f32)>> = t.sources[k]
+                .iter()
+                .map(|&(i, w)| {
+                    if w == 0.0 {
+                        Some((i, w))
+                    } else {
+                        own(i).map(|j| (j, w))
+                    }
+                })
+                .collect();
+            if let Some(w) = within {
+                return [w[0], w[1], w[2]];
+            }
+            let (mesh, bvh) = bvhs.entry(chart).or_insert_with(|| {
+                let mut m = Mesh {
+                    positions: coarse.positions.clone(),
+                    normals: coarse.normals.clone(),
+                    indices: Vec::new(),
+                    aux: Vec::new(),
+                    data: Default::default(),
+                    parts: Vec::new(),
+                };
+                for tri in coarse.indices.chunks_exact(3) {
+                    if coarse_chart[tri[0] as usize] == chart {
+                        m.indices.extend_from_slice(tri);
+                    }
+                }
+                let bvh = Bvh::new(&m);
+                (m, bvh)
+            });
+            let (tri, _, bary) = bvh.closest(mesh, v(&t.positions[k]));
+            [0, 1, 2].map(|c| (mesh.indices[tri * 3 + c], bary[c]))
+        })
+        .collect()
+}
+
+/// The source of largest weight.
+fn main_source(src: &[(u32, f32); 3]) -> (u32, f32) {
+    src.iter()
+        .copied()
+        .fold(src[0], |a, b| if b.1 > a.1 { b } else { a })
+}
+
+/// Per vertex, its texture chart, and the number of charts: vertices joined by a triangle, or sharing a
+/// position and both sets of texture coordinates (a hard edge splits the normals, not the chart), are in one
+/// chart.
+pub fn charts(m: &Mesh) -> (Vec<u32>, usize) {
+    let n = m.vertex_count();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn root(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            parent[i as usize] = parent[parent[i as usize] as usize];
+            i = parent[i as usize];
+        }
+        i
+    }
+    let join = |parent: &mut Vec<u32>, a: u32, b: u32| {
+        let (ra, rb) = (root(parent, a), root(parent, b));
+        if ra != rb {
+            parent[ra.max(rb) as usize] = ra.min(rb);
+        }
+    };
+    for tri in m.indices.chunks_exact(3) {
+        join(&mut parent, tri[0], tri[1]);
+        join(&mut parent, tri[1], tri[2]);
+    }
+    let uv = |set: &Option<Vec<[f32; 2]>>, i: usize| {
+        set.as_ref().map_or([0; 2], |u| u[i].map(f32::to_bits))
+    };
+    // A vertex's position and texture coordinates (both sets), as bits.
+    type Wedge = ([u32; 3], [u32; 2], [u32; 2]);
+    let mut same: HashMap<Wedge, u32> = HashMap::new();
+    for i in 0..n {
+        let key = (
+            m.positions[i].map(f32::to_bits),
+            uv(&m.data.uv0, i),
+            uv(&m.data.uv1, i),
+        );
+        let first = *same.entry(key).or_insert(i as u32);
+        join(&mut parent, first, i as u32);
+    }
+    let mut ids: HashMap<u32, u32> = HashMap::new();
+    let chart = (0..n as u32)
+        .map(|i| {
+            let r = root(&mut parent, i);
+            let next = ids.len() as u32;
+            *ids.entry(r).or_insert(next)
+        })
+        .collect();
+    (chart, ids.len())
+}
+
+/// A mesh's distinct positions: each with the mean of its vertices' normals (normalised; the first vertex's
+/// where they cancel) and its vertices (its wedges), and per vertex its position's index.
+struct Points {
+    index: HashMap<[u32; 3], u32>,
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    wedges: Vec<Vec<u32>>,
+    of_vertex: Vec<u32>,
+}
+
+impl Points {
+    fn of(m: &Mesh) -> Points {
+        let mut at: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut points = Points {
+            index: HashMap::new(),
+            positions: Vec::new(),
+            normals: Vec::new(),
+            wedges: Vec::new(),
+            of_vertex: Vec::with_capacity(m.vertex_count()),
+        };
+        for (i, p) in m.positions.iter().enumerate() {
+            let slot = *at.entry(p.map(f32::to_bits)).or_insert_with(|| {
+                points.positions.push(v(p));
+                points.normals.push(Vec3::ZERO);
+                points.wedges.push(Vec::new());
+                points.positions.len() as u32 - 1
+            });
+            points.normals[slot as usize] += v(&m.normals[i]);
+            points.wedges[slot as usize].push(i as u32);
+            points.of_vertex.push(slot);
+        }
+        for (n, w) in points.normals.iter_mut().zip(&points.wedges) {
+            *n = n.try_normalize().unwrap_or(v(&m.normals[w[0] as usize]));
+        }
+        points.index = at;
+        points
+    }
+}
+
+/// Of the coarse vertices `wedges` (one position's), the one whose attributes are nearest fine vertex `k`'s:
+/// the squared distance between the normals plus that between the texture coordinates (both sets, where the
+/// meshes have them); the lowest index of a tie.
+fn nearest_wedge(fine: &Mesh, k: usize, coarse: &Mesh, wedges: &[u32]) -> u32 {
+    let cost = |j: u32| attribute_distance(fine, k, coarse, j as usize);
+    wedges
+        .iter()
+        .copied()
+        .min_by(|&a, &b| cost(a).total_cmp(&cost(b)).then(a.cmp(&b)))
+        .unwrap_or(wedges[0])
+}
+
+/// The squared distance between fine vertex `k`'s normal and coarse vertex `j`'s plus that between their
+/// texture coordinates (both sets, where the meshes have them).
+fn attribute_distance(fine: &Mesh, k: usize, coarse: &Mesh, j: usize) -> f32 {
+    let tex = |m: &Mesh, i: usize| {
+        let a = m.data.uv0.as_ref().map_or([0.0; 2], |u| u[i]);
+        let b = m.data.uv1.as_ref().map_or([0.0; 2], |u| u[i]);
+        glam::Vec4::new(a[0], a[1], b[0], b[1])
+    };
+    v(&coarse.normals[j]).distance_squared(v(&fine.normals[k]))
+        + tex(coarse, j).distance_squared(tex(fine, k))
 }
 
 fn kd_build(pts: &[Vec3], idx: &mut [u32], depth: usize) {
@@ -260,15 +532,23 @@ fn kd_search(
     }
 }
 
-/// Closest point on the coarse surface, normal interpolated there.
+/// Closest point on the coarse surface, normal interpolated there. The point is found by position alone, so the
+/// wedges of a fine position (a seam, a hard edge) all take it; each corner of its triangle is then the coarse
+/// wedge at that corner's position nearest the fine vertex's attributes ([`nearest_wedge`]), so a vertex of one
+/// texture chart takes its normal and texture coordinates from its own chart's side of a seam.
 pub fn closest_surface(fine: &Mesh, coarse: &Mesh) -> MorphTargets {
     let bvh = Bvh::new(coarse);
+    let coarse_points = Points::of(coarse);
     let mut positions = Vec::with_capacity(fine.positions.len());
     let mut normals = Vec::with_capacity(fine.positions.len());
     let mut sources = Vec::with_capacity(fine.positions.len());
-    for p in &fine.positions {
+    for (k, p) in fine.positions.iter().enumerate() {
         let (tri, point, bary) = bvh.closest(coarse, v(p));
-        let t = &coarse.indices[tri * 3..tri * 3 + 3];
+        let t = [0, 1, 2].map(|c| {
+            let corner = coarse.indices[tri * 3 + c] as usize;
+            let wedges = &coarse_points.wedges[coarse_points.of_vertex[corner] as usize];
+            nearest_wedge(fine, k, coarse, wedges)
+        });
         let n = v(&coarse.normals[t[0] as usize]) * bary[0]
             + v(&coarse.normals[t[1] as usize]) * bary[1]
             + v(&coarse.normals[t[2] as usize]) * bary[2];
@@ -286,6 +566,7 @@ pub fn closest_surface(fine: &Mesh, coarse: &Mesh) -> MorphTargets {
         positions,
         normals,
         sources,
+        surface: Vec::new(),
     }
 }
 
@@ -467,6 +748,104 @@ mod tests {
     fn chain() -> LodChain {
         let m = Mesh::parse_obj("bunny", BUNNY_OBJ).unwrap();
         LodChain::build("bunny", &m, &DEFAULT_TARGETS).unwrap()
+    }
+
+    /// A flat strip in z = 0, y in [0, 1], with a texture seam at x = 1: chart A (x <= 1) maps u = x / 2 (the
+    /// atlas's left half), chart B (x >= 1) u = 1 - (x - 1) / 4 (its right edge, mirrored). A column at each of
+    /// `xs` (the seam's column twice, once per chart), a quad between neighbours of one chart.
+    fn seamed_strip(xs: &[f32]) -> Mesh {
+        let (mut positions, mut uv, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+        // Chart B first: a tie between the seam's wedges that went to the lowest index would take B's.
+        for (chart, range) in [(1, (1.0, 2.0)), (0, (0.0, 1.0))] {
+            let cols: Vec<f32> = xs
+                .iter()
+                .copied()
+                .filter(|&x| x >= range.0 && x <= range.1)
+                .collect();
+            let first = positions.len() as u32;
+            for &x in &cols {
+                let u = if chart == 0 {
+                    x / 2.0
+                } else {
+                    1.0 - (x - 1.0) / 4.0
+                };
+                for y in [0.0, 1.0] {
+                    positions.push([x, y, 0.0]);
+                    uv.push([u, y]);
+                }
+            }
+            for c in 0..cols.len() as u32 - 1 {
+                let (a, b) = (first + 2 * c, first + 2 * c + 2);
+                indices.extend_from_slice(&[a, b, a + 1, b, b + 1, a + 1]);
+            }
+        }
+        Mesh {
+            normals: vec![[0.0, 0.0, 1.0]; positions.len()],
+            aux: vec![[0.0; 4]; positions.len()],
+            positions,
+            indices,
+            data: crate::geometry::attributes::VertexData {
+                uv0: Some(uv),
+                ..Default::default()
+            },
+            parts: Vec::new(),
+        }
+    }
+
+    /// Across a texture seam, the wedges of one fine position take one target position (no crack opens), and
+    /// each fine vertex takes its texture coordinates from its own chart's coarse vertices, under every
+    /// correspondence: a vertex of chart A near the seam, whose nearest coarse position is the seam's, takes the
+    /// seam's chart-A wedge, not chart B's at the other end of the atlas.
+    #[test]
+    fn seams_keep_one_position_and_each_charts_coordinates() {
+        let fine = seamed_strip(&[0.0, 0.4, 0.8, 1.0, 1.2, 1.6, 2.0]);
+        let coarse = seamed_strip(&[0.0, 1.0, 2.0]);
+        let (fc, n) = charts(&fine);
+        assert_eq!(n, 2, "{fc:?}");
+        assert_eq!(charts(&coarse).1, 2);
+        let uv = |m: &Mesh, src: &[(u32, f32); 3]| {
+            src.iter().fold(glam::Vec2::ZERO, |a, &(i, w)| {
+                a + glam::Vec2::from(m.data.uv0.as_ref().unwrap()[i as usize]) * w
+            })
+        };
+        for how in [
+            Correspondence::Nearest,
+            Correspondence::NearestPosition,
+            Correspondence::Surface,
+        ] {
+            let t = morph_targets(&fine, &coarse, how);
+            for k in 0..fine.vertex_count() {
+                for j in 0..fine.vertex_count() {
+                    if fine.positions[k] == fine.positions[j] {
+                        assert_eq!(t.positions[k], t.positions[j], "{how:?}: {k} and {j}");
+                    }
+                }
+                // Chart A's coordinates are in [0, 0.5], chart B's in [0.75, 1].
+                let u = uv(&coarse, &t.surface[k]).x;
+                let mine = fine.data.uv0.as_ref().unwrap()[k][0];
+                assert_eq!(
+                    u <= 0.5,
+                    mine <= 0.5,
+                    "{how:?}: vertex {k} (u {mine}) goes to u {u}"
+                );
+            }
+            // The chart-A vertex at x = 0.8 goes to the seam's position (the nearest vertex) or stays where it
+            // is (the surface under it), at chart A's u there either way.
+            let k = fine.positions.iter().position(|p| p[0] == 0.8).unwrap();
+            let x = t.positions[k][0];
+            assert_eq!(
+                x,
+                if how == Correspondence::Surface {
+                    0.8
+                } else {
+                    1.0
+                }
+            );
+            assert!(
+                (uv(&coarse, &t.surface[k]).x - x / 2.0).abs() < 1e-6,
+                "{how:?}"
+            );
+        }
     }
 
     /// A target follows its coarse mesh: posed as it is, every correspondence gives back its own targets;

@@ -27,12 +27,33 @@ pub struct SurfaceVertex {
     pub color: [f32; 4],
 }
 
-/// geomorph's target of a vertex's material attributes on the coarser LOD (slot 4 with the PBR surface).
+/// geomorph's target of a vertex's material attributes on the coarser LOD (slot 4 with the PBR surface): its
+/// texture coordinates, and its tangent and colour packed into one attribute (`packed`: the tangent's xyz as
+/// 16-bit snorm in x and y's low half, the linear RGBA colour as 16-bit unorm in z and w), since a pipeline
+/// with the PBR surface and morph targets already uses 15 of the 16 vertex attributes wgpu allows.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct SurfaceTarget {
     pub tex: [f32; 4],
-    pub tangent: [f32; 4],
+    pub packed: [u32; 4],
+}
+
+impl SurfaceTarget {
+    /// The target of texture coordinates `tex`, unit tangent `tangent` and linear colour `color` (clamped to
+    /// [0, 1]); `shaders/surface/pbr.wgsl` unpacks it with unpack2x16snorm and unpack2x16unorm.
+    pub fn new(tex: [f32; 4], tangent: [f32; 3], color: [f32; 4]) -> Self {
+        let snorm = |v: f32| (v.clamp(-1.0, 1.0) * 32767.0).round() as i16 as u16 as u32;
+        let unorm = |v: f32| (v.clamp(0.0, 1.0) * 65535.0).round() as u32;
+        SurfaceTarget {
+            tex,
+            packed: [
+                snorm(tangent[0]) | snorm(tangent[1]) << 16,
+                snorm(tangent[2]),
+                unorm(color[0]) | unorm(color[1]) << 16,
+                unorm(color[2]) | unorm(color[3]) << 16,
+            ],
+        }
+    }
 }
 
 /// The part of the mesh shader that is the scene's surface (shaders/surface/).
@@ -266,7 +287,7 @@ fn mesh_vertex_buffers(
     const SURFACE: [wgpu::VertexAttribute; 3] =
         wgpu::vertex_attr_array![11 => Float32x4, 12 => Float32x4, 13 => Float32x4];
     const SURFACE_MORPH: [wgpu::VertexAttribute; 2] =
-        wgpu::vertex_attr_array![14 => Float32x4, 15 => Float32x4];
+        wgpu::vertex_attr_array![14 => Float32x4, 15 => Uint32x4];
     let [vertex, instance] = vertex_layouts();
     let morph = wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<Vertex>() as u64,

@@ -45,6 +45,35 @@ pub struct FrameFacts {
     pub t_waiting: u32,
 }
 
+/// The fewest frames any instance of `scene` spends in one transition along its path, counting only the
+/// transitions that begin and end on the path (one cut by its first or last frame is no measure of the room a
+/// method had); None when no transition does. The schedule is every method's, so this is the block's.
+pub fn shortest_transition(scene: &Scene) -> Option<u32> {
+    let mut driver = FrameDriver::new(scene);
+    // Per instance: the frame its current transition began on, None while steady or in one begun on frame 0.
+    let mut began: Vec<Option<u32>> = vec![None; scene.instances.len()];
+    let mut was: Vec<bool> = vec![false; scene.instances.len()];
+    let mut shortest: Option<u32> = None;
+    for frame in 0..scene.frames {
+        driver.advance(frame);
+        for (i, s) in driver.states.iter().enumerate() {
+            let now = s.in_transition();
+            match (was[i], now) {
+                (false, true) if frame > 0 => began[i] = Some(frame),
+                (true, false) => {
+                    if let Some(b) = began[i].take() {
+                        let n = frame - b;
+                        shortest = Some(shortest.map_or(n, |m| m.min(n)));
+                    }
+                }
+                _ => {}
+            }
+            was[i] = now;
+        }
+    }
+    shortest
+}
+
 impl<'s> FrameDriver<'s> {
     pub fn new(scene: &'s Scene) -> Self {
         let n = scene.instances.len();

@@ -32,7 +32,7 @@ pub mod switch_tuning;
 
 pub use block::{BlockOutput, BlockRunner, DumpPolicy};
 pub use block_gpu::{BlockGpu, MethodSetup};
-pub use driver::{FrameDriver, FrameFacts};
+pub use driver::{shortest_transition, FrameDriver, FrameFacts};
 pub use quality::{FrameImages, QualityOptions, QualitySchedule, QualityStage};
 pub use records::{BlockRounds, Round};
 pub use rounds::{round_frames, shuffled_order, Prepared, TimedMethod, Uploads, WarmUpPlan};

@@ -18,9 +18,9 @@ use wgpu::util::DeviceExt;
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
 #[serde(default, rename_all(deserialize = "kebab-case"))]
 pub struct ClusterLodOptions {
-    /// clusterlod: what a group's distance to the camera is measured to: `sphere` (meshoptimizer's rule; a
-    /// camera inside a group's sphere is at the near plane) or `box` (the group's box, unioned up the DAG).
-    #[arg(long, value_enum, default_value_t = CutBound::Sphere)]
+    /// clusterlod: what a group's distance to the camera is measured to: its sphere or its box.
+    #[arg(long, value_enum, value_parser = crate::defaults::names_only::<CutBound>(),
+          default_value_t = CutBound::Sphere, help_heading = crate::defaults::heading::METHODS)]
     pub cluster_bound: CutBound,
 }
 

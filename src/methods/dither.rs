@@ -20,13 +20,12 @@ use crate::scene::Scene;
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
 #[serde(default, rename_all(deserialize = "kebab-case"))]
 pub struct DitherOptions {
-    /// Threshold pattern of noise blending (`dither`).
-    #[arg(long, value_enum, default_value_t = NoisePattern::White16)]
+    /// dither: the threshold pattern of noise blending.
+    #[arg(long, value_enum, value_parser = crate::defaults::names_only::<NoisePattern>(),
+          default_value_t = NoisePattern::White16, help_heading = crate::defaults::heading::METHODS)]
     pub noise: NoisePattern,
-    /// dither: move the pattern every frame, as engines do under TAA so the history averages the two LODs
-    /// (tiled patterns: shifted by the Halton (2, 3) point of the frame, times the tile; ign: Jimenez's
-    /// offset of 5.588238 pixels a frame along x and y, over 64 frames). Default: a fixed pattern (Sheliemietiev et al. 2023).
-    #[arg(long)]
+    /// dither: move the pattern every frame, as engines do under TAA (default: a fixed pattern).
+    #[arg(long, help_heading = crate::defaults::heading::METHODS)]
     pub noise_temporal: bool,
 }
 

@@ -1,6 +1,8 @@
 //! `geomorph`: geomorphing between discrete LODs (Sheliemietiev et al. 2023 sections 10-11). A t-instance draws one mesh, the
 //! finer of its two LODs, whose vertices the vertex shader moves towards their targets on the coarser LOD by the
-//! morph weight (k when coarsening, 1 - k when refining), normals interpolated and renormalised. When the
+//! morph weight (k when coarsening, 1 - k when refining), normals interpolated and renormalised, and with a
+//! user scene's materials its texture coordinates, tangents and colours too, each from the texture chart the
+//! vertex lies in (geometry/morph.rs). When the
 //! transition ends the coarser LOD itself replaces the fully morphed finer one; what that swap leaves is
 //! measured by the `pop` column on those frames. Targets come from `--correspondence` (`src/geometry/morph.rs`), computed
 //! once per LOD pair and cached.
@@ -24,8 +26,9 @@ const MORPHING: u8 = 1;
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
 #[serde(default, rename_all(deserialize = "kebab-case"))]
 pub struct GeomorphOptions {
-    /// Vertex correspondence of geomorphing (`geomorph`).
-    #[arg(long, value_enum, default_value_t = Correspondence::Nearest)]
+    /// geomorph: how fine vertices are paired with the coarse LOD.
+    #[arg(long, value_enum, value_parser = crate::defaults::names_only::<Correspondence>(),
+          default_value_t = Correspondence::Auto, help_heading = crate::defaults::heading::METHODS)]
     pub correspondence: Correspondence,
 }
 
@@ -69,7 +72,7 @@ impl Geomorph {
                         let t = morph_targets_by_material(
                             &lod.mesh,
                             &coarse.mesh,
-                            options.correspondence,
+                            options.correspondence.resolve(scene.kind.is_user()),
                         );
                         if with_surface {
                             surface.extend(surface_targets(&lod.mesh, &coarse.mesh, &t));
@@ -94,10 +97,8 @@ impl Geomorph {
                         if with_surface {
                             surface.extend((0..lod.mesh.vertex_count()).map(|v| {
                                 let s = crate::gpu::surface_vertex(&lod.mesh, v);
-                                SurfaceTarget {
-                                    tex: s.tex,
-                                    tangent: s.tangent,
-                                }
+                                let t = [s.tangent[0], s.tangent[1], s.tangent[2]];
+                                SurfaceTarget::new(s.tex, t, s.color)
                             }));
                         }
                     }
@@ -136,32 +137,31 @@ impl Geomorph {
     }
 }
 
-/// Per vertex of `fine`, the texture coordinates and tangent at its target on `coarse` (the coarse vertices'
-/// interpolated by the target's weights; the tangent renormalised, its sign the fine vertex's).
+/// Per vertex of `fine`, the texture coordinates, tangent and colour at its target on `coarse`: the coarse
+/// vertices' of the target's sources (each the wedge of the fine vertex's texture chart at its position,
+/// `geometry/morph.rs`) interpolated by their weights; the tangent renormalised (the fine vertex's where the
+/// interpolation cancels).
 fn surface_targets(fine: &Mesh, coarse: &Mesh, t: &MorphTargets) -> Vec<SurfaceTarget> {
     let of = |m: &Mesh, v: usize| crate::gpu::surface_vertex(m, v);
-    t.sources
+    t.surface
         .iter()
         .enumerate()
         .map(|(k, src)| {
             let mine = of(fine, k);
-            let (mut tex, mut tangent) = ([0.0f32; 4], glam::Vec3::ZERO);
+            let (mut tex, mut tangent, mut color) =
+                (glam::Vec4::ZERO, glam::Vec3::ZERO, glam::Vec4::ZERO);
             for &(i, w) in src {
                 if w != 0.0 {
                     let c = of(coarse, i as usize);
-                    for (a, b) in tex.iter_mut().zip(c.tex) {
-                        *a += b * w;
-                    }
+                    tex += glam::Vec4::from(c.tex) * w;
                     tangent += glam::Vec3::from_slice(&c.tangent[..3]) * w;
+                    color += glam::Vec4::from(c.color) * w;
                 }
             }
             let tangent = tangent
                 .try_normalize()
                 .unwrap_or(glam::Vec3::from_slice(&mine.tangent[..3]));
-            SurfaceTarget {
-                tex,
-                tangent: [tangent.x, tangent.y, tangent.z, mine.tangent[3]],
-            }
+            SurfaceTarget::new(tex.to_array(), tangent.to_array(), color.to_array())
         })
         .collect()
 }

@@ -28,9 +28,9 @@ use wgpu::util::DeviceExt;
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
 #[serde(default, rename_all(deserialize = "kebab-case"))]
 pub struct RoamOptions {
-    /// roam-morph: frames over which a vertex a split adds moves from its edge's midpoint to its height (at
-    /// least 1).
-    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..))]
+    /// roam-morph: frames over which a vertex a split adds moves from its edge's midpoint to its height.
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..),
+          help_heading = crate::defaults::heading::METHODS)]
     pub roam_morph_frames: u32,
 }
 

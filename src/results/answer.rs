@@ -8,6 +8,9 @@
 //! - The candidates are the methods that show LOD transitions: every method but the references (`reference`,
 //!   `reference-flat`, ...), with a largest lodpop (none under `--quality off`).
 //! - The hard switch is `discrete` where it ran, else the baseline.
+//! - Where a transition of the block spans fewer than [`MIN_TRANSITION_FRAMES`] frames (summary.csv's
+//!   `transition_frames_min`), no blending method can have acted on it: one sentence says so and names no
+//!   method (a run of the hard switch alone is answered as usual).
 //! - The budget is `--budget-lodpop` where given (`lodbench tune`'s budget, say), else half the hard switch's
 //!   largest lodpop: a smooth method is there to take the hard switch's pop away, and one that does not halve it
 //!   has not done so; a fixed default would mean something else at every resolution (lodpop is an RMS over the
@@ -137,6 +140,9 @@ fn block_sentences(
         .find(|r| r.method == "discrete")
         .or_else(|| candidates.iter().find(|r| r.method == baseline))
         .copied();
+    if let Some(sentence) = no_room(name, rows, &candidates, hard) {
+        return vec![sentence];
+    }
     let mut out = Vec::new();
     // Least lodpop as the sentence shows it (3 figures), the cheaper of a tie.
     let shown = |r: &SummaryRecord| sig3(r.lodpop_max).parse::<f64>().unwrap_or(f64::INFINITY);
@@ -192,6 +198,35 @@ fn block_sentences(
         pairs,
     ));
     out
+}
+
+/// The fewest frames a transition must span for a blending method to act on it: over one frame a blend shows
+/// one of its two LODs whole, as the hard switch does.
+pub const MIN_TRANSITION_FRAMES: u32 = 2;
+
+/// Where some transition of the block spans fewer than [`MIN_TRANSITION_FRAMES`] frames (summary.csv's
+/// `transition_frames_min`) and a method other than the hard switch ran: the one sentence that says so, in
+/// place of a winner the run could not have found.
+fn no_room(
+    name: &str,
+    rows: &[&SummaryRecord],
+    candidates: &[&SummaryRecord],
+    hard: Option<&SummaryRecord>,
+) -> Option<String> {
+    let n = rows
+        .iter()
+        .find_map(|r| r.transition_frames_min)
+        .filter(|&n| n < MIN_TRANSITION_FRAMES)?;
+    let smooth = candidates
+        .iter()
+        .any(|r| hard.is_none_or(|h| h.method != r.method));
+    smooth.then(|| {
+        format!(
+            "{name}: a transition here lasts {n} frame (the camera crosses a switch's band within it), too few \
+             for a blending method to act, so this run cannot say which method pops least; give the transitions \
+             room with --fade time --fade-frames 8, or a slower path."
+        )
+    })
 }
 
 /// A block's cost order: ratio to the baseline, unmeasured last.
@@ -453,6 +488,34 @@ mod tests {
                  1.10 [1.05, 1.15] times discrete's frame time. dither ran 1.18 [1.10, 1.27] times faster than \
                  alpha, the next within it."
             ]
+        );
+    }
+
+    /// A transition of one frame leaves a blend no room: the answer says so and names no method; with two frames
+    /// (or a hard switch alone in the run) it answers as usual.
+    #[test]
+    fn a_transition_of_one_frame_names_no_method() {
+        let rows = |frames: u32| {
+            ["discrete", "alpha", "dither"].map(|m| {
+                let mut r = row("s", m, 0.004, (1.0, 1.0, 1.0));
+                r.transition_frames_min = Some(frames);
+                r
+            })
+        };
+        let a = answers(&rows(1), &[], None);
+        assert_eq!(
+            a[0].sentences,
+            ["s: a transition here lasts 1 frame (the camera crosses a switch's band within it), too few for a \
+              blending method to act, so this run cannot say which method pops least; give the transitions room \
+              with --fade time --fade-frames 8, or a slower path."]
+        );
+        assert!(
+            answers(&rows(MIN_TRANSITION_FRAMES), &[], None)[0].sentences[0].contains("pops least")
+        );
+        let alone = answers(&rows(1)[..1], &[], None);
+        assert!(
+            alone[0].sentences[0].contains("the only method"),
+            "{alone:?}"
         );
     }
 

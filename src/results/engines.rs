@@ -23,7 +23,8 @@
 //!   fades in and out): LOD k's `start_margin` is `s_k (1 - b) .. s_k (1 + b)` and its `end_margin` the next
 //!   switch's (LOD0 starts at `0..0`, the last LOD ends never).
 //! - **three.js** (`LOD.addLevel(object, distance)`, the distance to the LOD object's own position): LOD k at `s_k`
-//!   (LOD0 at 0); three.js does not blend, so the bands are not written (its `hysteresis` stays 0).
+//!   (LOD0 at 0), each level offset by minus the sphere's centre so the LOD object stands at the centre; three.js
+//!   does not blend, so the bands are not written (its `hysteresis` stays 0).
 
 use serde::{Deserialize, Serialize};
 
@@ -38,6 +39,9 @@ pub struct EngineModel {
     pub switches: Vec<f32>,
     /// Per switch, the blend band's half-width as a fraction of its distance (0: a hard switch).
     pub bands: Vec<f32>,
+    /// Triangles of LOD 0, 1, ... of the chain the switches are for (the usable LODs).
+    #[serde(default)]
+    pub triangles: Vec<u32>,
 }
 
 pub use crate::geometry::lod::{distance_of, screen_size};
@@ -219,29 +223,80 @@ pub fn from_bevy(ranges: &[BevyRange]) -> (Vec<f32>, Vec<f32>) {
         .unzip()
 }
 
-/// three.js: `LOD.addLevel(object, distance)` per LOD, as a script.
-pub fn threejs(m: &EngineModel) -> String {
-    let mut out = format!(
-        "// lodbench tune: {} (distances from its bounding sphere's centre, model space {:?}: place the LOD \
-         object there)\nconst lod = new THREE.LOD();\n",
-        m.name, m.center
+/// The table of models in threejs-lod.js, between these two lines.
+const THREE_TABLE_START: &str = "const lodbenchModels = ";
+const THREE_TABLE_END: &str = "; // end of lodbenchModels";
+
+/// three.js: a script that builds a `THREE.LOD` per model with `LOD.addLevel(object, distance)` (LOD0 at 0),
+/// runnable as a classic script in a page (it defines `lodbenchModels` and `lodbenchLod`) and with Node's
+/// `require`. three.js measures a LOD's distance from the LOD object's world position, lodbench's from the
+/// model's bounding-sphere centre: `lodbenchLod` wraps each level in a group moved by minus the centre, so the LOD
+/// object's position is that centre. `header`: comment lines on what the distances are for.
+pub fn threejs(models: &[EngineModel], header: &[String]) -> String {
+    let table: serde_json::Map<String, serde_json::Value> = models
+        .iter()
+        .map(|m| {
+            let distances: Vec<f32> = std::iter::once(0.0)
+                .chain(m.switches.iter().copied())
+                .collect();
+            let entry = serde_json::json!({
+                "center": m.center,
+                "radius": m.radius,
+                "triangles": m.triangles,
+                "distances": distances,
+            });
+            (m.name.clone(), entry)
+        })
+        .collect();
+    let mut out: String = header.iter().map(|l| format!("// {l}\n")).collect();
+    out.push_str(&format!(
+        "{THREE_TABLE_START}{}{THREE_TABLE_END}\n",
+        serde_json::to_string_pretty(&table).unwrap_or_default()
+    ));
+    out.push_str(
+        r#"
+// A THREE.LOD of the model `name` from its levels (three.js objects, LOD0 first, in the model's own space):
+// each level is put in a group moved by minus the model's bounding-sphere centre, so the LOD object stands at
+// that centre and three.js measures its distances from where lodbench did. Place the returned object where the
+// model's centre goes (the model's position plus its centre, scaled and turned as the model is).
+function lodbenchLod(THREE, name, levels) {
+  const model = lodbenchModels[name];
+  if (!model) throw new Error(`lodbenchLod: no model ${name}: ${Object.keys(lodbenchModels).join(", ")}`);
+  if (levels.length < model.distances.length) {
+    throw new Error(`lodbenchLod: ${name} needs ${model.distances.length} levels, got ${levels.length}`);
+  }
+  const lod = new THREE.LOD();
+  model.distances.forEach((distance, k) => {
+    const group = new THREE.Group();
+    group.position.set(-model.center[0], -model.center[1], -model.center[2]);
+    group.add(levels[k]);
+    lod.addLevel(group, distance);
+  });
+  return lod;
+}
+
+if (typeof module !== "undefined") module.exports = { lodbenchModels, lodbenchLod };
+"#,
     );
-    for (k, d) in std::iter::once(0.0)
-        .chain(m.switches.iter().copied())
-        .enumerate()
-    {
-        out.push_str(&format!("lod.addLevel(levels[{k}], {d});\n"));
-    }
     out
 }
 
-pub fn from_threejs(script: &str) -> Vec<f32> {
-    script
-        .lines()
-        .filter_map(|l| l.strip_prefix("lod.addLevel(levels["))
-        .filter_map(|l| l.split_once("], "))
-        .filter_map(|(_, d)| d.trim_end_matches(");").parse().ok())
-        .skip(1)
+/// The switch distances per model of a script written by [`threejs`] (LOD0's 0 left out), in its order.
+pub fn from_threejs(script: &str) -> Option<Vec<(String, Vec<f32>)>> {
+    let start = script.find(THREE_TABLE_START)? + THREE_TABLE_START.len();
+    let end = script[start..].find(THREE_TABLE_END)? + start;
+    let table: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_str(&script[start..end]).ok()?;
+    table
+        .iter()
+        .map(|(name, m)| {
+            let d: Vec<f32> = m["distances"]
+                .as_array()?
+                .iter()
+                .map(|x| x.as_f64().map(|x| x as f32))
+                .collect::<Option<_>>()?;
+            Some((name.clone(), d.into_iter().skip(1).collect()))
+        })
         .collect()
 }
 
@@ -256,6 +311,7 @@ mod tests {
             center: [0.0, 0.1, 0.0],
             switches: vec![3.0, 6.5, 14.0],
             bands: vec![0.05, 0.1, 0.0],
+            triangles: vec![1000, 500, 250, 125],
         }
     }
 
@@ -282,7 +338,11 @@ mod tests {
         assert!(close(&s, &m.switches) && close(&b, &m.bands), "{s:?} {b:?}");
         let (s, b) = from_bevy(&bevy(&m));
         assert!(close(&s, &m.switches) && close(&b, &m.bands), "{s:?} {b:?}");
-        assert!(close(&from_threejs(&threejs(&m)), &m.switches));
+        let three =
+            from_threejs(&threejs(std::slice::from_ref(&m), &[])).expect("the table reads back");
+        assert_eq!(three.len(), 1);
+        assert_eq!(three[0].0, m.name);
+        assert!(close(&three[0].1, &m.switches));
     }
 
     /// The screen size is the projected diameter over the viewport's height: a unit sphere at distance d with a

@@ -38,7 +38,10 @@ pub struct SceneConfig {
     pub materials: crate::geometry::material::MaterialMode,
     /// `--shader-work`: extra ALU iterations per shaded fragment (0: none).
     pub shader_work: u32,
+    /// The LOD schedule of the built-in scenes (`--fade` defaults to `distance`, as in the papers).
     pub schedule: ScheduleParams,
+    /// The LOD schedule of a user's glTF file (`--fade` defaults to `time`, [`ScheduleParams::FOR_USER_FILES`]).
+    pub user_schedule: ScheduleParams,
     /// `--taa on`: the jitter of every frame's camera and the resolve after it.
     pub taa: Option<crate::effects::taa::Taa>,
     /// `--shadows on`: the shadow map (and a ground under the bunny scenes).
@@ -72,6 +75,17 @@ impl AnimationChoice {
 }
 
 impl SceneConfig {
+    /// The LOD schedule of `kind`, checked: a user's file's or the built-in scenes'.
+    pub fn schedule(&self, kind: SceneKind) -> Result<ScheduleParams> {
+        let s = if kind.is_user() {
+            self.user_schedule
+        } else {
+            self.schedule
+        };
+        s.validate()?;
+        Ok(s)
+    }
+
     /// The profile's values for `kind` with the explicit flags applied.
     pub fn resolved(&self, kind: SceneKind) -> ProfileValues {
         let p = kind.profile(self.profile);

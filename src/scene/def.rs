@@ -80,7 +80,7 @@ impl SceneDef {
             width: pv.width,
             height: pv.height,
             fov_y,
-            schedule: cfg.schedule,
+            schedule: cfg.schedule(kind)?,
             counts: cfg.counts(kind),
             camera_mode: cfg.camera,
             mesh_source: set.mesh_source,

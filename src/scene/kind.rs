@@ -181,6 +181,9 @@ impl SceneKind {
             .into_iter()
             .find(|k| k.name() == name)
             .ok_or_else(|| {
+                if let Some(remedy) = scene_remedy(std::path::Path::new(name)) {
+                    return Error::Config(format!("--scene {name}: {remedy}"));
+                }
                 let mut valid = Self::names();
                 valid.push("or a glTF file (PATH.gltf, PATH.glb)");
                 Error::unknown("scene", name, &valid)
@@ -334,6 +337,51 @@ impl SceneKind {
             (Trees, Paper) => vec![4000],
         }
     }
+}
+
+/// What `--scene` was given, where it names something on disk that is not a scene, and the remedy: a folder (the
+/// glTF files in it), an OBJ or other mesh file (`--mesh`).
+fn scene_remedy(path: &std::path::Path) -> Option<String> {
+    if path.is_dir() {
+        // Its glTF files, else its folders' (the Khronos sample assets' Model/glTF/, Model/glTF-Binary/).
+        let entries = |dir: &std::path::Path| -> Vec<std::path::PathBuf> {
+            let mut v: Vec<_> = std::fs::read_dir(dir)
+                .map(|r| r.filter_map(|e| e.ok()).map(|e| e.path()).collect())
+                .unwrap_or_default();
+            v.sort();
+            v
+        };
+        let gltf = |v: Vec<std::path::PathBuf>| -> Vec<String> {
+            v.into_iter()
+                .filter(|p| p.is_file() && is_gltf_path(&p.to_string_lossy()))
+                .map(|p| p.display().to_string())
+                .collect()
+        };
+        let mut files = gltf(entries(path));
+        if files.is_empty() {
+            let below = entries(path)
+                .into_iter()
+                .filter(|p| p.is_dir())
+                .flat_map(|d| entries(&d));
+            files = gltf(below.collect());
+        }
+        return Some(match files.as_slice() {
+            [] => "is a folder, not a scene: give a glTF file (PATH.gltf or PATH.glb) or a built-in scene's \
+                   name (lodbench list)"
+                .to_string(),
+            [one] => format!("is a folder, not a scene: did you mean --scene {one}?"),
+            many => format!(
+                "is a folder, not a scene: did you mean one of its glTF files ({})?",
+                many.join(", ")
+            ),
+        });
+    }
+    let ext = path.extension()?.to_string_lossy().to_ascii_lowercase();
+    (ext == "obj").then(|| {
+        "is an OBJ mesh, not a scene: --scene takes a glTF file or a built-in scene; a mesh file replaces the \
+         bunny of the bunny scenes with --mesh (lodbench run --scene bunny-sweep --mesh FILE.obj)"
+            .to_string()
+    })
 }
 
 #[cfg(test)]

@@ -49,6 +49,19 @@ impl Default for ScheduleParams {
 }
 
 impl ScheduleParams {
+    /// A user's glTF file's defaults: a time fade of 8 frames. Its default flight crosses a switch's distance
+    /// band in about one frame, where no blend can act; over 8 frames (133 ms at 60 frames a second) a blend
+    /// changes the frame by about an eighth of the hard switch a frame, well within the answer's default budget
+    /// (half the hard switch's), and the quick profile's 60 frames hold a 4-level chain's three fades. Engines
+    /// fade longer (Unity's LODGroup.crossFadeAnimationDuration is 0.5 s): `--fade-frames 30` on a longer path.
+    pub const FOR_USER_FILES: ScheduleParams = ScheduleParams {
+        fade: FadeMode::Time,
+        band: 0.05,
+        fade_frames: 8,
+        hysteresis: 0.0,
+        max_transitions: 0,
+    };
+
     pub fn validate(&self) -> Result<()> {
         if !(0.0..0.5).contains(&self.band) {
             return Err(Error::Config(format!(

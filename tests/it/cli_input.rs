@@ -235,6 +235,72 @@ fn gltf_mesh_gives_the_scene_the_obj_gives() {
     }
 }
 
+/// What `--scene` names but is not a scene gets the remedy: a folder the glTF files in it (or in its folders, the
+/// Khronos sample assets' layout), an OBJ `--mesh`, and a glTF file whose image is missing `--materials flat`
+/// (which then draws it).
+#[test]
+fn a_scene_that_is_not_one_names_its_remedy() {
+    let dir = tempfile::tempdir().unwrap();
+    let tetra = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/tetra.gltf");
+    let model = dir.path().join("Tetra");
+    std::fs::create_dir_all(model.join("glTF")).unwrap();
+    std::fs::copy(&tetra, model.join("glTF/Tetra.gltf")).unwrap();
+    let inner = model.join("glTF");
+    let one = format!(
+        "is a folder, not a scene: did you mean --scene {}?",
+        inner.join("Tetra.gltf").display()
+    );
+    fails_with(
+        &lodbench(&["run", "--scene", inner.to_str().unwrap()], &[]),
+        &[&one],
+    );
+    std::fs::create_dir_all(model.join("glTF-Binary")).unwrap();
+    let glb = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/tetra.glb");
+    std::fs::copy(&glb, model.join("glTF-Binary/Tetra.glb")).unwrap();
+    fails_with(
+        &lodbench(&["describe", "--scene", model.to_str().unwrap()], &[]),
+        &[
+            "is a folder, not a scene: did you mean one of its glTF files",
+            "glTF/Tetra.gltf",
+            "glTF-Binary/Tetra.glb",
+        ],
+    );
+    let obj = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bunny.obj");
+    fails_with(
+        &lodbench(&["run", "--scene", obj.to_str().unwrap()], &[]),
+        &["is an OBJ mesh, not a scene", "--mesh FILE.obj"],
+    );
+    // tetra.gltf with a base colour texture whose image is not there.
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&tetra).unwrap()).unwrap();
+    doc["images"] = serde_json::json!([{ "uri": "missing.png" }]);
+    doc["textures"] = serde_json::json!([{ "source": 0 }]);
+    doc["materials"] =
+        serde_json::json!([{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }]);
+    for m in doc["meshes"].as_array_mut().unwrap() {
+        for p in m["primitives"].as_array_mut().unwrap() {
+            p["material"] = serde_json::json!(0);
+        }
+    }
+    let missing = write(dir.path(), "missing-image.gltf", &doc.to_string());
+    fails_with(
+        &lodbench(&["describe", "--scene", &missing], &[]),
+        &[
+            "missing.png",
+            "not found: put the image beside the file, or draw the file without its materials with --materials flat",
+        ],
+    );
+    let flat = lodbench(
+        &["describe", "--scene", &missing, "--materials", "flat"],
+        &[],
+    );
+    assert!(
+        flat.status.success(),
+        "{}",
+        String::from_utf8_lossy(&flat.stderr)
+    );
+}
+
 #[test]
 fn bad_numbers_are_rejected() {
     let out = lodbench(&["run", "--width", "0"], &[]);

@@ -3,6 +3,7 @@
 //! bad budgets are refused in one line.
 
 use crate::common::{fails_with, lodbench};
+use lodbench::results::engines;
 use std::path::Path;
 
 fn fixture(name: &str) -> String {
@@ -87,7 +88,48 @@ fn tune_finds_a_switch_known_in_closed_form() {
         (godot[0][1][1]["visibility_range_begin"].as_f64().unwrap() - found).abs() < 1e-4 * found
     );
     let three = std::fs::read_to_string(out.join("engines/threejs-lod.js")).unwrap();
-    assert!(three.contains("lod.addLevel(levels[1], "), "{three}");
+    let three = engines::from_threejs(&three).expect("threejs-lod.js's table reads back");
+    assert_eq!(three.len(), 1);
+    assert_eq!(three[0].1, [found as f32]);
+
+    // Every engine file, read back as written into its engine's settings, converts back to the switches tune.json
+    // gives its engines (the file's own conversion, docs/engines.md).
+    let models: Vec<engines::EngineModel> = serde_json::from_value(t["engines"].clone()).unwrap();
+    let read = |f: &str| std::fs::read_to_string(out.join("engines").join(f)).unwrap();
+    let unity: Vec<engines::UnityLodGroup> =
+        serde_json::from_str(&read("unity-lodgroup.json")).unwrap();
+    let unreal: Vec<engines::UnrealLods> =
+        serde_json::from_str(&read("unreal-screen-sizes.json")).unwrap();
+    let godot: Vec<(String, Vec<engines::GodotNode>)> =
+        serde_json::from_str(&read("godot-visibility-ranges.json")).unwrap();
+    let bevy: Vec<(String, Vec<engines::BevyRange>)> =
+        serde_json::from_str(&read("bevy-visibility-ranges.json")).unwrap();
+    let close = |a: &[f32], b: &[f32]| {
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .all(|(x, y)| (x - y).abs() <= 1e-4 * y.abs())
+    };
+    for (k, m) in models.iter().enumerate() {
+        let fov = fov as f32;
+        assert!(close(&engines::from_unity(&unity[k], fov).0, &m.switches));
+        assert!(close(
+            &engines::from_unreal(&unreal[k], m.radius, fov),
+            &m.switches
+        ));
+        assert!(close(&engines::from_godot(&godot[k].1).0, &m.switches));
+        assert!(close(&engines::from_bevy(&bevy[k].1).0, &m.switches));
+        assert_eq!(
+            (godot[k].0.as_str(), bevy[k].0.as_str()),
+            (m.name.as_str(), m.name.as_str())
+        );
+        assert_eq!(m.triangles.len(), m.switches.len() + 1, "{m:?}");
+    }
+    let readme = read("README.md");
+    assert!(
+        readme.contains("320x240") && readme.contains("## Unity"),
+        "{readme}"
+    );
 }
 
 #[test]

@@ -15,7 +15,8 @@
 
 mod common;
 
-// src/cli: flags, validation and the errors of bad input.
+// src/cli: flags, validation and the errors of bad input; the help texts.
+mod cli_help;
 mod cli_input;
 // src/commands: the subcommands through the binary.
 mod commands_clips;

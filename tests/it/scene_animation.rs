@@ -115,7 +115,7 @@ fn the_clip_is_drawn() {
     let camera = dir.path().join("still.csv");
     std::fs::write(
         &camera,
-        "frame,x,y,z,target_x,target_y,target_z\n0,0,40,160,0,40,0\n1,0,40,160.0001,0,40,0\n",
+        "frame,x,y,z,target_x,target_y,target_z\n0,0,40,160,0,40,0\n1,0,40,160,0,40,0\n",
     )
     .unwrap();
     let frame = |animation: &str, f: u32| -> Vec<u8> {

@@ -325,7 +325,8 @@ fn export_then_run_gives_the_built_in_schedule() {
         built_in.extend_from_slice(&common);
         run_into(&a, &built_in);
         // The built-in scenes' look: one colour per model (the exported file's materials drawn in full would be
-        // lit by glTF's BRDF instead of the built-in Lambert).
+        // lit by glTF's BRDF instead of the built-in Lambert), and their fade (a glTF file fades by time unless
+        // told).
         let mut imported = vec![
             "--scene",
             glb.to_str().unwrap(),
@@ -333,6 +334,8 @@ fn export_then_run_gives_the_built_in_schedule() {
             frames,
             "--materials",
             "flat",
+            "--fade",
+            "distance",
         ];
         imported.extend_from_slice(&common);
         run_into(&b, &imported);
@@ -597,5 +600,73 @@ fn the_default_camera_sees_every_instance_on_frame_0() {
                 );
             }
         }
+    }
+}
+
+/// geomorph on a textured, skinned model with texture seams and hard edges (Fox.glb): every attribute morphs
+/// within the vertex's own texture chart, so its largest lodpop is below the hard switch's, and at least as far
+/// below as with `--materials flat` (where a texture smeared across the atlas cannot show); a frame in the
+/// middle of its first transition matches the blessed snapshot (tests/snapshots/transitions/Fox_geomorph.png).
+/// With the time fade a user's file takes by default, every transition of dither and alpha spans more than one
+/// frame.
+#[test]
+fn geomorph_carries_textures_within_their_charts() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = assets("Fox.glb");
+    let run = |materials: &str, dump: bool| {
+        #[rustfmt::skip]
+        let mut args = vec![
+            "--scene", path.to_str().unwrap(), "--method", "discrete,alpha,dither,geomorph",
+            "--materials", materials, "--width", "160", "--height", "120", "--frames", "60", "--rounds", "1",
+            "--warmup", "1",
+        ];
+        if dump {
+            args.extend(["--dump-frames", "--dump-transitions"]);
+        }
+        run_into(&dir.path().join(materials), &args)
+    };
+    let ratio = |out: &Path| {
+        let s = read_csv(&out.join("summary.csv"));
+        col(&s, "geomorph", "lodpop_max")[0] / col(&s, "discrete", "lodpop_max")[0]
+    };
+    let (full, flat) = (run("full", true), run("flat", false));
+    let (textured, untextured) = (ratio(&full), ratio(&flat));
+    assert!(
+        textured < 1.0,
+        "geomorph / discrete largest lodpop {textured}"
+    );
+    assert!(
+        textured <= untextured,
+        "textured {textured} against flat {untextured}"
+    );
+    // A time fade of 8 frames: 7 with an instance in transition, the 8th the new LOD's.
+    let summary = read_csv(&full.join("summary.csv"));
+    assert!(
+        summary.iter().all(|r| r["transition_frames_min"] == "7"),
+        "{summary:?}"
+    );
+    let transitions = read_csv(&full.join("transitions.csv"));
+    for t in transitions
+        .iter()
+        .filter(|t| ["alpha", "dither"].contains(&t["method"].as_str()))
+    {
+        let span = |c: &str| t[c].parse::<u32>().unwrap();
+        assert!(span("last_frame") > span("first_frame"), "{t:?}");
+    }
+    let first = transitions
+        .iter()
+        .find(|t| t["method"] == "geomorph")
+        .expect("a transition");
+    let mid = (first["first_frame"].parse::<u32>().unwrap()
+        + first["last_frame"].parse::<u32>().unwrap())
+        / 2;
+    let png = full.join(format!("frames/Fox.glb_geomorph_c1_f{mid:05}_method.png"));
+    let frame = image::open(&png)
+        .unwrap_or_else(|e| panic!("{}: {e}", png.display()))
+        .to_rgba8();
+    let snap =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots/transitions/Fox_geomorph.png");
+    if let Some(problem) = crate::common::snapshot_problem(&frame, &snap) {
+        panic!("{}: {problem}", png.display());
     }
 }

@@ -316,7 +316,12 @@ impl Doc<'_> {
                 views,
             )?,
         ) {
-            (Some(uri), _) => read_uri(&what, uri, self.dir())?,
+            (Some(uri), _) => read_uri(&what, uri, self.dir()).map_err(|e| {
+                format!(
+                    "{e}: put the image beside the file, or draw the file without its materials with \
+                     --materials flat"
+                )
+            })?,
             (None, Some(v)) => self.view_bytes(v, &what)?,
             (None, None) => return Err(format!("{what} has neither a uri nor a bufferView")),
         };

@@ -23,6 +23,10 @@ pub struct SummaryRecord {
     pub triangles_mean: f64,
     pub draw_calls_mean: f64,
     pub t_instances_mean: f64,
+    /// The fewest frames any instance spent in one transition along the path (of those that begin and end on
+    /// it), the same for every method of the block: 1 means the camera crossed a switch's band within a frame,
+    /// where no blending method can act ([`crate::measure::shortest_transition`]); empty without transitions.
+    pub transition_frames_min: Option<u32>,
     /// The quality pass's figures, empty with `--quality off`: mean rmse with its bootstrap interval, largest
     /// rmse, largest and 95th percentile pop.
     pub rmse_mean: Option<f64>,

@@ -45,17 +45,17 @@ pub enum FsiCheck {
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
 #[serde(default, rename_all(deserialize = "kebab-case"))]
 pub struct FsiOptions {
-    /// Visibility texture of Frame Sequential Interpolation (`fsi*`, Scherzer & Wimmer 2008 section 3.3).
-    #[arg(long, value_enum, default_value_t = VisTexture::Noise)]
+    /// fsi*: the visibility texture of Frame Sequential Interpolation (Scherzer & Wimmer 2008 section 3.3).
+    #[arg(long, value_enum, value_parser = crate::defaults::names_only::<VisTexture>(),
+          default_value_t = VisTexture::Noise, help_heading = crate::defaults::heading::METHODS)]
     pub vis_texture: VisTexture,
-    /// `fsi` only, not in the paper: `forward` uses an older fragment only if, reprojected with its own depth,
-    /// it lands within a pixel of the pixel (rejects the disocclusion ghosts of Scherzer & Wimmer 2008 section 4.2).
-    #[arg(long, value_enum, default_value_t = FsiCheck::None)]
+    /// fsi only, not in the paper: forward uses an older fragment only if it reprojects onto the pixel.
+    #[arg(long, value_enum, value_parser = crate::defaults::names_only::<FsiCheck>(),
+          default_value_t = FsiCheck::None, help_heading = crate::defaults::heading::METHODS)]
     pub fsi_check: FsiCheck,
-    /// `fsi*`: where the visibility texture is looked up: `object` (the paper's: the object-space position
-    /// before animation, so the pattern moves with the object) or `world` (the world-space position: the pattern
-    /// stays in place while an animated part moves through it; claim F27).
-    #[arg(long, value_enum, default_value_t = VisSpace::Object)]
+    /// fsi*: where the visibility texture is looked up: in object space (the paper's) or in world space.
+    #[arg(long, value_enum, value_parser = crate::defaults::names_only::<VisSpace>(),
+          default_value_t = VisSpace::Object, help_heading = crate::defaults::heading::METHODS)]
     pub vis_space: VisSpace,
 }
 

@@ -80,7 +80,7 @@ pub fn build(
     if let (Some(d), false) = (exact, model.switch_source == "override") {
         // Exact as written (the round trip through the pixel error may move the last bit), unless
         // --switch-distances or --switch-screen-sizes replaced them.
-        view.cfg.schedule.check_switches(&pending.name, d)?;
+        view.cfg.user_schedule.check_switches(&pending.name, d)?;
         model.switches = d.to_vec();
     }
     model.spin_per_frame = chain.spin_per_frame;
@@ -226,7 +226,7 @@ fn finish(
                 source,
             ),
         };
-    view.cfg.schedule.check_switches(&name, &switches)?;
+    view.cfg.user_schedule.check_switches(&name, &switches)?;
     Ok(Model {
         color,
         name,

@@ -8,6 +8,7 @@ use crate::scene::bunny::fit_distance;
 use crate::scene::camera_path::CameraPath;
 use crate::scene::config::SceneConfig;
 use crate::scene::kind::ProfileValues;
+use crate::scene::schedule::FadeMode;
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -73,13 +74,32 @@ pub fn start(sphere: (Vec3, f32), pv: &ProfileValues, fov_y: f32) -> (Vec3, f32)
 }
 
 /// How far out the flight goes: every instance (`(position on the last frame, the last switch of its model)`)
-/// beyond its model's last switch by the band, the hysteresis and 15 %, and at least 1.25 times the start.
-pub fn end(cfg: &SceneConfig, centre: Vec3, start: f32, instances: &[(Vec3, Option<f32>)]) -> f32 {
-    let (b, h) = (cfg.schedule.band, cfg.schedule.hysteresis);
+/// beyond its model's last switch by the band, the hysteresis and 15 %, and at least 1.25 times the start. With
+/// a time fade, also far enough that the flight, moving evenly over `frames`, crosses the last switch at least
+/// the fade's frames and two more before its end, so the last fade ends on the path (its frame after too).
+pub fn end(
+    cfg: &SceneConfig,
+    centre: Vec3,
+    start: f32,
+    frames: u32,
+    instances: &[(Vec3, Option<f32>)],
+) -> f32 {
+    let s = cfg.user_schedule;
+    let (b, h) = (s.band, s.hysteresis);
+    let room = s.fade_frames + 2;
     instances
         .iter()
         .filter_map(|&(p, last)| {
-            last.map(|s| s * (1.0 + h) * (1.0 + b) * 1.15 + p.distance(centre))
+            let last = last?;
+            let beyond = last * (1.0 + h) * (1.0 + b) * 1.15 + p.distance(centre);
+            let crossed = last * (1.0 + h) + p.distance(centre);
+            let fade_room = match s.fade {
+                FadeMode::Time if frames > room && crossed > start => {
+                    start + (crossed - start) * frames as f32 / (frames - room) as f32
+                }
+                _ => 0.0,
+            };
+            Some(beyond.max(fade_room))
         })
         .fold(start * 1.25, f32::max)
 }

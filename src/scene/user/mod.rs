@@ -105,10 +105,17 @@ pub fn def(
         cfg,
         sphere.0,
         start,
+        pv.frames,
         &last_places(&models, &instances, &placed, pv.frames),
     );
     let (from, to) = (eye0, sphere.0 + Vec3::Z * end);
-    let (near, far) = clip_planes(&models, &instances, &placed, pv.frames, &camera, [from, to]);
+    // The eyes the clip planes must hold everything from: the file's camera's, `--camera-path`'s, or the flight's.
+    let eyes: Vec<Vec3> = match (&camera, &cfg.camera_path) {
+        (Some((_, c)), _) => c.eyes().collect(),
+        (None, Some(p)) => p.eyes().collect(),
+        (None, None) => vec![from, to],
+    };
+    let (near, far) = clip_planes(&models, &instances, &placed, pv.frames, &camera, &eyes);
     let camera_source = camera_source(&camera, [from, to], sphere.1);
     let parts = UserParts {
         materials,
@@ -340,7 +347,8 @@ fn last_places(
 }
 
 /// The clip planes: the file camera's when it gives them; else near at 0.02 of the smallest model's radius and far
-/// at 1.5 times the farthest any instance gets from the camera's eyes (its keys, or the flight's ends), over the
+/// at 1.5 times the farthest any instance gets from the camera's `eyes` (its keys, `--camera-path`'s, or the
+/// flight's ends), over the
 /// frames (every 64th and the last).
 fn clip_planes(
     models: &[Model],
@@ -348,12 +356,8 @@ fn clip_planes(
     placed: &Placed,
     frames: u32,
     camera: &FileCamera,
-    flight: [Vec3; 2],
+    eyes: &[Vec3],
 ) -> (f32, f32) {
-    let eyes: Vec<Vec3> = match camera {
-        Some((_, c)) => c.eyes().collect(),
-        None => flight.to_vec(),
-    };
     let last = frames.saturating_sub(1);
     let reach = (0..frames.max(1))
         .step_by((frames / 64).max(1) as usize)
