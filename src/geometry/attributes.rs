@@ -3,8 +3,8 @@
 //! targets. Every simplified vertex is an original vertex, so each LOD gathers all of it by index
 //! ([`VertexData::gather`]) and indexes the same joints and targets.
 
-/// Skin influences: `per_vertex` (4 or 8: glTF's JOINTS_0/WEIGHTS_0, and _1) joint indices and weights per
-/// vertex, into the skin's joint list.
+/// Skin influences: `per_vertex` (4 per glTF JOINTS_n/WEIGHTS_n set: 4, 8, 12, ...) joint indices and weights
+/// per vertex, into the skin's joint list.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SkinInfluences {
     pub per_vertex: usize,

@@ -26,7 +26,7 @@ const MORPHING: u8 = 1;
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args, serde::Serialize, serde::Deserialize)]
 #[serde(default, rename_all(deserialize = "kebab-case"))]
 pub struct GeomorphOptions {
-    /// geomorph: how fine vertices are paired with the coarse LOD.
+    /// geomorph: how fine vertices are paired with the coarse LOD (auto: surface on a glTF file, else nearest).
     #[arg(long, value_enum, value_parser = crate::defaults::names_only::<Correspondence>(),
           default_value_t = Correspondence::Auto, help_heading = crate::defaults::heading::METHODS)]
     pub correspondence: Correspondence,

@@ -137,3 +137,84 @@ fn the_clip_is_drawn() {
     assert_ne!(frame("0", 0), frame("0", 20), "the clip moves the fox");
     assert_eq!(frame("none", 0), frame("none", 20), "at rest nothing moves");
 }
+
+/// Every set of joints and weights skins a vertex (glTF 2.0 section 3.7.3.3), as assimp's quad_skin.glb has three:
+/// SimpleSkin.gltf with its weights split over three sets (half in JOINTS_0/WEIGHTS_0, a quarter in each of _1 and
+/// _2, the same joints) is posed exactly as the file itself, at rest and on a frame of its clip. Reading the first
+/// two sets alone would scale each skinned vertex's offset by 3/4.
+#[test]
+fn every_set_of_joints_and_weights_skins_the_vertex() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = assets("SimpleSkin.gltf");
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    // WEIGHTS_0: accessor 3 (10 VEC4 floats at byte 160 of buffer view 2, in buffer 1, an embedded data URI).
+    let uri = doc["buffers"][1]["uri"].as_str().unwrap().to_string();
+    let b64 = uri.split_once(',').unwrap().1;
+    let bytes = base64::Engine::decode(&base64::engine::general_purpose::STANDARD, b64).unwrap();
+    let weights: Vec<f32> = bytes[160..160 + 160]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    let mut extra = Vec::new();
+    for share in [0.5f32, 0.25, 0.25] {
+        for w in &weights {
+            extra.extend_from_slice(&(w * share).to_le_bytes());
+        }
+    }
+    std::fs::write(dir.path().join("weights.bin"), &extra).unwrap();
+    let buffer = doc["buffers"].as_array().unwrap().len();
+    doc["buffers"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({ "uri": "weights.bin", "byteLength": extra.len() }));
+    let views = doc["bufferViews"].as_array().unwrap().len();
+    doc["bufferViews"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({ "buffer": buffer, "byteLength": extra.len() }));
+    let first = doc["accessors"].as_array().unwrap().len();
+    for k in 0..3 {
+        doc["accessors"].as_array_mut().unwrap().push(serde_json::json!({
+            "bufferView": views, "byteOffset": 160 * k, "componentType": 5126, "count": 10, "type": "VEC4"
+        }));
+    }
+    let attrs = &mut doc["meshes"][0]["primitives"][0]["attributes"];
+    for k in 0..3 {
+        attrs[format!("JOINTS_{k}")] = serde_json::json!(2);
+        attrs[format!("WEIGHTS_{k}")] = serde_json::json!(first + k);
+    }
+    let split = dir.path().join("three-sets.gltf");
+    std::fs::write(&split, doc.to_string()).unwrap();
+    let obj = |file: &Path, frame: &str, tag: &str| -> String {
+        let out = dir.path().join(format!("{tag}-{frame}.obj"));
+        #[rustfmt::skip]
+        let r = crate::common::lodbench(&[
+            "export", "--scene", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--frame", frame,
+        ], &[]);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        std::fs::read_to_string(&out).unwrap()
+    };
+    let vertices = |text: &str| -> Vec<f64> {
+        text.lines()
+            .filter(|l| l.starts_with("v "))
+            .flat_map(|l| l[2..].split_whitespace().map(|x| x.parse::<f64>().unwrap()))
+            .collect()
+    };
+    for frame in ["0", "40"] {
+        let (a, b) = (
+            vertices(&obj(&path, frame, "file")),
+            vertices(&obj(&split, frame, "split")),
+        );
+        assert_eq!(a.len(), b.len());
+        let worst = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            worst < 1e-5,
+            "frame {frame}: vertices differ by up to {worst}"
+        );
+    }
+}

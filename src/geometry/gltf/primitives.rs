@@ -25,7 +25,7 @@ pub struct Triangles {
     /// TANGENT, or MikkTSpace's when the primitive's material has a normal texture and the file gives none.
     pub tangents: Option<Vec<[f32; 4]>>,
     pub colors: Option<Vec<[f32; 4]>>,
-    /// JOINTS_0/WEIGHTS_0 (and _1).
+    /// Every JOINTS_n/WEIGHTS_n set.
     pub skin: Option<SkinInfluences>,
     /// Morph targets' POSITION (zeros where a target has none) and NORMAL displacements.
     pub targets: Vec<MorphTarget>,
@@ -403,7 +403,8 @@ impl Doc<'_> {
         )
     }
 
-    /// JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1: four influences a set, both of a set or neither.
+    /// Every set of JOINTS_n/WEIGHTS_n, from 0 up to the first set absent (glTF 2.0 section 3.7.3.3: all of them
+    /// skin the vertex): four influences a set, both of a set or neither.
     fn skin_influences(
         &mut self,
         attrs: &Value,
@@ -414,7 +415,7 @@ impl Doc<'_> {
         let mut joints = Vec::new();
         let mut weights = Vec::new();
         let mut sets = 0;
-        for set in 0..2 {
+        for set in 0.. {
             let j = attribute(attrs, &format!("JOINTS_{set}"), what, accessors)?;
             let w = attribute(attrs, &format!("WEIGHTS_{set}"), what, accessors)?;
             let (j, w) = match (j, w) {
@@ -699,8 +700,8 @@ impl Merged {
             (Some(s), None) if self.skinned_vertices == base => self.skin = Some(s.clone()),
             _ => {
                 return Err(
-                    "mixes primitives with and without skin influences (JOINTS_0, WEIGHTS_0), or with 4 and 8 \
-                     influences; skin every primitive of a skinned mesh alike"
+                    "mixes primitives with and without skin influences (JOINTS_0, WEIGHTS_0), or with different \
+                     numbers of JOINTS_n/WEIGHTS_n sets; skin every primitive of a skinned mesh alike"
                         .into(),
                 )
             }

@@ -129,7 +129,17 @@ fn generated(
         .into_iter()
         .next()
         .ok_or_else(|| bad("a model without a mesh".into()))?;
-    let (chain, note) = LodChain::build_by_error(&pending.name, &mesh, &errors, view.cfg.simplify)?;
+    let (mut chain, note) =
+        LodChain::build_by_error(&pending.name, &mesh, &errors, view.cfg.simplify)?;
+    let dropped = if view.cfg.switch_distances.is_none() && view.cfg.switch_screen_sizes.is_none() {
+        drop_near_levels(&pending.name, &mut chain, view)
+    } else {
+        None
+    };
+    let note = match (note, dropped) {
+        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+        (a, b) => a.or(b),
+    };
     let mut model = finish(
         view,
         pending.name,
@@ -140,6 +150,62 @@ fn generated(
     )?;
     model.lod_colors = pending.lod_colors;
     Ok((model, None, note.map(|n| format!("{file}: mesh {n}"))))
+}
+
+/// Drops from a generated chain each level that adds almost nothing over the one kept before it: a level whose
+/// switch distance is within the ratio of a transition band's far edge to the next band's near edge
+/// (`(1 + band)(1 + hysteresis) / ((1 - band)(1 - hysteresis))`, 1.105 by default) of the previous kept level's,
+/// where meshopt stopped within a few percent of the error before (its bands would overlap under a distance fade,
+/// and its switch would change next to nothing). Returns what was dropped, for the run's notes.
+fn drop_near_levels(name: &str, chain: &mut LodChain, view: &View<'_>) -> Option<String> {
+    let s = view.cfg.user_schedule;
+    let ratio = (1.0 + s.band) * (1.0 + s.hysteresis) / ((1.0 - s.band) * (1.0 - s.hysteresis));
+    let switches = lod::switch_distances(chain, 1.0, view.pixel_error, view.pv.height, view.fov_y);
+    let keep = levels_to_keep(&switches, ratio);
+    let dropped: Vec<String> = (1..chain.lods.len())
+        .filter(|&k| !keep[k])
+        .map(|k| {
+            let before = (0..k).rev().find(|&j| keep[j]).unwrap_or(0);
+            let prev = if before == 0 {
+                switches[0]
+            } else {
+                switches[before - 1]
+            };
+            format!(
+                "LOD{k} ({} triangles, switch {:.4} within {:.1} % of LOD{before}'s)",
+                chain.lods[k].mesh.triangle_count(),
+                switches[k - 1],
+                (switches[k - 1] / prev - 1.0) * 100.0
+            )
+        })
+        .collect();
+    if dropped.is_empty() {
+        return None;
+    }
+    let mut k = 0;
+    chain.lods.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+    Some(format!(
+        "{}: its generated chain drops {}: a level that adds almost nothing over the one before",
+        name,
+        dropped.join(", ")
+    ))
+}
+
+/// Per level of a chain (LOD0 first) whose switch distances are `switches` (LOD1's first), whether it stays: LOD0
+/// and every level whose switch lies beyond `ratio` times the last kept level's.
+fn levels_to_keep(switches: &[f32], ratio: f32) -> Vec<bool> {
+    let mut keep = vec![true; switches.len() + 1];
+    let mut last: Option<f32> = None;
+    for (k, &d) in switches.iter().enumerate() {
+        match last {
+            Some(prev) if d <= prev * ratio => keep[k + 1] = false,
+            _ => last = Some(d),
+        }
+    }
+    keep
 }
 
 /// An authored chain's errors per level, how its thresholds were given, and the switch source: its `exact`
@@ -240,4 +306,22 @@ fn finish(
         scale: 1.0,
         deformed_reach: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A level whose switch is within the band ratio of the last kept one is dropped, and the next is measured
+    /// against the last level kept, not the dropped one.
+    #[test]
+    fn near_levels_are_dropped_against_the_last_kept() {
+        let r = 1.105;
+        assert_eq!(levels_to_keep(&[1.0, 2.0, 4.0], r), [true; 4]);
+        assert_eq!(
+            levels_to_keep(&[1.0, 1.04, 1.1, 1.2, 3.0], r),
+            [true, true, false, false, true, true]
+        );
+        assert_eq!(levels_to_keep(&[], r), [true]);
+    }
 }
