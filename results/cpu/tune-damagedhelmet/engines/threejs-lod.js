@@ -1,6 +1,49 @@
-// lodbench tune: mesh_helmet_LP_13930damagedHelmet (distances from its bounding sphere's centre, model space [-0.0024815798, -0.18715495, -1.052022e-5]: place the LOD object there)
-const lod = new THREE.LOD();
-lod.addLevel(levels[0], 0);
-lod.addLevel(levels[1], 19.160713);
-lod.addLevel(levels[2], 22.293283);
-lod.addLevel(levels[3], 37.874104);
+// lodbench tune: switch distances for three.js (THREE.LOD), from each model's bounding-sphere centre.
+// These switches keep each switch within a largest lodpop of 0.004 at 320x240 pixels with a 60.0 degree vertical field of view; at another viewport or field of view the same switch pops differently: tune there.
+// They hold for the LOD chain lodbench drew: a glTF file's authored chain (MSFT_lod), else the one lodbench generated with meshoptimizer, which tuned.glb holds. Use those levels, or a chain with these triangle counts:
+//   mesh_helmet_LP_13930damagedHelmet: 15,452 -> 4,927 -> 3,919 -> 3,340 triangles
+// Usage: const lod = lodbenchLod(THREE, "NAME", [level0, level1, ...]); scene.add(lod);
+const lodbenchModels = {
+  "mesh_helmet_LP_13930damagedHelmet": {
+    "center": [
+      -0.0024815797805786133,
+      -0.18715494871139526,
+      -0.000010520219802856445
+    ],
+    "distances": [
+      0.0,
+      19.16071319580078,
+      22.293283462524414,
+      37.87410354614258
+    ],
+    "radius": 1.2721858024597168,
+    "triangles": [
+      15452,
+      4927,
+      3919,
+      3340
+    ]
+  }
+}; // end of lodbenchModels
+
+// A THREE.LOD of the model `name` from its levels (three.js objects, LOD0 first, in the model's own space):
+// each level is put in a group moved by minus the model's bounding-sphere centre, so the LOD object stands at
+// that centre and three.js measures its distances from where lodbench did. Place the returned object where the
+// model's centre goes (the model's position plus its centre, scaled and turned as the model is).
+function lodbenchLod(THREE, name, levels) {
+  const model = lodbenchModels[name];
+  if (!model) throw new Error(`lodbenchLod: no model ${name}: ${Object.keys(lodbenchModels).join(", ")}`);
+  if (levels.length < model.distances.length) {
+    throw new Error(`lodbenchLod: ${name} needs ${model.distances.length} levels, got ${levels.length}`);
+  }
+  const lod = new THREE.LOD();
+  model.distances.forEach((distance, k) => {
+    const group = new THREE.Group();
+    group.position.set(-model.center[0], -model.center[1], -model.center[2]);
+    group.add(levels[k]);
+    lod.addLevel(group, distance);
+  });
+  return lod;
+}
+
+if (typeof module !== "undefined") module.exports = { lodbenchModels, lodbenchLod };
