@@ -109,12 +109,7 @@ pub fn def(
         &last_places(&models, &instances, &placed, pv.frames),
     );
     let (from, to) = (eye0, sphere.0 + Vec3::Z * end);
-    // The eyes the clip planes must hold everything from: the file's camera's, `--camera-path`'s, or the flight's.
-    let eyes: Vec<Vec3> = match (&camera, &cfg.camera_path) {
-        (Some((_, c)), _) => c.eyes().collect(),
-        (None, Some(p)) => p.eyes().collect(),
-        (None, None) => vec![from, to],
-    };
+    let eyes = clip_eyes(&camera, cfg.camera_path.as_ref(), [from, to]);
     let (near, far) = clip_planes(&models, &instances, &placed, pv.frames, &camera, &eyes);
     let camera_source = camera_source(&camera, [from, to], sphere.1);
     let parts = UserParts {
@@ -344,6 +339,20 @@ fn last_places(
             )
         })
         .collect()
+}
+
+/// The eyes the clip planes must hold everything from: the file's camera's, `--camera-path`'s, or the flight's
+/// ends.
+fn clip_eyes(
+    camera: &FileCamera,
+    path: Option<&crate::scene::camera_path::CameraPath>,
+    flight: [Vec3; 2],
+) -> Vec<Vec3> {
+    match (camera, path) {
+        (Some((_, c)), _) => c.eyes().collect(),
+        (None, Some(p)) => p.eyes().collect(),
+        (None, None) => flight.to_vec(),
+    }
 }
 
 /// The clip planes: the file camera's when it gives them; else near at 0.02 of the smallest model's radius and far
