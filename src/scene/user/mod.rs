@@ -99,7 +99,6 @@ pub fn def(
         motion::widen_to_poses(a, &mut models, &|i, f| placed.at(i, f));
         notes.push(motion::note(file, a, instances.len()));
     }
-
     // The flight's end, the clip planes, and what the camera does.
     let end = flight::end(
         cfg,
