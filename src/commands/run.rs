@@ -409,18 +409,13 @@ impl RunJob<'_> {
         let measured = record_outputs(outputs, &methods, manifest, output)?;
         // The block's one clock.
         let clock = Clock::of(measured.iter().flat_map(|m| &m.rows));
-        let first_summary = output.summaries.len();
         summarise(
             cfg,
-            baseline.as_deref(),
+            (baseline.as_deref(), clock),
             &measured,
-            clock,
+            crate::measure::shortest_transition(&scene),
             &mut output.summaries,
         );
-        let room = crate::measure::shortest_transition(&scene);
-        for s in &mut output.summaries[first_summary..] {
-            s.transition_frames_min = room;
-        }
         let block_rows: Vec<Vec<FrameRecord>> = measured.into_iter().map(|m| m.rows).collect();
         output.rounds.extend(round_records(
             &block_rows,
@@ -462,12 +457,12 @@ impl RunJob<'_> {
 }
 
 /// Each measured method's summary row, with its ratios to the baseline where the baseline was measured too, on
-/// the block's `clock`.
+/// the block's `clock`, and the block's shortest transition (`room`, [`crate::measure::shortest_transition`]).
 fn summarise(
     cfg: &RunConfig,
-    baseline: Option<&str>,
+    (baseline, clock): (Option<&str>, Clock),
     measured: &[MeasuredMethod],
-    clock: Clock,
+    room: Option<u32>,
     summaries: &mut Vec<SummaryRecord>,
 ) {
     let baseline_rows = baseline.and_then(|b| {
@@ -485,6 +480,7 @@ fn summarise(
             if let (Some(b), Some(base)) = (baseline, baseline_rows) {
                 s.set_ratios(b, &m.rows, base);
             }
+            s.transition_frames_min = room;
             summaries.push(s);
         }
     }

@@ -357,14 +357,16 @@ fn scene_remedy(path: &std::path::Path) -> Option<String> {
                 .map(|p| p.display().to_string())
                 .collect()
         };
-        let mut files = gltf(entries(path));
-        if files.is_empty() {
-            let below = entries(path)
-                .into_iter()
-                .filter(|p| p.is_dir())
-                .flat_map(|d| entries(&d));
-            files = gltf(below.collect());
-        }
+        let top = entries(path);
+        let below: Vec<_> = top
+            .iter()
+            .filter(|p| p.is_dir())
+            .flat_map(|d| entries(d))
+            .collect();
+        let files = match gltf(top) {
+            found if found.is_empty() => gltf(below),
+            found => found,
+        };
         return Some(match files.as_slice() {
             [] => "is a folder, not a scene: give a glTF file (PATH.gltf or PATH.glb) or a built-in scene's \
                    name (lodbench list)"

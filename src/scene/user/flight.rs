@@ -75,8 +75,9 @@ pub fn start(sphere: (Vec3, f32), pv: &ProfileValues, fov_y: f32) -> (Vec3, f32)
 
 /// How far out the flight goes: every instance (`(position on the last frame, the last switch of its model)`)
 /// beyond its model's last switch by the band, the hysteresis and 15 %, and at least 1.25 times the start. With
-/// a time fade, also far enough that the flight, moving evenly over `frames`, crosses the last switch at least
-/// the fade's frames and two more before its end, so the last fade ends on the path (its frame after too).
+/// a time fade, also far enough that the flight, moving evenly over `frames`, crosses the last switch more than
+/// the fade's frames and one before its end (`room` = fade + 2 frames, scaled by (frames - 1) / frames since the
+/// flight's last frame is at frames - 1), so the last fade ends on the path, its steady frame after it too.
 pub fn end(
     cfg: &SceneConfig,
     centre: Vec3,
