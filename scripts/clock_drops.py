@@ -19,7 +19,7 @@ import json
 import sys
 from pathlib import Path
 
-# A change of more than a fifth either way (as src/measure/probe_rounds.rs, clock_changed).
+# A change of more than a fifth either way: src/measure/probe_rounds.rs's CLOCK_CHANGED_BELOW (its test reads both).
 CHANGED_BELOW = 0.8
 
 

@@ -6,10 +6,16 @@ says which columns of each CSV the scripts read; scripts/tests/test_columns.py c
 Rust record the file is written from, and that every column a script reads by name is declared here, so a column
 renamed or removed in lodbench fails a test rather than a script (or, read with `.get`, quietly reads nothing).
 
+A folder's answer (the sentences and decision table report.html leads with) is answer.json, written by the binary
+(src/results/answer/); `part_text` and `sentence_text` read its parts. The number formats of the report's other
+tables (`sig3`, `thousands`, `ratio_text`) are those of src/numbers.rs, so the two read alike. (Not in a module of
+their own called `numbers`: beside the scripts, that name would hide Python's own `numbers`, which numpy imports.)
+
 (Not called `results`: run from the repository root, Python would also find the top-level results/ folder under
 that name.)
 """
 import csv
+import math
 from pathlib import Path
 
 # A run folder's files (src/results/files.rs), and those of `lodbench perceptual`, `tune`, `probe` and `overhead`.
@@ -24,6 +30,8 @@ RULES_CSV = "rules.csv"
 PROBE_CSV = "probe.csv"
 OVERHEAD_CSV = "overhead.csv"
 RUN_JSON = "run.json"
+# The answer of a run, experiment or merged folder (written by src/results/answer/; schema "lodbench-answer/1").
+ANSWER_JSON = "answer.json"
 EXPERIMENT_JSON = "experiment.json"
 TUNE_JSON = "tune.json"
 # The clips of a run folder: clips/index.json.
@@ -101,3 +109,42 @@ def run_folder_of(folder: Path, variables, values) -> Path:
     if not variables:
         return folder
     return folder / RUNS_DIR / "+".join(f"{k}={str(v).replace(',', 'x')}" for k, v in zip(variables, values))
+
+
+def sig3(x) -> str:
+    """At least 3 significant figures, never in exponent form: 1.52, 15.2, 152, 1523, 0.00287; `-` where there is
+    none (src/numbers.rs's sig3)."""
+    if x is None or x != x or x in (float("inf"), float("-inf")):
+        return "-"
+    if x == 0:
+        return "0"
+    d = max(0, 2 - math.floor(math.log10(abs(x))))
+    return f"{x:.{d}f}"
+
+
+def thousands(x) -> str:
+    """A count with thousands separators, rounded: 3,674; `-` where there is none (src/numbers.rs's thousands)."""
+    if x is None or x != x or x in (float("inf"), float("-inf")):
+        return "-"
+    return f"{round(x):,}"
+
+
+def ratio_text(r, lo=None, hi=None) -> str:
+    """A ratio with its 95 % interval, 2 decimals: 1.23 [1.10, 1.37]; the ratio alone without an interval
+    (src/numbers.rs's ratio)."""
+    if r is None or r != r:
+        return "-"
+    if lo is None or hi is None or lo != lo or hi != hi:
+        return f"{r:.2f}"
+    return f"{r:.2f} [{lo:.2f}, {hi:.2f}]"
+
+
+def part_text(part) -> str:
+    """The text of one part of answer.json's sentences and table rows: a string as it is, a number (an object with
+    text, file, row, cols, fmt, op) as its text."""
+    return part if isinstance(part, str) else part["text"]
+
+
+def sentence_text(parts) -> str:
+    """A sentence of answer.json as it reads: its parts joined."""
+    return "".join(part_text(p) for p in parts)

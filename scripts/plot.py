@@ -45,8 +45,19 @@ with more than one adapter (`merge --allow-adapters`) each (method, adapter) pai
 `method [adapter]`, so no curve mixes two GPUs.
 Every figure draws a method in its one colour (scripts/method_colours.py), the same in all of them, and a method's
 further series (a repeat `NAME#2`, another adapter, other swept values) in shades of it.
+
+The answer report.md and report.html lead with (per scene: which method pops least, which is the cheapest within
+the popping budget, and the decision table) is the folder's answer.json, as the binary wrote it (src/results/answer/:
+`lodbench run`, `experiment`, `merge` and `perceptual` write it, word for word what `lodbench run` prints). A folder
+without one (made before the binary wrote it), or with a perceptual.csv newer than it, gets it first from
+`lodbench answer FOLDER`: the binary is $LODBENCH (or $LODBENCH_BIN), else target/release/lodbench of this
+repository (under $CARGO_TARGET_DIR where set), else `lodbench` on the PATH.
 """
 import argparse
+import json
+import os
+import shutil
+import subprocess
 import sys
 from collections import OrderedDict
 from pathlib import Path
@@ -60,21 +71,26 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 from PIL import Image  # noqa: E402
 
-import answer  # noqa: E402  (scripts/answer.py, beside this file)
 import frontier  # noqa: E402  (scripts/frontier.py, beside this file)
 import method_colours  # noqa: E402  (scripts/method_colours.py, beside this file)
 import report_html  # noqa: E402  (scripts/report_html.py, beside this file)
 from lodbench_results import (  # noqa: E402  (scripts/lodbench_results.py, beside this file)
+    ANSWER_JSON,
     FRAMES_CSV,
     PAIRS_CSV,
+    PERCEPTUAL_CSV,
     RULES_CSV,
-    RUN_JSON,
+    RUNS_DIR,
     SUMMARY_CSV,
     TRANSITIONS_CSV,
     TUNE_CSV,
     TUNE_JSON,
+    part_text,
+    ratio_text,
     read_csv,
-    run_folder_of,
+    sentence_text,
+    sig3,
+    thousands,
 )
 
 # Every figure colours a method by method_colours.series_colours (one colour per method across the figures);
@@ -535,10 +551,11 @@ def fsi_buffers(scene, frames_dir, by_method, path):
 
 
 def table_cells(rows, columns, raw=()):
-    """The text of each cell of a table of `rows` (dicts) under `columns`, numbers by unit (scripts/answer.py:
-    counts with thousands separators, a ratio with its interval, other figures to 3 significant figures; full
-    precision stays in the CSVs), other values as they are, a missing one empty. report.md and report.html show
-    the same cells. Columns in `raw` (the swept variables, labels) are shown as they are."""
+    """The text of each cell of a table of `rows` (dicts) under `columns`, numbers by unit (src/numbers.rs's rules:
+    lodbench_results.sig3, thousands and ratio_text; counts with thousands separators, a ratio with its interval,
+    other figures to 3 significant figures; full precision stays in the CSVs), other values as they are, a missing
+    one empty. report.md and report.html show the same cells. Columns in `raw` (the swept variables, labels) are
+    shown as they are."""
     out = []
     for r in rows:
         cells = []
@@ -548,7 +565,7 @@ def table_cells(rows, columns, raw=()):
                 cells.append(v)
                 continue
             if c.startswith("ratio_to_baseline") and f"{c}_ci95_lo" in r:
-                cells.append(answer.ratio_text(num(v), num(r.get(f"{c}_ci95_lo")), num(r.get(f"{c}_ci95_hi")))
+                cells.append(ratio_text(num(v), num(r.get(f"{c}_ci95_lo")), num(r.get(f"{c}_ci95_hi")))
                              if v != "" else "")
                 continue
             try:
@@ -559,7 +576,7 @@ def table_cells(rows, columns, raw=()):
             if x != x or c in ("count",):
                 cells.append(v)
             else:
-                cells.append(answer.thousands(x) if c in COUNT_COLUMNS else answer.sig3(x))
+                cells.append(thousands(x) if c in COUNT_COLUMNS else sig3(x))
         out.append(cells)
     return out
 
@@ -571,10 +588,74 @@ def markdown_table(rows, columns, raw=()):
     return "\n".join(lines)
 
 
+ROOT = Path(__file__).resolve().parents[1]
+ANSWER_SCHEMA = "lodbench-answer/1"
+
+
+def lodbench_binary():
+    """The lodbench binary that makes answer.json, as scripts/tests/conftest.py's lodbench_binary finds it but never
+    building it: $LODBENCH (the name scripts/regenerate-results.sh takes) or $LODBENCH_BIN (the tests'), else this
+    repository's target/release/lodbench (under $CARGO_TARGET_DIR where set), else `lodbench` on the PATH; None
+    where there is none."""
+    for var in ("LODBENCH", "LODBENCH_BIN"):
+        if os.environ.get(var):
+            return Path(os.environ[var])
+    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+    if not target.is_absolute():
+        target = ROOT / target
+    if (target / "release" / "lodbench").is_file():
+        return target / "release" / "lodbench"
+    found = shutil.which("lodbench")
+    return Path(found) if found else None
+
+
+def answer_stale(folder: Path):
+    """Why folder's answer.json must be (re)made, or None: it has none (a folder made before the binary wrote
+    one), or a perceptual.csv the answer reads (the folder's own, its runs') is newer (`lodbench perceptual` of an
+    older binary, which did not rewrite it)."""
+    path = folder / ANSWER_JSON
+    if not path.is_file():
+        return f"no {ANSWER_JSON} (a folder made before lodbench wrote one)"
+    made = path.stat().st_mtime
+    for p in [folder / PERCEPTUAL_CSV, *sorted((folder / RUNS_DIR).glob(f"*/{PERCEPTUAL_CSV}"))]:
+        if p.is_file() and p.stat().st_mtime > made:
+            return f"{p.relative_to(folder).as_posix()} is newer than {ANSWER_JSON}"
+    return None
+
+
+def answer_of(folder: Path):
+    """folder's answer.json (the answer report.md and report.html lead with), made first by `lodbench answer FOLDER`
+    where answer_stale says so. Raises ValueError where it cannot be made or read."""
+    why = answer_stale(folder)
+    if why is not None:
+        command = f"lodbench answer {folder}"
+        binary = lodbench_binary()
+        if binary is None:
+            raise ValueError(f"{why}, and no lodbench binary to make it: build it (cargo build --release), or set "
+                             f"LODBENCH to one, and run `{command}`")
+        print(f"{folder}: {why}; making it with `{command}` ({binary})")
+        try:
+            r = subprocess.run([str(binary), "answer", str(folder)], capture_output=True, text=True)
+        except OSError as e:
+            raise ValueError(f"{why}, and `{command}` could not run {binary} ({e})") from None
+        if r.returncode != 0:
+            raise ValueError(f"`{command}` ({binary}) failed with status {r.returncode}: "
+                             f"{(r.stderr or r.stdout).strip()}")
+    path = folder / ANSWER_JSON
+    try:
+        said = json.loads(path.read_text())
+    except (OSError, ValueError) as e:
+        raise ValueError(f"{ANSWER_JSON}: not readable JSON ({e}); remake it with `lodbench answer {folder}`") from None
+    if not isinstance(said, dict) or said.get("schema") != ANSWER_SCHEMA:
+        raise ValueError(f"{ANSWER_JSON}: not of schema {ANSWER_SCHEMA}; remake it with `lodbench answer {folder}`")
+    return said
+
+
 def report(folder: Path, transition: str = "worst") -> list:
     """Writes folder's figures, report.md and report.html; returns the figures as [(file name, caption)]. Raises
     ValueError on what the folder's data does not allow (a malformed clips/index.json, a missing clip image, ...)
-    before anything is written."""
+    before anything is written (answer.json that can be neither read nor made, among them)."""
+    answer = answer_of(folder)
     clips = report_html.load_clips(folder)
     runs = report_html.manifest(folder)
     frames = read_csv(folder / FRAMES_CSV)
@@ -605,21 +686,16 @@ def report(folder: Path, transition: str = "worst") -> list:
             if rows:
                 frontier_tables.append((f"{scene}: cheapest at or below a popping (paired within a run)", rows,
                                         frontier.COLUMNS))
-    # The answer first (scripts/answer.py), from the rows as the runs name their methods.
-    pairs_all = read_csv(folder / PAIRS_CSV) if (folder / PAIRS_CSV).is_file() else []
-    answers = []
-    for name, key, rows, said in answer.answers(summary, pairs_all, lambda values: budget_of(folder, variables,
-                                                                                           values), variables):
-        jods = frontier.perceptual_popping(folder, variables, key[0])
-        answers.append({"name": name, "sentences": said, "columns": answer.DECISION_COLUMNS,
-                        "rows": answer.decision_rows(key, rows, transitions_csv, jods, variables)})
+    # The answer first: answer.json's blocks, as the binary wrote them.
+    answers = [{"name": b["name"], "sentences": b["sentences"], "columns": answer["columns"], "rows": b["rows"]}
+               for b in answer["blocks"]]
     if not variables:
         for (scene,), rows in group(summary, "scene").items():
             first_count = rows[0]["count"]
             rows = [r for r in rows if r["count"] == first_count]
             if any(r.get("lodpop_max") for r in rows) and any(r.get("ratio_to_baseline") for r in rows):
-                level = budget_of(folder, variables, ())
-                decision_figure(scene, rows, level, figs / f"decision_{scene}.png")
+                block = next((b for b in answer["blocks"] if b["scene"] == scene and b["count"] == first_count), None)
+                decision_figure(scene, rows, block, figs / f"decision_{scene}.png")
                 headline.append((f"decision_{scene}.png", f"{scene}: cost against popping, one point per method"))
     if variables and not swept:
         # Each combination of swept values is its own series, in the figures and the tables.
@@ -689,20 +765,20 @@ def report(folder: Path, transition: str = "worst") -> list:
                 if all(p[m][k] != p[m][k] for *_, p in per_transition for m in p):
                     continue
                 rows = [{"transition": f"frames {a}-{b} ({lods})",
-                         **{m: answer.sig3(p[m][k]) for m in methods if m in p}} for a, b, lods, p in per_transition]
+                         **{m: sig3(p[m][k]) for m in methods if m in p}} for a, b, lods, p in per_transition]
                 sections.append((f"{scene}: {what} of each transition (its frames and the 2 after)", rows,
                                  ["transition"] + methods))
         else:
-            rows = [{"transition": f"frames {a}-{b}", **{m: answer.sig3(p[m]) for m in methods if m in p}}
+            rows = [{"transition": f"frames {a}-{b}", **{m: sig3(p[m]) for m in methods if m in p}}
                     for a, b, p in per_transition]
             sections.append((f"{scene}: max pop within {TRANSITION_WINDOW} frames of each transition", rows,
                              ["transition"] + methods))
     title = f"lodbench report: {folder.name}"
     text = [f"# {title}", ""]
     for a in answers:
-        text += [f"## {a['name']}", ""] + [answer.text(s) for s in a["sentences"]] + [""]
+        text += [f"## {a['name']}", ""] + [sentence_text(s) for s in a["sentences"]] + [""]
         text += ["| " + " | ".join(a["columns"]) + " |", "|" + "---|" * len(a["columns"])]
-        text += ["| " + " | ".join(str(c) for c in row) + " |" for row in a["rows"]] + [""]
+        text += ["| " + " | ".join(part_text(c) for c in row) + " |" for row in a["rows"]] + [""]
     for name, caption in headline:
         text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
     for heading, rows, cols in sections:
@@ -751,25 +827,14 @@ def summary_groups(header, lead):
     return out
 
 
-def budget_of(folder: Path, variables, values):
-    """The run's --budget-lodpop (its run.json's config), or None."""
-    import json
-    path = run_folder_of(folder, variables, values) / RUN_JSON
-    try:
-        cfg = json.loads(path.read_text()).get("config") or {}
-    except (OSError, ValueError, AttributeError):
-        return None
-    b = cfg.get("budget_lodpop")
-    return float(b) if isinstance(b, (int, float)) and not isinstance(b, bool) else None
-
-
-def decision_figure(scene, rows, budget, path):
+def decision_figure(scene, rows, block, path):
     """Each method's cost (time over the baseline's, all frames, with its 95 % interval) against its largest
-    lodpop, the budget of the answer drawn across: the answer's two sentences at a glance. The methods are named in
-    the legend only: labels at the points pile up where methods cost and pop alike."""
+    lodpop, the budget of the answer drawn across (`block`: the scene's block of answer.json, whose budget is the
+    run's --budget-lodpop or half its hard switch's largest lodpop; none where it has no budget): the answer's two
+    sentences at a glance. The methods are named in the legend only: labels at the points pile up where methods
+    cost and pop alike."""
     fig, ax = plt.subplots(figsize=(9, 4.4))
-    hard = answer.hard_switch(rows, next((r["baseline"] for r in rows if r.get("baseline")), None))
-    level = budget if budget is not None else (num(hard["lodpop_max"]) / 2 if hard else None)
+    budget = (block or {}).get("budget")
     colours = method_colours.series_colours(r["method"] for r in rows)
     for r in rows:
         x, lo, hi, y = (num(r.get(c)) for c in ("ratio_to_baseline", "ratio_to_baseline_ci95_lo",
@@ -778,10 +843,9 @@ def decision_figure(scene, rows, budget, path):
             continue
         err = [[x - lo], [hi - x]] if lo == lo and hi == hi else None
         ax.errorbar([x], [y], xerr=err, fmt="o", color=colours[r["method"]], capsize=3, label=r["method"])
-    if level is not None:
-        ax.axhline(level, color="0.3", lw=1.2, ls="--",
-                   label=f"budget {answer.sig3(level)}" + (" (--budget-lodpop)" if budget is not None else
-                                                            f" (half of {hard['method']}'s)"))
+    if budget is not None:
+        ax.axhline(budget["lodpop"], color="0.3", lw=1.2, ls="--",
+                   label=f"budget {sig3(budget['lodpop'])} ({budget['source']})")
     baseline = next((r["baseline"] for r in rows if r.get("baseline")), "the baseline")
     ax.set_xlabel(f"time over {baseline}'s, all frames (95 % interval)")
     ax.set_ylabel("largest lodpop (lower: less popping)")
@@ -905,12 +969,12 @@ def tune_answers(folder: Path, meta, rules):
     out = []
     for m in meta["models"]:
         pairs = m["pairs"]
-        where = ", ".join(f"{p['lod_from']}->{p['lod_to']} at {answer.sig3(p['switch_distance'])}"
+        where = ", ".join(f"{p['lod_from']}->{p['lod_to']} at {sig3(p['switch_distance'])}"
                           if p["switch_distance"] is not None else f"{p['lod_from']}->{p['lod_to']} never"
                           for p in pairs)
         said = [[f"{m['name']}: within a {metric} of {limit:g} ({meta['width']}x{meta['height']}, "
                  f"{meta['settings']['views']} views), the switches are {where} (distance from the bounding "
-                 f"sphere's centre, radius {answer.sig3(m['radius'])})."]]
+                 f"sphere's centre, radius {sig3(m['radius'])})."]]
         broken = []
         for rule in ("unreal", "godot", "meshopt"):
             rs = [r for r in rules if r["model"] == m["name"] and r["rule"] == rule]
@@ -925,10 +989,10 @@ def tune_answers(folder: Path, meta, rules):
             ok = worst is not None and (worst >= limit if metric == "jod" else worst <= limit)
             u = units.get(m["name"], {}).get(p["lod_from"], {})
             rows.append([f"{p['lod_from']}->{p['lod_to']}",
-                         f"{answer.thousands(p['triangles_from'])} -> {answer.thousands(p['triangles_to'])}",
-                         answer.sig3(p["switch_distance"]), answer.sig3(worst), f"{limit:g}",
-                         "yes" if ok else "no", answer.sig3(p["error_px_at_switch"]),
-                         *(answer.sig3(u.get(c)) for c in columns[7:11]), answer.sig3(p["switch_distance"])])
+                         f"{thousands(p['triangles_from'])} -> {thousands(p['triangles_to'])}",
+                         sig3(p["switch_distance"]), sig3(worst), f"{limit:g}",
+                         "yes" if ok else "no", sig3(p["error_px_at_switch"]),
+                         *(sig3(u.get(c)) for c in columns[7:11]), sig3(p["switch_distance"])])
         out.append({"name": m["name"], "sentences": said, "columns": columns, "rows": rows})
     return out
 

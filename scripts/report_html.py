@@ -1,6 +1,7 @@
 """report.html of a lodbench results folder: plot.py's tables and figures, a player per transition clip, the manifest.
 
-plot.py computes the tables and figures once and hands them here (report.md shows the same ones). The page is
+plot.py computes the tables and figures once and hands them here (report.md shows the same ones), with the answer
+the page leads with as the binary wrote it (the folder's answer.json, src/results/answer/). The page is
 self-contained: inline style and script, and the folder's own files by relative paths (`figures/...`, `clips/...`),
 so the folder can be moved, archived or opened from disk without a network.
 
@@ -283,15 +284,17 @@ def script_json(value) -> str:
 
 
 def value_html(v) -> str:
-    """A str, or a scripts/answer.py Value as a span whose data- attributes say which CSV cells it shows."""
-    if not hasattr(v, "cols"):
+    """A part of answer.json's sentences and rows: a str as it is, a number (an object: text, file, row, cols, fmt,
+    op) as a span whose data- attributes say which CSV cells it shows."""
+    if isinstance(v, str):
         return esc(v)
-    return (f'<span class="v" data-file="{esc(v.file)}" data-row="{esc(json.dumps(v.row))}" '
-            f'data-cols="{esc(",".join(v.cols))}" data-fmt="{esc(v.fmt)}" data-op="{esc(v.op)}">{esc(v.text)}</span>')
+    return (f'<span class="v" data-file="{esc(v["file"])}" data-row="{esc(json.dumps(v["row"]))}" '
+            f'data-cols="{esc(",".join(v["cols"]))}" data-fmt="{esc(v["fmt"])}" data-op="{esc(v["op"])}">'
+            f'{esc(v["text"])}</span>')
 
 
 def answer_html(a) -> str:
-    """One block's answer: its sentences, then its decision table."""
+    """One block's answer: its sentences, then its decision table (under `a["columns"]`, answer.json's)."""
     sentences = "".join(f'<p class="sentence">{"".join(value_html(part) for part in s)}</p>' for s in a["sentences"])
     head = "".join(f"<th>{esc(c)}</th>" for c in a["columns"])
     body = "\n".join("<tr>" + "".join(
@@ -316,8 +319,9 @@ TUNE_NOTE = ("The worst popping is over tune's views from each switch to the end
 
 
 def page(title: str, answers, headline, tables, figures, clips, runs, players=True, note=ANSWER_NOTE) -> str:
-    """report.html, the answer first. `answers`: [{name, sentences, columns, rows}] (scripts/answer.py: sentences
-    as lists of str and Value parts, rows of str and Value cells); `headline`: [(file in figures/, caption)], the
+    """report.html, the answer first. `answers`: [{name, sentences, columns, rows}] (a block of the folder's
+    answer.json, its columns those of answer.json: sentences as lists of parts, rows of cells, each a str or a
+    number's object, value_html); `headline`: [(file in figures/, caption)], the
     figures that follow the answer; `tables`: [(heading, columns, rows of cell texts)], folded (the
     "cheapest at or below a popping" tables of an experiment open); `figures`: the other figures; `clips`:
     load_clips()'s or None; `runs`: manifest()'s, or the manifest section's HTML; `players`: False leaves out the

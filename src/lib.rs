@@ -23,6 +23,7 @@ pub mod geometry;
 pub mod gpu;
 pub mod measure;
 pub mod methods;
+pub mod numbers;
 pub mod results;
 pub mod rng;
 pub mod scene;

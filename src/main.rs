@@ -2,8 +2,8 @@
 
 use lodbench::cli::{Cli, Command};
 use lodbench::commands::{
-    clips, compare, describe, experiment, export, list, merge, overhead, perceptual, probe, run,
-    tune,
+    answer, clips, compare, describe, experiment, export, list, merge, overhead, perceptual, probe,
+    run, tune,
 };
 use lodbench::Error;
 use std::process::ExitCode;
@@ -20,6 +20,7 @@ fn main() -> ExitCode {
         Command::Experiment(args) => experiment::execute(&args),
         Command::Merge(args) => merge::execute(&args),
         Command::Compare(args) => compare::execute(&args),
+        Command::Answer(args) => answer::execute(&args),
         Command::Perceptual(args) => perceptual::execute(&args),
         Command::Clips(args) => clips::execute(&args),
         Command::Tune(args) => tune::execute(&args),

@@ -17,6 +17,16 @@ def block(scene, count, before, after, warm=None, short=None):
             "clock_warmup_ms": warm, "clock_warmups_short": short}
 
 
+def test_the_threshold_is_the_rust_one():
+    """The script's line is the binary's (src/measure/probe_rounds.rs, CLOCK_CHANGED_BELOW): one figure, two
+    readers."""
+    import re
+    rust = (ROOT / "src" / "measure" / "probe_rounds.rs").read_text()
+    m = re.search(r"pub const CLOCK_CHANGED_BELOW: f64 = ([0-9.]+);", rust)
+    assert m, "CLOCK_CHANGED_BELOW is gone from probe_rounds.rs"
+    assert float(m.group(1)) == clock_drops.CHANGED_BELOW
+
+
 def test_a_fifth_either_way_is_a_change():
     assert clock_drops.changed(10.0, 7.9) and clock_drops.changed(2.0, 10.0)
     assert not clock_drops.changed(10.0, 8.5) and not clock_drops.changed(8.5, 10.0)

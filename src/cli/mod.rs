@@ -139,6 +139,9 @@ pub enum Command {
     /// Compare two methods' frame times in a results folder: A's time over B's per block, paired round by
     /// round, with its 95 % interval and whether the two differ (all frames, in transition, steady).
     Compare(CompareArgs),
+    /// Write a results folder's answer (answer.json: which method pops least, the cheapest within the budget,
+    /// the decision table) from its CSVs, and print its sentences; for a folder made before answer.json was.
+    Answer(AnswerArgs),
     /// Score each method's clip of each transition of a run (made with --dump-frames --dump-transitions)
     /// against the reference's with ColorVideoVDP; writes perceptual.csv and compares with lodpop.
     Perceptual(PerceptualArgs),
@@ -343,6 +346,12 @@ pub struct MergeArgs {
     /// Merge runs built from uncommitted changes even where their changes differ or cannot be told apart.
     #[arg(long)]
     pub allow_dirty: bool,
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct AnswerArgs {
+    /// A results folder: a run's, an experiment's or a merged one (its summary.csv).
+    pub dir: PathBuf,
 }
 
 #[derive(Debug, Clone, Args)]

@@ -51,7 +51,7 @@ pub fn execute(args: &DescribeArgs) -> Result<()> {
         d.profile,
         d.width,
         d.height,
-        crate::results::answer::sig3(Some(d.fov_y_deg as f64)),
+        crate::numbers::sig3(Some(d.fov_y_deg as f64)),
         d.frames,
         d.instance_counts
     );
@@ -215,7 +215,7 @@ fn print_path(d: &SceneDescription) -> Result<()> {
                 format!("a time fade over {} frames", s.fade_frames),
             crate::scene::schedule::FadeMode::Distance => format!(
                 "a distance fade over +-{} % of each switch distance",
-                crate::results::answer::sig3(Some(s.band as f64 * 100.0))
+                crate::numbers::sig3(Some(s.band as f64 * 100.0))
             ),
         },
         if s.hysteresis > 0.0 {

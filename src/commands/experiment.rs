@@ -150,6 +150,7 @@ impl Experiment {
                     .collect();
                 concat_csv(&out.join(file), &header, &parts)?;
             }
+            crate::results::answer::write(out)?;
         }
         Ok(folders)
     }

@@ -476,6 +476,7 @@ fn write_merged(
     for file in RUN_CSVS {
         concat_csv(&out.join(file), &lead_header, &csv_parts(plan, runs, file))?;
     }
+    crate::results::answer::write(out)?;
     let mut record = first.clone();
     record.shard = None;
     record.merged_from = Some(inputs.iter().map(|d| d.display().to_string()).collect());

@@ -1,5 +1,5 @@
-//! One file per subcommand: what `lodbench run`, `experiment`, `merge`, `compare`, `clips`, `perceptual`, `list`,
-//! `describe`, `export`, `tune` and `probe` do, from the parsed flags to a results folder or a printed report. Each file's `execute` is what
+//! One file per subcommand: what `lodbench run`, `experiment`, `merge`, `compare`, `answer`, `clips`, `perceptual`,
+//! `list`, `describe`, `export`, `tune`, `probe` and `overhead` do, from the parsed flags to a results folder or a printed report. Each file's `execute` is what
 //! the binary calls.
 
 /// `print!` / `println!` to stdout that give up quietly when stdout is gone (`lodbench describe ... | head`):
@@ -18,6 +18,7 @@ macro_rules! outln {
 }
 // Defined before the modules, so every subcommand's file has them in scope.
 
+pub mod answer;
 pub mod clips;
 pub mod compare;
 pub mod describe;

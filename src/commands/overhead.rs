@@ -9,16 +9,19 @@ use crate::gpu::GpuContext;
 use crate::measure::overhead_rounds::{check_same_image, measure, OverheadRecord};
 use crate::measure::{BlockGpu, MethodSetup};
 use crate::methods::Registry;
-use crate::results::answer::{aligned, ratio, sig3};
+use crate::numbers::{aligned, ratio, sig3};
 use crate::results::csv::write_whole;
+use crate::results::files::{OVERHEAD_CSV, OVERHEAD_JSON};
+use crate::results::manifest::BuildVersion;
 use crate::scene::{SceneConfig, SceneDef, SceneKind};
 use serde::Serialize;
 
 /// What overhead.json holds.
 #[derive(Serialize)]
 struct OverheadManifest<'a> {
-    lodbench_version: &'static str,
-    git_commit: &'static str,
+    /// The build: lodbench_version, git_commit, source_diff_hash.
+    #[serde(flatten)]
+    build: BuildVersion,
     adapter: crate::gpu::AdapterSummary,
     scenes: Vec<&'static str>,
     methods: &'a [String],
@@ -69,10 +72,9 @@ pub fn execute(args: &OverheadArgs) -> Result<()> {
         seed: args.seed,
     };
     let (rows, blocks) = measure_blocks(&ctx, args, &cfg, &defs, &methods, setup)?;
-    write_whole(&out, "overhead.csv", &rows)?;
+    write_whole(&out, OVERHEAD_CSV, &rows)?;
     let manifest = OverheadManifest {
-        lodbench_version: env!("CARGO_PKG_VERSION"),
-        git_commit: env!("LODBENCH_GIT_COMMIT"),
+        build: BuildVersion::this(),
         adapter: ctx.info.clone(),
         scenes: defs.iter().map(|d| d.name()).collect(),
         methods: &methods,
@@ -82,7 +84,7 @@ pub fn execute(args: &OverheadArgs) -> Result<()> {
         blocks,
         rows: &rows,
     };
-    crate::results::manifest::write_json_file(&out, "overhead.json", &manifest)?;
+    crate::results::manifest::write_json_file(&out, OVERHEAD_JSON, &manifest)?;
     out!("{}", table(&rows));
     outln!(
         "adapter: {}; medians over {} rounds; throughput: triangles per second over the bare draw's, paired by \

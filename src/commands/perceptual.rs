@@ -216,7 +216,8 @@ struct ClipSet {
     before: Vec<Image>,
 }
 
-/// Scores every method's clip of every transition in `dir` and writes `dir/perceptual.csv`.
+/// Scores every method's clip of every transition in `dir` and writes `dir/perceptual.csv` (and its answer.json
+/// anew, whose decision table quotes the lowest JOD).
 pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<PerceptualRecord>> {
     let transitions = read_transitions(dir)?;
     let clips = Clips {
@@ -262,6 +263,11 @@ pub fn check(dir: &Path, settings: &PerceptualSettings) -> Result<Vec<Perceptual
         w.serialize(r)?;
     }
     w.flush().map_err(|e| Error::io(&path, e))?;
+    drop(w);
+    // The answer's decision table quotes each method's lowest JOD.
+    if dir.join(crate::results::files::SUMMARY_CSV).is_file() {
+        crate::results::answer::write(dir)?;
+    }
     Ok(out)
 }
 

@@ -7,15 +7,18 @@ use crate::error::{Error, Result};
 use crate::gpu::probe_kernels::{Amounts, Probes};
 use crate::gpu::GpuContext;
 use crate::measure::probe_rounds::{measure, ProbeRecord, CONTROL_RANGE, DOUBLED_RANGE};
-use crate::results::answer::{aligned, ratio, sig3};
+use crate::numbers::{aligned, ratio, sig3};
 use crate::results::csv::write_whole;
+use crate::results::files::{PROBE_CSV, PROBE_JSON};
+use crate::results::manifest::BuildVersion;
 use serde::Serialize;
 
 /// What probe.json holds.
 #[derive(Serialize)]
 struct ProbeManifest<'a> {
-    lodbench_version: &'static str,
-    git_commit: &'static str,
+    /// The build: lodbench_version, git_commit, source_diff_hash.
+    #[serde(flatten)]
+    build: BuildVersion,
     adapter: crate::gpu::AdapterSummary,
     width: u32,
     height: u32,
@@ -54,10 +57,9 @@ pub fn execute(args: &ProbeArgs) -> Result<()> {
     let ctx = GpuContext::new(args.adapter.as_deref())?;
     let probes = Probes::new(&ctx, (args.width, args.height), Amounts::at(args.scale))?;
     let rows = measure(&ctx, &probes, args.rounds, args.seed)?;
-    write_whole(&out, "probe.csv", &rows)?;
+    write_whole(&out, PROBE_CSV, &rows)?;
     let manifest = ProbeManifest {
-        lodbench_version: env!("CARGO_PKG_VERSION"),
-        git_commit: env!("LODBENCH_GIT_COMMIT"),
+        build: BuildVersion::this(),
         adapter: ctx.info.clone(),
         width: args.width,
         height: args.height,
@@ -67,7 +69,7 @@ pub fn execute(args: &ProbeArgs) -> Result<()> {
         scale: args.scale,
         probes: &rows,
     };
-    crate::results::manifest::write_json_file(&out, "probe.json", &manifest)?;
+    crate::results::manifest::write_json_file(&out, PROBE_JSON, &manifest)?;
     out!("{}", table(&rows));
     outln!(
         "adapter: {}; rates are medians over {} rounds with the geometric mean's 95 % interval; x2 and control \
@@ -104,11 +106,11 @@ pub fn table(rows: &[ProbeRecord]) -> String {
             _ => "-".into(),
         };
         cells.push(vec![
-            r.probe.to_string(),
-            format!("{} {}", giga(r.rate_median), r.unit),
+            r.probe.name().to_string(),
+            format!("{} {}", giga(r.rate_median), r.unit.name()),
             rate,
             sig3(Some(r.ms_median)),
-            r.clock.to_string(),
+            r.clock.name().to_string(),
             ratio(Some(r.doubled_ratio), r.doubled_ci95_lo, r.doubled_ci95_hi),
             r.control.to_string(),
             ratio(Some(r.control_ratio), r.control_ci95_lo, r.control_ci95_hi),

@@ -11,6 +11,7 @@ use crate::measure::records::{
 };
 use crate::measure::{BlockOutput, BlockRunner, FrameImages, MethodSetup, QualityOptions};
 use crate::methods::{is_reference, Registry};
+use crate::results::answer::AnswerFile;
 use crate::results::csv::{
     write_pairs, write_rounds, write_summary, write_transitions, FramesWriter,
 };
@@ -52,8 +53,8 @@ pub struct RunSummary {
     /// pairs.csv's rows.
     pub pairs: Vec<PairRecord>,
     pub blocks: Vec<BlockInfo>,
-    /// `--budget-lodpop`: the popping budget the answer under the table is stated within.
-    pub budget_lodpop: Option<f64>,
+    /// The answer the table ends with, as answer.json holds it.
+    pub answer: AnswerFile,
     /// The adapter is a CPU rasteriser (lavapipe): no GPU clock to drop, and its triangle rate read around a block
     /// varies by up to 40 % from reading to reading, so the blocks' clock notes are not printed.
     pub cpu_adapter: bool,
@@ -136,12 +137,13 @@ pub fn run_with(cfg: &RunConfig, registry: &Registry) -> Result<RunSummary> {
     }
     manifest.write(&out_dir)?;
     let (summaries, pairs) = result?;
+    let answer = crate::results::answer::write(&out_dir)?;
     Ok(RunSummary {
         out_dir,
         summaries,
         pairs,
         blocks: manifest.blocks.clone(),
-        budget_lodpop: cfg.budget_lodpop,
+        answer,
         cpu_adapter: manifest
             .adapter
             .as_ref()
@@ -488,24 +490,13 @@ fn summarise(
 
 /// The table printed at the end of a run: columns sized to their contents, numbers by unit (milliseconds to 3
 /// significant figures, triangles with thousands separators, ratios with their interval; full precision in the
-/// CSVs), then the answer (`results::answer`) and what the columns mean.
+/// CSVs), then the answer (answer.json's sentences, `results::answer`) and what the columns mean.
 pub fn summary_table(s: &RunSummary) -> String {
-    use crate::results::answer::{aligned, answers};
     let right = [
         false, false, true, true, true, true, true, true, true, true, true, true, false,
     ];
-    let mut out = aligned(&summary_rows(s), &right);
-    let said = answers(&s.summaries, &s.pairs, s.budget_lodpop);
-    if said.iter().any(|a| !a.sentences.is_empty()) {
-        out.push('\n');
-        for a in &said {
-            for sentence in &a.sentences {
-                out.push_str(sentence);
-                out.push('\n');
-            }
-        }
-        out.push('\n');
-    }
+    let mut out = crate::numbers::aligned(&summary_rows(s), &right);
+    out.push_str(&crate::results::answer::sentences_text(&s.answer));
     let baseline = s.summaries.iter().find_map(|r| r.baseline.clone());
     out.push_str(&format!(
         "lodpop max is the popping: the largest change LOD switching alone makes to a frame, the pose held \
@@ -525,7 +516,7 @@ pub fn summary_table(s: &RunSummary) -> String {
 
 /// The summary table's header and one row of cells per summary.
 fn summary_rows(s: &RunSummary) -> Vec<Vec<String>> {
-    use crate::results::answer::{ratio, sig3, thousands};
+    use crate::numbers::{ratio, sig3, thousands};
     let mut rows = vec![[
         "scene",
         "method",
@@ -640,7 +631,7 @@ mod tests {
             summaries: vec![record("terrain", "blocks", 1.0, 1000.0)],
             pairs: Vec::new(),
             blocks: vec![block("blocks", 10e6, 2.5e6), block("roam", 10e6, 2.5e6)],
-            budget_lodpop: None,
+            answer: answer_of(&[record("terrain", "blocks", 1.0, 1000.0)]),
             cpu_adapter: false,
         };
         let text = summary_table(&s);
@@ -664,21 +655,26 @@ mod tests {
         assert!(!summary_table(&steady).contains("changed speed"));
     }
 
+    fn answer_of(summaries: &[SummaryRecord]) -> AnswerFile {
+        crate::results::answer::from_records(summaries, &[], &[], None).expect("rows")
+    }
+
     #[test]
     fn the_table_stays_aligned_for_a_long_scene_name() {
         let long = "a-forty-character-user-scene-name-01.glb";
         assert_eq!(long.len(), 40);
+        let summaries = vec![
+            record("bunny-sweep", "discrete", 1.0, 1183.0),
+            record("bunny-sweep", "alpha-2pass", 1.234_567, 1556.4),
+            record(long, "discrete", 1.0, 557_500.0),
+            record(long, "fsi-noreproject", 12.345_67, 3674.0),
+        ];
         let s = RunSummary {
             out_dir: PathBuf::from("out"),
-            summaries: vec![
-                record("bunny-sweep", "discrete", 1.0, 1183.0),
-                record("bunny-sweep", "alpha-2pass", 1.234_567, 1556.4),
-                record(long, "discrete", 1.0, 557_500.0),
-                record(long, "fsi-noreproject", 12.345_67, 3674.0),
-            ],
+            answer: answer_of(&summaries),
+            summaries,
             pairs: Vec::new(),
             blocks: Vec::new(),
-            budget_lodpop: None,
             cpu_adapter: false,
         };
         let text = summary_table(&s);

@@ -14,6 +14,10 @@ use crate::measure::switch_tuning::{
 };
 use crate::results::csv::write_whole;
 use crate::results::engines::{self, EngineModel};
+use crate::results::files::{
+    EngineFile, ENGINES_DIR, ENGINES_README, RULES_CSV, TUNED_GLB, TUNE_CSV, TUNE_JSON,
+};
+use crate::results::manifest::BuildVersion;
 use crate::scene::{Scene, SceneConfig, SceneDef, SceneKind};
 use glam::{Quat, Vec3};
 use serde::Serialize;
@@ -22,8 +26,9 @@ use std::path::{Path, PathBuf};
 /// What tune.json holds.
 #[derive(Serialize)]
 struct TuneManifest<'a> {
-    lodbench_version: &'static str,
-    git_commit: &'static str,
+    /// The build: lodbench_version, git_commit, source_diff_hash.
+    #[serde(flatten)]
+    build: BuildVersion,
     scene: String,
     adapter: crate::gpu::AdapterSummary,
     width: u32,
@@ -147,10 +152,9 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
     let engine_models = write_engine_tables(&out, &models, &settings, &viewing)?;
     let tuned = tuned_scene(&scene, &models);
     let glb = crate::scene::export_glb::glb_with(&tuned, false)?;
-    write(&out.join("tuned.glb"), &glb)?;
+    write(&out.join(TUNED_GLB), &glb)?;
     let manifest = TuneManifest {
-        lodbench_version: env!("CARGO_PKG_VERSION"),
-        git_commit: env!("LODBENCH_GIT_COMMIT"),
+        build: BuildVersion::this(),
         scene: def.name().to_string(),
         adapter: ctx.info.clone(),
         width: scene.width,
@@ -162,7 +166,7 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
         engines: engine_models.clone(),
     };
     write(
-        &out.join("tune.json"),
+        &out.join(TUNE_JSON),
         serde_json::to_string_pretty(&manifest)?.as_bytes(),
     )?;
     write_rules(&out, &models)?;
@@ -255,7 +259,7 @@ impl Viewing {
                  of view; at another viewport or field of view the same switch pops differently: tune there.",
                 self.width,
                 self.height,
-                crate::results::answer::sig3(Some(self.fov_y.to_degrees() as f64)),
+                crate::numbers::sig3(Some(self.fov_y.to_degrees() as f64)),
             ),
             "They hold for the LOD chain lodbench drew: a glTF file's authored chain (MSFT_lod), else the one \
              lodbench generated with meshoptimizer, which tuned.glb holds. Use those levels, or a chain with these \
@@ -266,7 +270,7 @@ impl Viewing {
             let tris: Vec<String> = m
                 .triangles
                 .iter()
-                .map(|&t| crate::results::answer::thousands(Some(t as f64)))
+                .map(|&t| crate::numbers::thousands(Some(t as f64)))
                 .collect();
             out.push(format!("  {}: {} triangles", m.name, tris.join(" -> ")));
         }
@@ -296,7 +300,7 @@ fn print_results(out: &Path, models: &[ModelSwitches], engines: &[EngineModel], 
         "engine settings in {}: Unity, Unreal, Godot, Bevy and three.js; how to enter each: {} (also \
          docs/engines.md)",
         out.join(ENGINES_DIR).display(),
-        out.join(ENGINES_DIR).join("README.md").display()
+        out.join(ENGINES_DIR).join(ENGINES_README).display()
     );
     outln!(
         "figures: python3 scripts/plot.py {}; the rules along a path: python3 scripts/tune_rules.py {}",
@@ -307,7 +311,7 @@ fn print_results(out: &Path, models: &[ModelSwitches], engines: &[EngineModel], 
         outln!(
             "every method with these switches, answered within the budget: lodbench run --scene {} \
              --budget-lodpop {x}",
-            out.join("tuned.glb").display()
+            out.join(TUNED_GLB).display()
         );
     }
 }
@@ -336,7 +340,7 @@ fn tuned_scene(scene: &crate::scene::Scene, models: &[ModelSwitches]) -> crate::
         let switches: Vec<f32> = t.pairs.iter().map_while(|p| p.switch_distance).collect();
         m.chain.lods.truncate(switches.len() + 1);
         m.switches = switches;
-        m.switch_source = "tune";
+        m.switch_source = crate::scene::model::SwitchSource::Tune;
     }
     out.models = list.into();
     out
@@ -350,7 +354,7 @@ fn write(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 fn write_samples(out: &Path, samples: &[Sample]) -> Result<()> {
-    write_whole(out, "tune.csv", samples).map(|_| ())
+    write_whole(out, TUNE_CSV, samples).map(|_| ())
 }
 
 /// One row of rules.csv.
@@ -396,7 +400,7 @@ fn write_rules(out: &Path, models: &[ModelSwitches]) -> Result<()> {
             }
         }
     }
-    write_whole(out, "rules.csv", &rows).map(|_| ())
+    write_whole(out, RULES_CSV, &rows).map(|_| ())
 }
 
 /// The cross-fading engines' files with blending methods' bands: `dithered` for Unity and Bevy, `blended` for
@@ -419,22 +423,21 @@ fn write_fading(
         .collect();
     use erased::Json;
     write(
-        &dir.join("unity-lodgroup-crossfade.json"),
+        &dir.join(EngineFile::UnityLodGroupCrossfade.name()),
         unity.text().as_bytes(),
     )?;
     write(
-        &dir.join("bevy-visibility-ranges-fade.json"),
+        &dir.join(EngineFile::BevyVisibilityRangesFade.name()),
         bevy.text().as_bytes(),
     )?;
     write(
-        &dir.join("godot-visibility-ranges-fade.json"),
+        &dir.join(EngineFile::GodotVisibilityRangesFade.name()),
         godot.text().as_bytes(),
     )
 }
 
-/// The folder of the engine files, and its README (docs/engines.md, after what the switches hold for).
-const ENGINES_DIR: &str = "engines";
-const ENGINES_README: &str = include_str!("../../docs/engines.md");
+/// The engine folder's README's text (docs/engines.md), after what the switches hold for.
+const ENGINES_README_TEXT: &str = include_str!("../../docs/engines.md");
 
 fn write_engines(out: &Path, models: &[EngineModel], viewing: &Viewing) -> Result<()> {
     let fov_y = viewing.fov_y;
@@ -451,17 +454,20 @@ fn write_engines(out: &Path, models: &[EngineModel], viewing: &Viewing) -> Resul
         .iter()
         .map(|m| (m.name.clone(), engines::bevy(m)))
         .collect();
-    write(&dir.join("unity-lodgroup.json"), json(&unity).as_bytes())?;
     write(
-        &dir.join("unreal-screen-sizes.json"),
+        &dir.join(EngineFile::UnityLodGroup.name()),
+        json(&unity).as_bytes(),
+    )?;
+    write(
+        &dir.join(EngineFile::UnrealScreenSizes.name()),
         json(&unreal).as_bytes(),
     )?;
     write(
-        &dir.join("godot-visibility-ranges.json"),
+        &dir.join(EngineFile::GodotVisibilityRanges.name()),
         json(&godot).as_bytes(),
     )?;
     write(
-        &dir.join("bevy-visibility-ranges.json"),
+        &dir.join(EngineFile::BevyVisibilityRanges.name()),
         json(&bevy).as_bytes(),
     )?;
     let about = viewing.about(models);
@@ -475,11 +481,11 @@ fn write_engines(out: &Path, models: &[EngineModel], viewing: &Viewing) -> Resul
             .to_string(),
     );
     write(
-        &dir.join("threejs-lod.js"),
+        &dir.join(EngineFile::ThreejsLod.name()),
         engines::threejs(models, &header).as_bytes(),
     )?;
-    let readme = format!("{}\n\n{ENGINES_README}", about.join("\n\n"));
-    write(&dir.join("README.md"), readme.as_bytes())
+    let readme = format!("{}\n\n{ENGINES_README_TEXT}", about.join("\n\n"));
+    write(&dir.join(ENGINES_README), readme.as_bytes())
 }
 
 /// Serialising what `write_engines` writes, whatever its type.

@@ -21,6 +21,7 @@
 //! The reference always casts LOD0.
 
 use crate::error::{Error, Result};
+use crate::geometry::projection::Sphere;
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -96,14 +97,18 @@ pub enum Caster {
 }
 
 /// The light's view-projection: orthographic along `-to_light`, its square side and depth fitted to the
-/// spheres `(centre, radius)` (the depth widened by `receiver_depth` behind them, where the shadows land);
+/// `spheres` (the depth widened by `receiver_depth` behind them, where the shadows land);
 /// with the box's depth in world units.
-pub fn light_matrix(to_light: Vec3, spheres: &[(Vec3, f32)], receiver_depth: f32) -> (Mat4, f32) {
+pub fn light_matrix(to_light: Vec3, spheres: &[Sphere], receiver_depth: f32) -> (Mat4, f32) {
     let dir = to_light.normalize_or(Vec3::Y);
     let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
     let view = Mat4::look_at_rh(Vec3::ZERO, -dir, up);
     let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
-    for &(c, r) in spheres {
+    for &Sphere {
+        centre: c,
+        radius: r,
+    } in spheres
+    {
         let p = view.transform_point3(c);
         lo = lo.min(p - Vec3::splat(r));
         hi = hi.max(p + Vec3::splat(r));
@@ -131,16 +136,15 @@ mod tests {
     #[test]
     fn light_box_holds_the_spheres() {
         let spheres = [
-            (Vec3::new(0.0, 1.0, 0.0), 0.5),
-            (Vec3::new(4.0, 1.0, 2.0), 1.0),
+            Sphere::new(Vec3::new(0.0, 1.0, 0.0), 0.5),
+            Sphere::new(Vec3::new(4.0, 1.0, 2.0), 1.0),
         ];
         let (m, depth) = light_matrix(Vec3::new(-0.45, 0.8, 0.4), &spheres, 10.0);
         assert!(depth > 10.0);
-        for (c, r) in spheres {
-            let p = m.project_point3(c);
+        for s in spheres {
+            let p = m.project_point3(s.centre);
             assert!(p.x.abs() <= 1.0 && p.y.abs() <= 1.0, "{p}");
             assert!((0.0..=1.0).contains(&p.z), "{p}");
-            let _ = r;
         }
         // Farther along the light's direction is deeper.
         let d = Vec3::new(-0.45, 0.8, 0.4).normalize();

@@ -1,6 +1,6 @@
 //! Deforming a mesh on the CPU: its morph targets at given weights, then its skin at given joint matrices, the
 //! order glTF 2.0 gives (section 3.7.2.2: "morph targets ... then skinning"). lodbench deforms each frame's
-//! vertices here and uploads them (`gpu/scene_gpu.rs`), so that every method draws the same deformed geometry
+//! vertices here and uploads them (`gpu/scene_gpu/pose.rs`), so that every method draws the same deformed geometry
 //! through its own pipelines unchanged.
 
 use crate::geometry::attributes::Deformable;

@@ -443,31 +443,6 @@ pub fn surface_deviation(lod0: &Mesh, lod: &Mesh) -> (f32, f32) {
     (max, mean as f32)
 }
 
-/// Distance at which an object-space error `error_abs` (at instance scale `scale`) projects to `pixel_error`
-/// pixels on a viewport `height_px` pixels high with vertical field of view `fov_y` (radians):
-/// `pixels = error * height / (2 d tan(fov/2))`, solved for d.
-pub fn switch_distance(
-    error_abs: f32,
-    scale: f32,
-    pixel_error: f32,
-    height_px: u32,
-    fov_y: f32,
-) -> f32 {
-    error_abs * scale * height_px as f32 / (2.0 * pixel_error * (fov_y * 0.5).tan())
-}
-
-/// The object-space error (at instance scale `scale`) that projects to `pixel_error` pixels at distance
-/// `distance`: the inverse of [`switch_distance`].
-pub fn error_at_distance(
-    distance: f32,
-    scale: f32,
-    pixel_error: f32,
-    height_px: u32,
-    fov_y: f32,
-) -> f32 {
-    distance * 2.0 * pixel_error * (fov_y * 0.5).tan() / (height_px as f32 * scale)
-}
-
 /// Switch distances for LOD1.. of a chain: where LOD i's error reaches `pixel_error` pixels. Made strictly
 /// increasing (a LOD whose error is not larger than the previous one's switches just after it), so that the
 /// schedule always moves one LOD at a time.
@@ -480,7 +455,8 @@ pub fn switch_distances(
 ) -> Vec<f32> {
     let mut out: Vec<f32> = Vec::new();
     for lod in &chain.lods[1..] {
-        let d = switch_distance(lod.error_abs, scale, pixel_error, height_px, fov_y);
+        let d =
+            super::projection::switch_distance(lod.error_abs, scale, pixel_error, height_px, fov_y);
         let d = match out.last() {
             Some(&prev) if d <= prev * 1.0001 => prev * 1.0001,
             _ => d,
@@ -490,19 +466,10 @@ pub fn switch_distances(
     out
 }
 
-/// The screen size of a sphere of radius `r` at distance `d` (vertical field of view `fov_y`).
-pub fn screen_size(r: f32, d: f32, fov_y: f32) -> f32 {
-    r / (d * (fov_y * 0.5).tan())
-}
-
-/// The distance at which a sphere of radius `r` has screen size `s`.
-pub fn distance_of(r: f32, s: f32, fov_y: f32) -> f32 {
-    r / (s * (fov_y * 0.5).tan())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::projection::switch_distance;
     use std::path::Path;
 
     fn bunny() -> Mesh {

@@ -3,6 +3,7 @@
 use crate::error::{Error, Result};
 use crate::geometry::attributes::VertexData;
 use crate::geometry::gltf;
+use crate::geometry::projection::Sphere;
 use glam::Vec3;
 use std::path::Path;
 
@@ -51,7 +52,7 @@ pub const AUX_LEAF_CLUSTER: f32 = 2.0;
 pub const AUX_BLADE: f32 = 3.0;
 /// A vertex of a mesh deformed per frame (a skin, animated morph weights): its position is the frame's, and
 /// `aux` holds its rest position as `(x, y, kind, z)`, the object-space position before animation that FSI's
-/// visibility texture reads (set by the GPU layer, `gpu/scene_gpu.rs`).
+/// visibility texture reads (set by the GPU layer, `gpu/scene_gpu/pose.rs`).
 pub const AUX_DEFORMED: f32 = 4.0;
 
 impl Mesh {
@@ -248,15 +249,8 @@ impl Mesh {
     }
 
     /// Centre of the bounding box and the radius of the sphere around it that holds every vertex.
-    pub fn bounding_sphere(&self) -> (Vec3, f32) {
-        let (lo, hi) = self.bounds();
-        let c = (lo + hi) * 0.5;
-        let r = self
-            .positions
-            .iter()
-            .map(|p| Vec3::from(*p).distance(c))
-            .fold(0.0f32, f32::max);
-        (c, r)
+    pub fn bounding_sphere(&self) -> Sphere {
+        Sphere::around(&self.positions)
     }
 
     /// Loads a mesh file, choosing the reader by the extension (any case): `.obj` [`Mesh::load_obj`],

@@ -12,6 +12,7 @@ pub mod material;
 pub mod mesh;
 pub mod morph;
 pub mod procgen;
+pub mod projection;
 pub mod roam_mesh;
 pub mod tangents;
 pub mod terrain;

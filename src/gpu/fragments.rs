@@ -1,10 +1,10 @@
 //! Counting a frame's fragments: the fragment shader invocations of every render pass a method begins through
-//! [`SceneGpu`](super::SceneGpu) while counting is on, read with pipeline statistics queries
-//! (`wgpu::Features::PIPELINE_STATISTICS_QUERY`, `FRAGMENT_SHADER_INVOCATIONS`).
+//! [`SceneGpu`](super::SceneGpu) for a view that counts them (`View::count_fragments`), read with pipeline
+//! statistics queries (`wgpu::Features::PIPELINE_STATISTICS_QUERY`, `FRAGMENT_SHADER_INVOCATIONS`).
 //!
-//! The quality pass turns counting on around the method's own frame ([`FragmentQueries::start`] ..
-//! [`FragmentQueries::resolve`]) and never in a timed frame, so the timing rounds hold no query. A pass begun while
-//! counting gets a query of its own, ended when the pass ends ([`Pass`]). The queries live in query sets of
+//! The quality pass hands the method's own frame a counting view and resolves its queries after it
+//! ([`FragmentQueries::resolve`]); no other frame's view counts, timed frames included, so the timing rounds hold
+//! no query. A pass begun for a counting view gets a query of its own, ended when the pass ends ([`Pass`]). The queries live in query sets of
 //! [`SET_QUERIES`] each, reused every frame (like the timer's ring) and added as a frame needs more (alpha-2pass
 //! begins two passes per instance in transition: hundreds on a grid of bunnies); at the frame's end each set's
 //! used range is resolved into the pass's [`FragmentRows`], and the rows are summed per frame when read. Passes a
@@ -23,11 +23,12 @@ pub const SET_QUERIES: u32 = 32;
 const CHUNK_BYTES: u64 = 1 << 20;
 const ALIGN: u64 = wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT;
 
-/// The query sets and the state of the frame being counted.
+/// The query sets, and how many of their queries the frame being counted has begun. Whether a pass is counted is
+/// its view's (`View::count_fragments`); the sets grow and their slots are handed out behind `&self`, since passes
+/// are begun through a shared `SceneGpu`.
 pub struct FragmentQueries {
     device: wgpu::Device,
     sets: RefCell<Vec<wgpu::QuerySet>>,
-    counting: Cell<bool>,
     used: Cell<u32>,
 }
 
@@ -43,21 +44,14 @@ impl FragmentQueries {
         Some(FragmentQueries {
             device: device.clone(),
             sets: RefCell::new(Vec::new()),
-            counting: Cell::new(false),
             used: Cell::new(0),
         })
     }
 
-    /// Counts every pass begun from now until [`FragmentQueries::resolve`].
-    pub fn start(&self) {
-        self.counting.set(true);
-        self.used.set(0);
-    }
-
-    /// Ends counting: resolves the frame's queries into `rows` as frame `frame`'s.
+    /// Resolves the queries of the passes counted since the last resolve into `rows` as frame `frame`'s, and
+    /// frees their slots for the next frame.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder, rows: &mut FragmentRows, frame: u32) {
-        self.counting.set(false);
-        let used = self.used.get();
+        let used = self.used.replace(0);
         let sets = self.sets.borrow();
         let mut spans = Vec::new();
         for (k, set) in sets.iter().enumerate() {
@@ -73,11 +67,8 @@ impl FragmentQueries {
         rows.set_frame(frame, spans);
     }
 
-    /// `pass` with a query begun in it when counting is on.
+    /// `pass` with a query begun in it.
     pub fn wrap<'e>(&self, mut pass: wgpu::RenderPass<'e>) -> Pass<'e> {
-        if !self.counting.get() {
-            return Pass::plain(pass);
-        }
         let slot = self.used.get();
         let k = (slot / SET_QUERIES) as usize;
         let mut sets = self.sets.borrow_mut();

@@ -57,6 +57,27 @@ pub const PROBES: [Probe; 7] = [
     Probe::Bandwidth,
 ];
 
+/// What a probe's quantity counts (probe.csv's `unit`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Unit {
+    Triangles,
+    Vertices,
+    Fragments,
+    Bytes,
+}
+
+impl Unit {
+    pub fn name(self) -> &'static str {
+        match self {
+            Unit::Triangles => "triangles",
+            Unit::Vertices => "vertices",
+            Unit::Fragments => "fragments",
+            Unit::Bytes => "bytes",
+        }
+    }
+}
+
 /// A probe's variants: the base, its quantity doubled, and a control that keeps the quantity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Variant {
@@ -81,13 +102,18 @@ impl Probe {
     }
 
     /// What the quantity counts.
-    pub fn unit(self) -> &'static str {
+    pub fn unit(self) -> Unit {
         match self {
-            Probe::Triangles | Probe::TrianglesInstanced => "triangles",
-            Probe::Vertices => "vertices",
-            Probe::FillOpaque | Probe::FillBlended | Probe::Depth => "fragments",
-            Probe::Bandwidth => "bytes",
+            Probe::Triangles | Probe::TrianglesInstanced => Unit::Triangles,
+            Probe::Vertices => Unit::Vertices,
+            Probe::FillOpaque | Probe::FillBlended | Probe::Depth => Unit::Fragments,
+            Probe::Bandwidth => Unit::Bytes,
         }
+    }
+
+    /// A fill probe: full-screen quads of shaded fragments, opaque or blended.
+    pub fn is_fill(self) -> bool {
+        matches!(self, Probe::FillOpaque | Probe::FillBlended)
     }
 
     /// What the control variant changes.

@@ -1,5 +1,5 @@
 //! The shadow pass of `--shadows on` (src/shadow.rs): the casters' depth from the light into one of the
-//! scene's shadow maps (`SceneGpu::shadow_views`), drawn with the placeholder's camera bind group so the map
+//! scene's shadow maps (`SceneGpu::shadows`), drawn with the placeholder's camera bind group so the map
 //! being written is never the one bound.
 
 use crate::gpu::draw_list::{DrawList, DrawStats, PipelineIndex};
@@ -24,7 +24,7 @@ impl ShadowPass {
         ShadowPass {
             whole: p("shadow caster", None),
             dithered: p("shadow caster, dithered", Some("fs_shadow_dither")),
-            buffers: (0..gpu.shadow_views.len())
+            buffers: (0..gpu.shadows.views.len())
                 .map(|i| {
                     gpu.create_instance_buffer(
                         &format!("shadow map {i} casters"),
@@ -47,8 +47,13 @@ impl ShadowPass {
         let buffer = &self.buffers[map.index()];
         gpu.upload(buffer, list);
         // Lit by the placeholder, so that the map being written is never the one bound.
-        let view = &gpu.shadow_views[map.index()];
-        let mut pass = gpu.begin_depth_pass(encoder, view, ShadowMap::NONE, "shadow pass");
+        let view = &gpu.shadows.views[map.index()];
+        let mut pass = gpu.begin_depth_pass(
+            encoder,
+            view,
+            crate::gpu::scene_gpu::View::lit_by(ShadowMap::NONE),
+            "shadow pass",
+        );
         gpu.draw(&mut pass, buffer, 0, list, &[&self.whole, &self.dithered])
     }
 }

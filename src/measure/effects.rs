@@ -3,6 +3,7 @@
 
 use super::diff_kernel::DiffKernel;
 use crate::error::Result;
+use crate::geometry::projection::Sphere;
 use crate::gpu::scene_gpu::ShadowMap;
 use crate::gpu::shadow_pass::ShadowPass;
 use crate::gpu::taa_resolve::{TaaResolve, TaaStream};
@@ -61,19 +62,19 @@ pub fn frame_lights(scene: &Scene) -> Vec<FrameLight> {
     }
     (0..scene.frames)
         .map(|f| {
-            let spheres: Vec<(glam::Vec3, f32)> = scene
+            let spheres: Vec<Sphere> = scene
                 .instances
                 .iter()
                 .enumerate()
                 .filter(|(i, _)| scene.ground != Some(*i))
                 .map(|(i, inst)| {
-                    (
+                    Sphere::new(
                         scene.instance_position(i, f),
                         scene.models[inst.model as usize].radius,
                     )
                 })
                 .collect();
-            let r = spheres.iter().map(|s| s.1).fold(0.0f32, f32::max);
+            let r = spheres.iter().map(|s| s.radius).fold(0.0f32, f32::max);
             let (matrix, depth) = crate::effects::shadow::light_matrix(
                 glam::Vec3::from(crate::gpu::LIGHT_DIR),
                 &spheres,

@@ -2,7 +2,7 @@
 //! each rule's distance beside its own; docs/methods.md, "The engines' rules"), from the LOD's simplifier error
 //! and the model's bounding sphere.
 
-use crate::geometry::lod::distance_of;
+use crate::geometry::projection::{distance_of, switch_distance};
 use serde::{Deserialize, Serialize};
 
 /// An engine's rule: an error bound on the LOD's simplifier error
@@ -52,7 +52,8 @@ impl Rule {
     /// `r`, and the run's viewport height and vertical field of view: strictly increasing, as a schedule needs
     /// (a switch not beyond the previous one moves just past it).
     pub fn distances(self, errors: &[f32], r: f32, height_px: u32, fov_y: f32) -> Vec<f32> {
-        let project = |e: f32, px: f32| e * height_px as f32 / (2.0 * px * (fov_y * 0.5).tan());
+        // Where error e projects to px pixels.
+        let project = |e: f32, px: f32| switch_distance(e, 1.0, px, height_px, fov_y);
         let mut previous_size = 1.0f32;
         let mut out: Vec<f32> = Vec::with_capacity(errors.len());
         for (i, &e) in errors.iter().enumerate() {
@@ -86,7 +87,7 @@ impl Rule {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::lod::screen_size;
+    use crate::geometry::projection::screen_size;
 
     /// The rules' closed forms: Unreal's 8 pixels at 960 pixels of focal length and a radius beyond, as a screen
     /// size; Godot's 1 pixel from the near side; meshopt's 1 pixel from the centre; the fallbacks.

@@ -3,7 +3,7 @@
 //!
 //! - `driver.rs`: the walk along the path (the LOD schedule, shared by every method);
 //! - `rounds.rs`: the warm-up and the interleaved timing rounds;
-//! - `quality.rs`: the quality pass in stages (render, shadow maps, effects, metrics, read-back requests,
+//! - `quality/`: the quality pass in stages, a file per job (render, shadow maps, effects, metrics, read-back requests,
 //!   counterfactuals, collect);
 //! - `effects.rs`: which shadow map stands for what, the shadow's share, the lights, the TAA streams;
 //! - `reference_cache.rs`: the reference's frames kept for the block's next methods;

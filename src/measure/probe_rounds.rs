@@ -14,8 +14,9 @@
 
 use crate::error::Result;
 use crate::gpu::context::GpuContext;
-use crate::gpu::probe_kernels::{Amounts, Probe, Probes, Variant, PROBES, VARIANTS};
+use crate::gpu::probe_kernels::{Amounts, Probe, Probes, Unit, Variant, PROBES, VARIANTS};
 use crate::gpu::timestamps::GpuTimer;
+use crate::measure::records::Clock;
 use crate::measure::stats::{paired_log_ratio, percentile};
 use crate::rng::SplitMix64;
 use serde::Serialize;
@@ -28,12 +29,12 @@ pub const CONTROL_RANGE: (f64, f64) = (0.8, 1.25);
 /// One row of probe.csv.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct ProbeRecord {
-    pub probe: &'static str,
-    pub unit: &'static str,
+    pub probe: Probe,
+    pub unit: Unit,
     /// The base variant's amount of the unit.
     pub quantity: f64,
     /// `gpu_ms` (timestamps) or `cpu_ms` (submission to idle).
-    pub clock: &'static str,
+    pub clock: Clock,
     pub rounds: u32,
     /// The base variant's median time on `clock`; on the timestamps (None without them); and on the CPU's
     /// clock from its submission to the device's idle, less an empty submission's time.
@@ -218,10 +219,15 @@ impl ClockCheck {
     }
 }
 
-/// Whether a block's rates before and after differ by more than a fifth.
+/// A block's triangle rates before and after it whose lower is below this fraction of the higher differ by more
+/// than a fifth: the adapter changed speed during the block. scripts/clock_drops.py's `CHANGED_BELOW` is this
+/// (scripts/tests/test_clock_drops.py reads both).
+pub const CLOCK_CHANGED_BELOW: f64 = 0.8;
+
+/// Whether a block's rates before and after differ by more than a fifth ([`CLOCK_CHANGED_BELOW`]).
 pub fn clock_changed(before: f64, after: f64) -> bool {
     let (lo, hi) = (before.min(after), before.max(after));
-    lo.is_finite() && hi > 0.0 && lo / hi < 0.8
+    lo.is_finite() && hi > 0.0 && lo / hi < CLOCK_CHANGED_BELOW
 }
 
 /// The run's triangle ceiling: the highest of the triangle probes' rates at its start ([`triangle_ceiling`] of
@@ -246,12 +252,12 @@ pub fn run_triangle_ceiling(
 /// (`fragments`) includes what the adapter shades around a triangle's edges besides, which is work of the same
 /// kind. The depth probe has no fragment shader and is not a fill rate of shaded fragments.
 pub fn fragment_ceiling<'r>(rows: impl IntoIterator<Item = &'r ProbeRecord>) -> Option<f64> {
-    fastest(rows, |r| r.probe.starts_with("fill-"))
+    fastest(rows, |r| r.probe.is_fill())
 }
 
 /// The triangle ceiling of a run's ceilings: the larger of the two triangle probes' rates.
 pub fn triangle_ceiling(rows: &[ProbeRecord]) -> Option<f64> {
-    fastest(rows, |r| r.unit == "triangles")
+    fastest(rows, |r| r.unit == Unit::Triangles)
 }
 
 /// The highest finite rate of the rows `keep` keeps.
@@ -419,10 +425,10 @@ fn probe_record(
         percentile(&r, 50.0).unwrap_or(f64::NAN)
     };
     ProbeRecord {
-        probe: p.name(),
+        probe: p,
         unit: p.unit(),
         quantity: q,
-        clock: if use_gpu { "gpu_ms" } else { "cpu_ms" },
+        clock: if use_gpu { Clock::GpuMs } else { Clock::CpuMs },
         rounds,
         ms_median: percentile(base, 50.0).unwrap_or(f64::NAN),
         gpu_ms_median: stamped.then_some(gpu_median),

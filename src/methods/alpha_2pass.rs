@@ -198,7 +198,7 @@ impl Method for AlphaTwoPass {
                     let mut pass = gpu.begin_depth_pass(
                         encoder,
                         &self.object_depth_view,
-                        input.view.shadow,
+                        input.view,
                         "alpha-2pass nearest surface",
                     );
                     stats += gpu.draw_instances(

@@ -359,8 +359,9 @@ impl Method for AlphaSorted {
                 );
                 {
                     // The layer cleared to no colour and no alpha; the depth as copied.
-                    let mut pass =
-                        gpu.counted(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    let mut pass = gpu.counted(
+                        input.view,
+                        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                             label: Some("alpha-sorted peel"),
                             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                                 view: &self.layer_view,
@@ -384,7 +385,8 @@ impl Method for AlphaSorted {
                             timestamp_writes: None,
                             occlusion_query_set: None,
                             multiview_mask: None,
-                        }));
+                        }),
+                    );
                     gpu.apply_view(&mut pass, input.view);
                     let previous = if layer == 0 { 0 } else { 1 + (1 - cur) };
                     pass.set_bind_group(1, &self.peel_groups[previous], &[]);

@@ -141,6 +141,83 @@ pub fn read_frame_times(dir: &Path) -> Result<FramesTimes> {
     })
 }
 
+/// One CSV row as its file holds it: (column, cell) in the header's order. The answer reads summary.csv,
+/// pairs.csv, transitions.csv and perceptual.csv as these, swept columns included, and quotes the cells it shows.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CsvRow(pub Vec<(String, String)>);
+
+impl CsvRow {
+    /// The cell of column `col`; `""` where the row has none.
+    pub fn text(&self, col: &str) -> &str {
+        self.0
+            .iter()
+            .find(|(c, _)| c == col)
+            .map_or("", |(_, v)| v.as_str())
+    }
+
+    /// The cell of column `col` as a number; None where it is empty, missing, not a number or NaN.
+    pub fn num(&self, col: &str) -> Option<f64> {
+        self.text(col).parse::<f64>().ok().filter(|x| !x.is_nan())
+    }
+
+    /// The row's cells of `cols`, in that order (a column it lacks as `""`).
+    pub fn pick(&self, cols: &[&str]) -> CsvRow {
+        CsvRow(
+            cols.iter()
+                .map(|c| (c.to_string(), self.text(c).to_string()))
+                .collect(),
+        )
+    }
+}
+
+/// Written as a JSON object whose keys keep the row's order.
+impl serde::Serialize for CsvRow {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut m = s.serialize_map(Some(self.0.len()))?;
+        for (k, v) in &self.0 {
+            m.serialize_entry(k, v)?;
+        }
+        m.end()
+    }
+}
+
+/// The rows of `path` ([`CsvRow`]s); an empty list where the file is absent.
+pub fn read_rows(path: &Path) -> Result<Vec<CsvRow>> {
+    if !path.is_file() {
+        return Ok(Vec::new());
+    }
+    rows_from(::csv::Reader::from_path(path)?)
+}
+
+/// `records` as their CSV file would hold them: the same writer, read back as [`CsvRow`]s.
+pub fn rows_of<T: serde::Serialize>(records: &[T]) -> Result<Vec<CsvRow>> {
+    let mut w = ::csv::Writer::from_writer(Vec::new());
+    for r in records {
+        w.serialize(r)?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::Csv(e.into_error().into()))?;
+    rows_from(::csv::Reader::from_reader(bytes.as_slice()))
+}
+
+fn rows_from<R: std::io::Read>(mut r: ::csv::Reader<R>) -> Result<Vec<CsvRow>> {
+    let header = r.headers()?.clone();
+    let mut out = Vec::new();
+    for rec in r.records() {
+        let rec = rec?;
+        out.push(CsvRow(
+            header
+                .iter()
+                .zip(rec.iter())
+                .map(|(h, v)| (h.to_string(), v.to_string()))
+                .collect(),
+        ));
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -44,7 +44,7 @@ pub struct EngineModel {
     pub triangles: Vec<u32>,
 }
 
-pub use crate::geometry::lod::{distance_of, screen_size};
+pub use crate::geometry::projection::{distance_of, screen_size};
 
 /// Unreal: `ScreenSize` per LOD (LOD0 first).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

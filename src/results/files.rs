@@ -7,7 +7,12 @@
 //!   [`TRANSITIONS_CSV`], [`ROUNDS_CSV`], [`PAIRS_CSV`] (`results::csv`);
 //! - [`FRAMES_DIR`]`/`: with `--dump-frames`, `<stem>_<kind>.png` per dumped frame ([`DumpKind`]);
 //! - [`CLIPS_DIR`]`/`: `lodbench clips`, with [`INDEX_JSON`] (built as `clips.partial/`);
-//! - [`PERCEPTUAL_CSV`]: `lodbench perceptual`.
+//! - [`PERCEPTUAL_CSV`]: `lodbench perceptual`;
+//! - [`ANSWER_JSON`]: the answer the folder leads with (`results::answer`), also in an experiment folder.
+//!
+//! A tune folder (`lodbench tune --out DIR`): [`TUNE_JSON`], [`TUNE_CSV`], [`RULES_CSV`], [`TUNED_GLB`] and
+//! [`ENGINES_DIR`]`/` (each engine's file, [`EngineFile`], and [`ENGINES_README`]).
+//! A probe folder: [`PROBE_JSON`] and [`PROBE_CSV`]; an overhead folder: [`OVERHEAD_JSON`] and [`OVERHEAD_CSV`].
 //!
 //! An experiment folder (`lodbench experiment`, `lodbench merge`): [`EXPERIMENT_JSON`]
 //! (`results::manifest::ExperimentRecord`), the [`RUN_CSVS`] of all its runs joined, and each run's folder under
@@ -24,6 +29,54 @@ pub const PAIRS_CSV: &str = "pairs.csv";
 pub const PERCEPTUAL_CSV: &str = "perceptual.csv";
 pub const RUN_JSON: &str = "run.json";
 pub const EXPERIMENT_JSON: &str = "experiment.json";
+/// The answer of a run or experiment folder (`results::answer`).
+pub const ANSWER_JSON: &str = "answer.json";
+/// `lodbench tune`'s manifest: what was tuned, the switches per model, the build.
+pub const TUNE_JSON: &str = "tune.json";
+/// `lodbench tune`'s samples: each view's pop per LOD pair and distance.
+pub const TUNE_CSV: &str = "tune.csv";
+/// `lodbench tune`'s switch distances by rule (its own and the engines').
+pub const RULES_CSV: &str = "rules.csv";
+/// `lodbench tune`'s scene as glTF, with the tuned switches.
+pub const TUNED_GLB: &str = "tuned.glb";
+/// `lodbench tune`'s folder of engine settings.
+pub const ENGINES_DIR: &str = "engines";
+/// The page in [`ENGINES_DIR`] that says how to use each file.
+pub const ENGINES_README: &str = "README.md";
+/// `lodbench probe`'s manifest and rows.
+pub const PROBE_JSON: &str = "probe.json";
+pub const PROBE_CSV: &str = "probe.csv";
+/// `lodbench overhead`'s manifest and rows.
+pub const OVERHEAD_JSON: &str = "overhead.json";
+pub const OVERHEAD_CSV: &str = "overhead.csv";
+
+/// The files in [`ENGINES_DIR`], one per engine's setting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EngineFile {
+    UnityLodGroup,
+    UnityLodGroupCrossfade,
+    UnrealScreenSizes,
+    GodotVisibilityRanges,
+    GodotVisibilityRangesFade,
+    BevyVisibilityRanges,
+    BevyVisibilityRangesFade,
+    ThreejsLod,
+}
+
+impl EngineFile {
+    pub fn name(self) -> &'static str {
+        match self {
+            EngineFile::UnityLodGroup => "unity-lodgroup.json",
+            EngineFile::UnityLodGroupCrossfade => "unity-lodgroup-crossfade.json",
+            EngineFile::UnrealScreenSizes => "unreal-screen-sizes.json",
+            EngineFile::GodotVisibilityRanges => "godot-visibility-ranges.json",
+            EngineFile::GodotVisibilityRangesFade => "godot-visibility-ranges-fade.json",
+            EngineFile::BevyVisibilityRanges => "bevy-visibility-ranges.json",
+            EngineFile::BevyVisibilityRangesFade => "bevy-visibility-ranges-fade.json",
+            EngineFile::ThreejsLod => "threejs-lod.js",
+        }
+    }
+}
 /// The frame dumps of a run folder.
 pub const FRAMES_DIR: &str = "frames";
 /// The transition clips of a run folder.

@@ -184,8 +184,9 @@ pub struct AdapterRecord {
 }
 
 /// The build that made a run or an experiment folder: `lodbench merge` merges folders of one build only, and
-/// `lodbench experiment --resume` reuses only runs of this build.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// `lodbench experiment --resume` reuses only runs of this build. Every manifest (run.json, tune.json,
+/// probe.json, overhead.json) and answer.json carry it, its fields at the manifest's top level.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct BuildVersion {
     pub lodbench_version: Option<String>,
     pub git_commit: Option<String>,

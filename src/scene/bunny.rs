@@ -11,9 +11,10 @@
 use crate::error::{Error, Result};
 use crate::geometry::lod::{self, LodChain, DEFAULT_TARGETS};
 use crate::geometry::mesh::Mesh;
+use crate::geometry::projection::{error_at_distance, fit_distance, Sphere};
 use crate::scene::config::SceneConfig;
 use crate::scene::kind::{ProfileValues, SceneKind, SweepStart};
-use crate::scene::model::{Instance, Layout, Model, ModelSet, Motion};
+use crate::scene::model::{Instance, Layout, Model, ModelSet, Motion, SwitchSource};
 use crate::scene::schedule::ScheduleParams;
 use glam::Vec3;
 use serde::Serialize;
@@ -134,14 +135,6 @@ impl BunnyPath {
     }
 }
 
-/// Nearest distance from the camera at which a bounding sphere of `radius` fits the view (the narrower of the
-/// two fovs).
-pub fn fit_distance(radius: f32, width: u32, height: u32, fov_y: f32) -> f32 {
-    let aspect = width as f32 / height as f32;
-    let half_fov = (fov_y * 0.5).min(((fov_y * 0.5).tan() * aspect).atan());
-    radius / half_fov.sin()
-}
-
 /// Where a user's mesh (`--mesh`) switches to LOD1, LOD2 and LOD3, as multiples of the distance at which it fits
 /// the view: its LOD chain is built by error ([`LodChain::build_by_error`]), LOD i the coarsest simplification
 /// whose error projects to the pixel error no nearer than `USER_SWITCH_FIT_MULTIPLES[i - 1]` x that distance.
@@ -219,7 +212,10 @@ fn bunny_model(
 ) -> Result<(Model, Option<String>)> {
     let height = pv.height;
     mesh.check_area(file)?;
-    let (center, radius) = mesh.bounding_sphere();
+    let Sphere {
+        centre: center,
+        radius,
+    } = mesh.bounding_sphere();
     if !(radius.is_finite() && radius > 0.0) {
         return Err(Error::Mesh {
             path: file.to_string(),
@@ -233,7 +229,7 @@ fn bunny_model(
             let pixel_error = cfg.pixel_error(kind, height);
             let errors: Vec<f32> = USER_SWITCH_FIT_MULTIPLES
                 .iter()
-                .map(|m| lod::error_at_distance(m * fit, 1.0, pixel_error, height, fov_y))
+                .map(|m| error_at_distance(m * fit, 1.0, pixel_error, height, fov_y))
                 .collect();
             LodChain::build_by_error(file, mesh, &errors, cfg.simplify)?
         }
@@ -241,10 +237,10 @@ fn bunny_model(
     let scale = 1.0;
     let (switches, switch_source) =
         match cfg.switch_override("the bunny", chain.lods.len(), radius, fov_y)? {
-            Some(s) => (s, "override"),
+            Some(s) => (s, SwitchSource::Override),
             None => (
                 lod::switch_distances(&chain, scale, cfg.pixel_error(kind, height), height, fov_y),
-                "pixel-error",
+                SwitchSource::PixelError,
             ),
         };
     cfg.schedule.check_switches("bunny", &switches)?;
@@ -306,7 +302,7 @@ fn ground_model(bunny: &Model, far: f32) -> (Model, Vec3) {
             }],
         },
         switches: Vec::new(),
-        switch_source: "none (the ground)",
+        switch_source: SwitchSource::Ground,
         center: Vec3::ZERO,
         radius: (hx * hx + hz * hz).sqrt(),
         scale: 1.0,

@@ -148,18 +148,10 @@ impl SceneConfig {
             Some(d) => d.clone(),
             None => values
                 .iter()
-                .map(|&s| screen_size_distance(radius, s, fov_y))
+                .map(|&s| crate::geometry::projection::distance_of(radius, s, fov_y))
                 .collect(),
         }))
     }
-}
-
-/// Distance at which a bounding sphere of `radius` has screen size `size`: its projected diameter over the
-/// viewport's height, `size = radius / (d tan(fov_y / 2))` (Unreal's screen size; Unity's screen-relative
-/// transition height for a sphere; the reading lodbench gives MSFT_screencoverage, which its specification
-/// calls a hint): `d = radius / (size tan(fov_y / 2))`.
-pub fn screen_size_distance(radius: f32, size: f32, fov_y: f32) -> f32 {
-    radius / (size * (fov_y * 0.5).tan())
 }
 
 /// Viewport height of Sheliemietiev et al. 2023's experiments (800x600): the bunny scenes' default

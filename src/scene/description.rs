@@ -95,7 +95,7 @@ pub struct HierarchyLevel {
 pub struct ModelDescription {
     pub name: String,
     pub radius: f32,
-    pub switch_source: &'static str,
+    pub switch_source: crate::scene::model::SwitchSource,
     pub lods: Vec<LodDescription>,
 }
 

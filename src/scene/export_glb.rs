@@ -23,6 +23,7 @@ use crate::geometry::material::{
     AlphaMode, Filter, Materials, TextureRef, Wrap, IDENTITY_TRANSFORM,
 };
 use crate::geometry::mesh::{Mesh, AUX_SOLID};
+use crate::geometry::projection::screen_size;
 use crate::scene::model::Scene;
 use glam::Vec3;
 use serde_json::{json, Value};
@@ -358,11 +359,10 @@ impl Writer {
             .collect();
         let mut node = place(ids[0], format!("{}_{i}_LOD0", m.name));
         if !coarser.is_empty() {
-            let tan = (scene.fov_y * 0.5).tan();
             let mut coverage: Vec<f64> = m
                 .switches
                 .iter()
-                .map(|&d| f64::from(m.radius / (d * tan)))
+                .map(|&d| f64::from(screen_size(m.radius, d, scene.fov_y)))
                 .collect();
             coverage.push(0.0);
             node["extensions"] = json!({"MSFT_lod": {"ids": coarser}});

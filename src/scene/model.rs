@@ -13,6 +13,60 @@ use glam::{Mat4, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
+/// Where a model's switch distances came from (`describe` and run.json write its [`SwitchSource::name`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SwitchSource {
+    /// `--pixel-error`, from each level's error.
+    PixelError,
+    /// `--pixel-error`, from meshopt's estimate of an authored level's error.
+    PixelErrorEstimated,
+    /// `--switch-distances` or `--switch-screen-sizes`.
+    Override,
+    /// The scene's own (SIMPLE's 12 radii, the unified scenes').
+    Scene,
+    /// Never switched (the ground).
+    Ground,
+    /// `lodbench tune`'s.
+    Tune,
+    /// An authored chain's exact distances (`extras.lodbench_switch_distances`, lodbench export's).
+    ExportedDistances,
+    /// An authored chain's MSFT_screencoverage.
+    ScreenCoverage,
+}
+
+impl SwitchSource {
+    pub fn name(self) -> &'static str {
+        match self {
+            SwitchSource::PixelError => "pixel-error",
+            SwitchSource::PixelErrorEstimated => "pixel-error (estimated)",
+            SwitchSource::Override => "override",
+            SwitchSource::Scene => "scene",
+            SwitchSource::Ground => "none (the ground)",
+            SwitchSource::Tune => "tune",
+            SwitchSource::ExportedDistances => "lodbench_switch_distances",
+            SwitchSource::ScreenCoverage => "MSFT_screencoverage",
+        }
+    }
+}
+
+impl std::fmt::Display for SwitchSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Serialize for SwitchSource {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl PartialEq<&str> for SwitchSource {
+    fn eq(&self, other: &&str) -> bool {
+        self.name() == *other
+    }
+}
+
 /// Seed of the procedural scenes' models and layouts (tree shapes, instance jitter and yaw, the terrain):
 /// fixed, so a scene is the same picture whatever `--seed` drives (the methods' noise).
 pub const SCENE_SEED: u64 = 2008;
@@ -42,8 +96,8 @@ pub struct Model {
     pub chain: LodChain,
     /// Switch distance of LOD1, LOD2, ... in world units.
     pub switches: Vec<f32>,
-    /// Where the switch distances came from: "pixel-error" or "override".
-    pub switch_source: &'static str,
+    /// Where the switch distances came from.
+    pub switch_source: SwitchSource,
     /// Bounding-sphere centre (object space) and radius (world units, after scale).
     pub center: Vec3,
     pub radius: f32,
@@ -209,7 +263,7 @@ impl Scene {
     pub fn cut_camera(&self, frame: u32, pixel_error: f32, bound: CutBound) -> CutCamera {
         CutCamera {
             eye: self.camera(frame).eye,
-            pixels_per_unit: self.height as f32 / (2.0 * (self.fov_y * 0.5).tan()),
+            pixels_per_unit: crate::geometry::projection::pixels_per_unit(self.height, self.fov_y),
             znear: self.near,
             pixel_error,
             bound,

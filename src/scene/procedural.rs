@@ -4,9 +4,12 @@
 use crate::error::Result;
 use crate::geometry::lod;
 use crate::geometry::procgen::{self, ModelChain};
+use crate::geometry::projection::Sphere;
 use crate::scene::config::SceneConfig;
 use crate::scene::kind::SceneKind;
-use crate::scene::model::{CameraTrack, Instance, Layout, Model, ModelSet, Motion, SCENE_SEED};
+use crate::scene::model::{
+    CameraTrack, Instance, Layout, Model, ModelSet, Motion, SwitchSource, SCENE_SEED,
+};
 use glam::Vec3;
 
 /// Rotation of the windmill blades per frame, radians (one turn in 5 s at 60 fps).
@@ -23,17 +26,20 @@ pub fn def(kind: SceneKind, cfg: &SceneConfig, height: u32, fov_y: f32) -> Resul
     let lod_generation_ms = started.elapsed().as_secs_f64() * 1e3;
     let lod_colors = chain.lod_colors.clone();
     let chain = chain.chain;
-    let (center, radius) = chain.lods[0].mesh.bounding_sphere();
+    let Sphere {
+        centre: center,
+        radius,
+    } = chain.lods[0].mesh.bounding_sphere();
     let scale = 1.0;
     let (switches, switch_source) = match (
         cfg.switch_override(name, chain.lods.len(), radius * scale, fov_y)?,
         kind,
     ) {
-        (Some(s), _) => (s, "override"),
-        (None, SceneKind::Simple) => (vec![12.0 * radius], "scene"),
+        (Some(s), _) => (s, SwitchSource::Override),
+        (None, SceneKind::Simple) => (vec![12.0 * radius], SwitchSource::Scene),
         (None, _) => (
             lod::switch_distances(&chain, scale, cfg.pixel_error(kind, height), height, fov_y),
-            "pixel-error",
+            SwitchSource::PixelError,
         ),
     };
     cfg.schedule.check_switches(name, &switches)?;

@@ -25,11 +25,14 @@ use crate::geometry::blocks::{BlockLod, Grid, Partition, PartitionMode, SeamPair
 use crate::geometry::cluster_dag::ClusterDag;
 use crate::geometry::lod::{Lod, LodChain};
 use crate::geometry::mesh::Mesh;
+use crate::geometry::projection::{fit_distance, Sphere};
 use crate::geometry::terrain::TerrainField;
 use crate::scene::bunny::{self, BUNNY_COLOR};
 use crate::scene::config::SceneConfig;
 use crate::scene::kind::{ProfileValues, SceneKind};
-use crate::scene::model::{CameraTrack, Instance, Layout, Model, ModelSet, Motion, SCENE_SEED};
+use crate::scene::model::{
+    CameraTrack, Instance, Layout, Model, ModelSet, Motion, SwitchSource, SCENE_SEED,
+};
 /// The unified scenes' data, defined with the rest of the data model.
 pub use crate::scene::model::{Preprocessing, Seam, SeamMesh, Unified};
 use crate::scene::schedule::ScheduleParams;
@@ -191,11 +194,14 @@ fn halves(input: UnifiedInput<'_>) -> Result<(Vec<Model>, UnifiedParts)> {
     let style = BlockStyle {
         targets: &HALVES_TARGETS,
         color: BUNNY_COLOR,
-        switch_source: "scene",
+        switch_source: SwitchSource::Scene,
     };
     let mut made = prepare(&input, grid, style)?;
-    let (center, radius) = input.mesh.bounding_sphere();
-    let distance = radius / half_fov(input.width, input.height, input.fov_y).sin() / 0.8;
+    let Sphere {
+        centre: center,
+        radius,
+    } = input.mesh.bounding_sphere();
+    let distance = fit_distance(radius, input.width, input.height, input.fov_y) / 0.8;
     for (bi, m) in made.blocks.models.iter_mut().enumerate() {
         // The first half never leaves LOD0, the second never shows it.
         m.switches = vec![if bi == 0 {
@@ -228,7 +234,7 @@ fn terrain(input: UnifiedInput<'_>) -> Result<(Vec<Model>, UnifiedParts)> {
     let style = BlockStyle {
         targets: &TERRAIN_TARGETS,
         color: TERRAIN_COLOR,
-        switch_source: "pixel-error",
+        switch_source: SwitchSource::PixelError,
     };
     let mut made = prepare(&input, grid, style)?;
     let pitch = 10f32.to_radians();
@@ -257,7 +263,7 @@ fn terrain_switches(m: &Model, input: &UnifiedInput<'_>) -> Vec<f32> {
         * 1.01;
     let mut out: Vec<f32> = Vec::new();
     for lod in &m.chain.lods[1..] {
-        let d = crate::geometry::lod::switch_distance(
+        let d = crate::geometry::projection::switch_distance(
             lod.error_abs,
             1.0,
             input.pixel_error,
@@ -271,12 +277,6 @@ fn terrain_switches(m: &Model, input: &UnifiedInput<'_>) -> Vec<f32> {
         out.push(d);
     }
     out
-}
-
-/// The narrower of the two half fields of view (radians).
-fn half_fov(width: u32, height: u32, fov_y: f32) -> f32 {
-    let aspect = width as f32 / height as f32;
-    (fov_y * 0.5).min(((fov_y * 0.5).tan() * aspect).atan())
 }
 
 /// The mesh's bounds and longest side, after checking it has an area and an extent.
@@ -297,7 +297,7 @@ fn checked_bounds(mesh: &Mesh, mesh_source: &str) -> Result<(Vec3, Vec3, f32)> {
 struct BlockStyle {
     targets: &'static [f32],
     color: [f32; 3],
-    switch_source: &'static str,
+    switch_source: SwitchSource,
 }
 
 /// Where the camera of a unified scene goes, and its clip planes.
@@ -422,7 +422,10 @@ fn block_model(
         .iter()
         .map(|l| l.mesh.vertex_count() as u64 * VERTEX_BYTES + l.mesh.indices.len() as u64 * 4)
         .sum::<u64>();
-    let (center, radius) = lods[0].mesh.bounding_sphere();
+    let Sphere {
+        centre: center,
+        radius,
+    } = lods[0].mesh.bounding_sphere();
     let model = Model {
         name: block_name,
         color: style.color,

@@ -221,7 +221,10 @@ pub fn near_distance() -> f32 {
 /// `actual` against the blessed PNG `snap` with the snapshots' tolerance (mean absolute difference at most 0.5 of
 /// 255 over R, G, B; at most 0.5 % of pixels off by more than 16 in a channel: another rasteriser's edge pixels
 /// pass, a changed shading, blend, pattern or LOD does not). With `LODBENCH_BLESS` set it writes `snap` instead.
-/// Returns what is wrong (a uniform frame fails too), or None.
+/// Returns what is wrong (a uniform frame fails too), or None; on a difference the frame and a map of each
+/// pixel's largest channel difference (times 8, in red) go to `target/snapshots/<name>-actual.png` and
+/// `-difference.png`. The one comparison of every snapshot test; re-bless with
+/// `LODBENCH_BLESS=1 cargo test --release --test it snapshot`.
 pub fn snapshot_problem(actual: &image::RgbaImage, snap: &Path) -> Option<String> {
     if std::env::var_os("LODBENCH_BLESS").is_some() {
         std::fs::create_dir_all(snap.parent().expect("a folder")).expect("snapshot folder");
@@ -231,15 +234,44 @@ pub fn snapshot_problem(actual: &image::RgbaImage, snap: &Path) -> Option<String
     let expected = image::open(snap)
         .unwrap_or_else(|e| panic!("{}: {e} (bless with LODBENCH_BLESS=1)", snap.display()))
         .to_rgba8();
+    if expected.dimensions() != actual.dimensions() {
+        return Some(format!(
+            "{}: {:?}, the frame {:?}",
+            snap.display(),
+            expected.dimensions(),
+            actual.dimensions()
+        ));
+    }
     let uniform = actual.pixels().all(|p| p == actual.get_pixel(0, 0));
     let (mean, bad) = image_difference(actual.as_raw(), expected.as_raw());
-    (uniform || mean > 0.5 || bad > 0.005).then(|| {
-        format!(
-            "mean {mean:.3}, {:.3} % off by > 16{}",
-            bad * 100.0,
-            if uniform { ", uniform frame" } else { "" }
-        )
-    })
+    if !(uniform || mean > 0.5 || bad > 0.005) {
+        return None;
+    }
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/snapshots");
+    let name = snap
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("snapshot");
+    let difference = image::RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
+        let (a, b) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
+        let worst = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
+        image::Rgba([worst.saturating_mul(8), 0, 0, 255])
+    });
+    let saved = std::fs::create_dir_all(&dir).is_ok()
+        && actual.save(dir.join(format!("{name}-actual.png"))).is_ok()
+        && difference
+            .save(dir.join(format!("{name}-difference.png")))
+            .is_ok();
+    Some(format!(
+        "mean {mean:.3}, {:.3} % off by > 16{}{}",
+        bad * 100.0,
+        if uniform { ", uniform frame" } else { "" },
+        if saved {
+            format!("; see {}", dir.display())
+        } else {
+            String::new()
+        }
+    ))
 }
 
 /// The built-in bunny with every triangle split into four at its edge midpoints, `levels` times (3,674 x 4^levels

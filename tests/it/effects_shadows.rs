@@ -34,7 +34,7 @@ fn shadow_map(
     ctx.check_errors().unwrap();
     read_texture(
         ctx,
-        &gpu.shadow_maps[ShadowMap::lit(0).index()],
+        &gpu.shadows.maps[ShadowMap::lit(0).index()],
         wgpu::TextureAspect::DepthOnly,
         4,
     )
@@ -71,11 +71,15 @@ fn follow_shadow_at_k_0_and_1_is_discretes() {
     let gpu = SceneGpu::new(&ctx, &scene).unwrap();
     let mut driver = FrameDriver::new(&scene);
     driver.advance(0);
-    let spheres: Vec<_> = [(scene.instance_position(0, 0), scene.models[0].radius)].to_vec();
+    let spheres: Vec<_> = [lodbench::geometry::projection::Sphere::new(
+        scene.instance_position(0, 0),
+        scene.models[0].radius,
+    )]
+    .to_vec();
     let (light, _) = light_matrix(
         glam::Vec3::from(lodbench::gpu::LIGHT_DIR),
         &spheres,
-        3.0 * spheres[0].1,
+        3.0 * spheres[0].radius,
     );
     gpu.write_camera(&scene.camera(0));
     gpu.write_light(&light, 0.0);

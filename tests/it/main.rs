@@ -25,6 +25,8 @@ mod commands_experiment;
 mod commands_overhead;
 mod commands_probe;
 mod commands_tune;
+// src/geometry: the projection every layer computes with.
+mod geometry_projection;
 // src/gpu: what the GPU draws of a scene's materials.
 mod gpu_materials;
 // src/measure: the quality pass's figures, and runs without it.

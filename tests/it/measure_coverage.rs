@@ -126,7 +126,7 @@ fn covered_equals_full(scene: &str, frames: &str, count: &str) {
         );
         for (block, tiles, drawn) in &full.1 {
             // The reference's frame compared with itself (its own draw, copied) is not read at all: every
-            // figure is 0 by construction (src/measure/quality.rs, `quality_frame`).
+            // figure is 0 by construction (src/measure/quality/frame.rs, `quality_frame`).
             let expected = if block.ends_with(" reference") {
                 0.0
             } else {

@@ -270,10 +270,9 @@ fn gpu_metrics_match_cpu_oracle() {
     assert!(cpu.iter().any(|m| m.de2000 > 1e-2));
 }
 
-/// A rendered frame against a blessed PNG. Tolerance: mean absolute difference at most 0.5 (of 255) per
-/// channel and at most 0.5 % of pixels differing by more than 16 in any channel, so a different LLVM or Mesa
-/// version's rasterisation may differ on edge pixels but a changed shading, colour or camera fails.
-/// Re-bless with `LODBENCH_BLESS=1 cargo test --test render snapshot`.
+/// A rendered frame against a blessed PNG, with the snapshots' tolerance (`common::snapshot_problem`: a
+/// different LLVM or Mesa version's rasterisation may differ on edge pixels, a changed shading, colour or camera
+/// fails).
 #[test]
 fn snapshot_reference_frame() {
     let scene = crate::common::sweep_scene(&[
@@ -298,65 +297,12 @@ fn snapshot_reference_frame() {
             Ok(())
         })
         .unwrap();
-    let actual = frame0.unwrap();
-    let (w, h) = (scene.width, scene.height);
+    let actual = image::RgbaImage::from_raw(scene.width, scene.height, frame0.unwrap())
+        .expect("a frame of the viewport's size");
     let snap =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots/bunny-sweep_reference_f0.png");
-    if std::env::var_os("LODBENCH_BLESS").is_some() {
-        image::save_buffer(&snap, &actual, w, h, image::ExtendedColorType::Rgba8).unwrap();
-        return;
-    }
-    let expected = image::open(&snap)
-        .unwrap_or_else(|e| panic!("{}: {e} (bless with LODBENCH_BLESS=1)", snap.display()))
-        .to_rgba8();
-    assert_eq!((expected.width(), expected.height()), (w, h));
-    let exp = expected.as_raw();
-    let mut sum = 0u64;
-    let mut bad = 0usize;
-    let mut diff_img = vec![0u8; actual.len()];
-    for (p, (a, b)) in actual.chunks_exact(4).zip(exp.chunks_exact(4)).enumerate() {
-        let mut worst = 0u8;
-        for c in 0..3 {
-            let d = a[c].abs_diff(b[c]);
-            sum += d as u64;
-            worst = worst.max(d);
-        }
-        bad += (worst > 16) as usize;
-        diff_img[p * 4..p * 4 + 4].copy_from_slice(&[worst.saturating_mul(8), 0, 0, 255]);
-    }
-    let pixels = (w * h) as usize;
-    let mean = sum as f64 / (pixels * 3) as f64;
-    let bad_frac = bad as f64 / pixels as f64;
-    // The bunny covers a good part of the frame: a blank image would not pass by accident.
-    let background = actual
-        .chunks_exact(4)
-        .filter(|p| p[..3] == exp[..3])
-        .count();
-    assert!(background < pixels, "frame is uniform");
-    if mean > 0.5 || bad_frac > 0.005 {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/snapshots");
-        std::fs::create_dir_all(&dir).unwrap();
-        image::save_buffer(
-            dir.join("bunny-sweep_reference_f0-actual.png"),
-            &actual,
-            w,
-            h,
-            image::ExtendedColorType::Rgba8,
-        )
-        .unwrap();
-        image::save_buffer(
-            dir.join("bunny-sweep_reference_f0-difference.png"),
-            &diff_img,
-            w,
-            h,
-            image::ExtendedColorType::Rgba8,
-        )
-        .unwrap();
-        panic!(
-            "snapshot differs: mean abs diff {mean:.3}, {:.3} % pixels off by > 16; see {}",
-            bad_frac * 100.0,
-            dir.display()
-        );
+    if let Some(problem) = snapshot_problem(&actual, &snap) {
+        panic!("snapshot differs: {problem}");
     }
 }
 
@@ -437,7 +383,7 @@ fn experiment_sweep_runs_and_merges() {
 /// One frame of every scene at 96x72 per method against a blessed PNG (tests/snapshots/scenes/), with the
 /// tolerance of `snapshot_reference_frame`: mean absolute difference at most 0.5 of 255 and at most 0.5 % of
 /// pixels off by more than 16. Frame 2 of a 4-frame run: the procedural scenes' camera is then two thirds of
-/// the way through its flight, inside the field. Re-bless with `LODBENCH_BLESS=1 cargo test --test render
+/// the way through its flight, inside the field. Re-bless with `LODBENCH_BLESS=1 cargo test --release --test it
 /// snapshot`.
 #[test]
 fn snapshot_scenes_every_method() {

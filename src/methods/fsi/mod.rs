@@ -65,7 +65,7 @@ pub use toggle::{
 
 use crate::effects::shadow::Caster;
 use crate::error::Result;
-use crate::gpu::scene_gpu::ShadowMap;
+use crate::gpu::scene_gpu::View;
 use crate::gpu::timestamps::GpuTimer;
 use crate::gpu::GpuContext;
 use crate::gpu::{read_texture, DrawList, DrawStats, InstanceBuffer, RenderTarget, SceneGpu};
@@ -104,7 +104,37 @@ struct Scratch {
 
 /// A t-instance's toggle: the frame its transition started (its phase 0; may be before the pass's first frame,
 /// see [`Fsi::encode`]), its (lod_from, lod_to), the LOD it started with.
-type Started = (i64, (u32, u32), u32);
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Started {
+    frame: i64,
+    lods: (u32, u32),
+    first: u32,
+}
+
+/// FSI's combination pass: the variant's pipeline (fsi_combine.wgsl's SAME_PIXEL and COMBINATION), its module
+/// and layouts (for the scratch pipeline of lodpop's counterfactuals), its inputs, output and timer.
+struct Combination {
+    pipeline: wgpu::ComputePipeline,
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
+    layout: wgpu::BindGroupLayout,
+    /// The pass writes here (storage textures cannot be sRGB); copied into the frame's target.
+    output: wgpu::Texture,
+    output_view: wgpu::TextureView,
+    uniform: wgpu::Buffer,
+    /// The pass's inputs, indexed by the newer buffer.
+    groups: [wgpu::BindGroup; 2],
+    timer: Option<GpuTimer>,
+}
+
+/// The state FSI keeps per instance.
+struct Toggles {
+    /// The frame its current transition started, its (lod_from, lod_to) and its first LOD.
+    started: Vec<Option<Started>>,
+    /// k of the previous frame, and this frame's |k - previous k| (the tau margin).
+    previous_k: Vec<Option<f32>>,
+    margin: Vec<f32>,
+}
 
 pub struct Fsi {
     variant: Variant,
@@ -114,26 +144,12 @@ pub struct Fsi {
     n_pipeline: crate::gpu::MeshPipelines,
     t_pipeline: crate::gpu::MeshPipelines,
     vis_group: wgpu::BindGroup,
-    /// The variant's combination (fsi_combine.wgsl's SAME_PIXEL and COMBINATION).
-    combine_pipeline: wgpu::ComputePipeline,
-    /// The combination's module and layout, for the scratch pipeline of lodpop's counterfactuals.
-    combine_module: wgpu::ShaderModule,
-    combine_pipeline_layout: wgpu::PipelineLayout,
-    /// The combination pass writes here (storage textures cannot be sRGB); copied into the frame's target.
-    combined: wgpu::Texture,
-    combine_uniform: wgpu::Buffer,
-    /// The combination pass's inputs, indexed by the newer buffer.
-    combine_groups: [wgpu::BindGroup; 2],
+    /// The combination pass: the two LOD buffers into the frame.
+    combine: Combination,
+    /// Per instance: its toggle and its k's step.
+    toggles: Toggles,
     /// The frame and camera the newer buffer of the last frame was rendered with.
     previous: Option<(u32, Camera)>,
-    /// Per instance: the frame its current transition started, its (lod_from, lod_to) and its first LOD.
-    started: Vec<Option<Started>>,
-    /// Per instance: k of the previous frame, and this frame's |k - previous k| (the tau margin).
-    previous_k: Vec<Option<f32>>,
-    margin: Vec<f32>,
-    combine_timer: Option<GpuTimer>,
-    combine_layout: wgpu::BindGroupLayout,
-    combined_view: wgpu::TextureView,
     /// What each LOD buffer drew last (per buffer), and the last two quality-pass frames' choices.
     choices: [Vec<Choice>; 2],
     /// The LOD buffer the last `encode` rendered at its frame's pose (its newer).
@@ -192,29 +208,29 @@ impl Fsi {
             n_pipeline,
             t_pipeline,
             vis_group,
-            combine_pipeline,
-            combine_module: module,
-            combine_pipeline_layout: layout,
-            combined,
-            combine_uniform,
-            combine_groups,
+            combine: Combination {
+                pipeline: combine_pipeline,
+                module,
+                pipeline_layout: layout,
+                layout: combine_layout,
+                output: combined,
+                output_view: combined_view,
+                uniform: combine_uniform,
+                groups: combine_groups,
+                timer: GpuTimer::on_device(device, gpu.queue.get_timestamp_period(), scene.frames),
+            },
+            toggles: Toggles {
+                started: vec![None; scene.instances.len()],
+                previous_k: vec![None; scene.instances.len()],
+                margin: vec![0.0; scene.instances.len()],
+            },
             previous: None,
-            started: vec![None; scene.instances.len()],
-            previous_k: vec![None; scene.instances.len()],
-            margin: vec![0.0; scene.instances.len()],
-            combine_timer: GpuTimer::on_device(
-                device,
-                gpu.queue.get_timestamp_period(),
-                scene.frames,
-            ),
             repeats_per_unit: scene
                 .models
                 .iter()
                 .map(|m| m.scale / m.radius.max(f32::MIN_POSITIVE))
                 .collect(),
             id_format: format,
-            combine_layout,
-            combined_view,
             last_newer: 0,
             choices: [Vec::new(), Vec::new()],
             recent: std::collections::VecDeque::new(),
@@ -238,11 +254,16 @@ impl Fsi {
                 .map_or(0, |l| l.mesh.triangle_count() as i64)
         };
         let mut diffs: Vec<(usize, i64)> = self
+            .toggles
             .started
             .iter()
             .enumerate()
             .filter_map(|(i, st)| {
-                let (_, (from, to), first) = (*st)?;
+                let Started {
+                    lods: (from, to),
+                    first,
+                    ..
+                } = (*st)?;
                 let other = if first == from { to } else { from };
                 let model = scene.instances[i].model;
                 Some((i, tris(model, first) - tris(model, other)))
@@ -251,10 +272,10 @@ impl Fsi {
         diffs.sort_by_key(|&(i, d)| (std::cmp::Reverse(d.abs()), i));
         let mut balance = 0i64;
         for (i, d) in diffs {
-            if let Some(st) = self.started[i].as_mut() {
+            if let Some(st) = self.toggles.started[i].as_mut() {
                 if balance.signum() * d.signum() > 0 {
                     // Phase 1: the other LOD now, the first one next frame.
-                    st.0 = f as i64 - 1;
+                    st.frame = f as i64 - 1;
                     balance -= d;
                 } else {
                     balance += d;
@@ -270,12 +291,10 @@ impl Fsi {
         choices.clear();
         for (i, (inst, s)) in input.scene.instances.iter().zip(input.states).enumerate() {
             choices.push(if s.in_transition() {
-                let lod = match (toggle, self.started[i]) {
+                let lod = match (toggle, self.toggles.started[i]) {
                     (Toggle::Buffer(0), _) => s.lod_from,
                     (Toggle::Buffer(_), _) => s.lod_to,
-                    (Toggle::AtFrame(f), Some((start, _, first))) => {
-                        toggle_lod(s, first, f as i64 - start)
-                    }
+                    (Toggle::AtFrame(f), Some(st)) => toggle_lod(s, st.first, f as i64 - st.frame),
                     (Toggle::AtFrame(_), None) => first_lod(s),
                 };
                 Choice {
@@ -287,7 +306,7 @@ impl Fsi {
                         if self.variant == Variant::Blend {
                             blend_weight(s, lod)
                         } else {
-                            tau_with_margin(s, lod, self.margin[i])
+                            tau_with_margin(s, lod, self.toggles.margin[i])
                         },
                         lod as f32,
                         front_id(i) as f32,
@@ -313,14 +332,14 @@ impl Fsi {
 
     fn render(
         &self,
-        (gpu, shadow): (&SceneGpu, ShadowMap),
+        (gpu, view): (&SceneGpu, View),
         encoder: &mut wgpu::CommandEncoder,
         slot: usize,
         buffer: usize,
         instances: u32,
     ) -> DrawStats {
         self.render_into(
-            (gpu, shadow),
+            (gpu, view),
             encoder,
             &self.buffers[buffer],
             &self.lists[slot],
@@ -329,11 +348,11 @@ impl Fsi {
         )
     }
 
-    /// Draws `list` (uploaded to `instances` from `first` on) into LOD buffer `b`, cleared first, lit by shadow
-    /// map `shadow`.
+    /// Draws `list` (uploaded to `instances` from `first` on) into LOD buffer `b`, cleared first, lit by the
+    /// view's shadow map (its scissor is for the frame's own target, not the LOD buffers).
     fn render_into(
         &self,
-        (gpu, shadow): (&SceneGpu, ShadowMap),
+        (gpu, view): (&SceneGpu, View),
         encoder: &mut wgpu::CommandEncoder,
         b: &LodBuffer,
         list: &DrawList,
@@ -341,46 +360,49 @@ impl Fsi {
         first: u32,
     ) -> DrawStats {
         let [r, g, bl] = crate::scene::BACKGROUND;
-        let mut pass = gpu.counted(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("fsi LOD buffer pass"),
-            color_attachments: &[
-                Some(wgpu::RenderPassColorAttachment {
-                    view: &b.target.color_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: r as f64,
-                            g: g as f64,
-                            b: bl as f64,
-                            a: 1.0,
-                        }),
+        let mut pass = gpu.counted(
+            view,
+            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("fsi LOD buffer pass"),
+                color_attachments: &[
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &b.target.color_view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color {
+                                r: r as f64,
+                                g: g as f64,
+                                b: bl as f64,
+                                a: 1.0,
+                            }),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &b.id_view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
+                ],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &b.target.depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
                         store: wgpu::StoreOp::Store,
-                    },
+                    }),
+                    stencil_ops: None,
                 }),
-                Some(wgpu::RenderPassColorAttachment {
-                    view: &b.id_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                }),
-            ],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &b.target.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
             }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        }));
-        pass.set_bind_group(0, gpu.camera_group(shadow), &[]);
+        );
+        pass.set_bind_group(0, gpu.camera_group(view.shadow), &[]);
         pass.set_bind_group(1, &self.vis_group, &[]);
         gpu.draw(
             &mut pass,
@@ -411,9 +433,9 @@ impl Fsi {
         }
         // Same bytes, sRGB-tagged: copies between the two formats are plain copies.
         encoder.copy_texture_to_texture(
-            self.combined.as_image_copy(),
+            self.combine.output.as_image_copy(),
             target.color.as_image_copy(),
-            self.combined.size(),
+            self.combine.output.size(),
         );
     }
 
@@ -426,11 +448,11 @@ impl Fsi {
         let combination = combination(self.variant, false);
         let (device, layout, view, format) = (
             &gpu.device,
-            &self.combine_layout,
-            &self.combined_view,
+            &self.combine.layout,
+            &self.combine.output_view,
             self.id_format,
         );
-        let module = (&self.combine_module, &self.combine_pipeline_layout);
+        let module = (&self.combine.module, &self.combine.pipeline_layout);
         self.scratch.get_or_insert_with(|| {
             let buffers = [
                 LodBuffer::new(gpu, "fsi lodpop buffer 0", w, h, format),
@@ -481,7 +503,7 @@ impl Fsi {
             fill_list(list, input, c);
             gpu.upload_at(&scratch.instances, slot as u32 * n, list);
             self.render_into(
-                (gpu, input.view.shadow),
+                (gpu, input.view),
                 encoder,
                 &scratch.buffers[k],
                 list,
@@ -561,25 +583,27 @@ impl Method for Fsi {
         let follows = matches!(self.previous, Some((p, _)) if p.wrapping_add(1) == f);
         let mut stats = DrawStats::default();
         if !follows {
-            self.started.fill(None);
-            self.previous_k.fill(None);
+            self.toggles.started.fill(None);
+            self.toggles.previous_k.fill(None);
         }
         let sequential = self.variant != Variant::SameFrame;
         for (i, s) in input.states.iter().enumerate() {
             let k = s.in_transition().then_some(s.k);
-            self.margin[i] = match (k, self.previous_k[i]) {
+            self.toggles.margin[i] = match (k, self.toggles.previous_k[i]) {
                 (Some(k), Some(p)) if sequential => (k - p).abs(),
                 _ => 0.0,
             };
-            self.previous_k[i] = k;
+            self.toggles.previous_k[i] = k;
         }
         for (i, s) in input.states.iter().enumerate() {
-            self.started[i] = match self.started[i] {
+            self.toggles.started[i] = match self.toggles.started[i] {
                 _ if !s.in_transition() => None,
-                Some((start, pair, first)) if pair == (s.lod_from, s.lod_to) => {
-                    Some((start, pair, first))
-                }
-                _ => Some((f as i64, (s.lod_from, s.lod_to), first_lod(s))),
+                Some(st) if st.lods == (s.lod_from, s.lod_to) => Some(st),
+                _ => Some(Started {
+                    frame: f as i64,
+                    lods: (s.lod_from, s.lod_to),
+                    first: first_lod(s),
+                }),
             };
         }
         if !follows {
@@ -597,13 +621,13 @@ impl Method for Fsi {
                 // Both buffers this frame, same camera (at a path's start: the previous frame as it would
                 // have been, the other LOD of each t-instance).
                 self.prepare(gpu, input, 1 - newer, old_toggle);
-                stats += self.render((gpu, input.view.shadow), encoder, 1 - newer, 1 - newer, n);
+                stats += self.render((gpu, input.view), encoder, 1 - newer, 1 - newer, n);
                 camera
             }
             (_, true, Some((_, c))) => c,
         };
         self.prepare(gpu, input, newer, new_toggle);
-        stats += self.render((gpu, input.view.shadow), encoder, newer, newer, n);
+        stats += self.render((gpu, input.view), encoder, newer, newer, n);
         self.last_newer = newer;
         self.previous = Some((f, camera));
         if !input.timed {
@@ -624,15 +648,15 @@ impl Method for Fsi {
             size: [target.width as f32, target.height as f32, 0.0, 0.0],
         };
         gpu.queue
-            .write_buffer(&self.combine_uniform, 0, bytemuck::bytes_of(&raw));
+            .write_buffer(&self.combine.uniform, 0, bytemuck::bytes_of(&raw));
         // Timed in the quality pass only: the timing pass's frames hold nothing but the method's own work.
-        let timer = self.combine_timer.as_ref().filter(|_| !input.timed);
+        let timer = self.combine.timer.as_ref().filter(|_| !input.timed);
         if let Some(t) = timer {
             t.begin(encoder, f);
         }
         self.combine(
             encoder,
-            (&self.combine_pipeline, &self.combine_groups[newer]),
+            (&self.combine.pipeline, &self.combine.groups[newer]),
             target,
         );
         if let Some(t) = timer {
@@ -647,7 +671,7 @@ impl Method for Fsi {
     }
 
     fn stage_gpu_ms(&self, ctx: &GpuContext) -> Result<Option<Vec<Option<f64>>>> {
-        match &self.combine_timer {
+        match &self.combine.timer {
             Some(t) => Ok(Some(t.read(ctx)?)),
             None => Ok(None),
         }

@@ -8,10 +8,11 @@ use crate::error::{Error, Result};
 use crate::geometry::gltf::{AuthoredChain, ChainSource};
 use crate::geometry::lod::{self, LodChain};
 use crate::geometry::mesh::Mesh;
+use crate::geometry::projection::{distance_of, error_at_distance, Sphere};
 use crate::scene::bunny::USER_SWITCH_FIT_MULTIPLES;
-use crate::scene::config::{screen_size_distance, SceneConfig};
+use crate::scene::config::SceneConfig;
 use crate::scene::kind::{ProfileValues, SceneKind};
-use crate::scene::model::Model;
+use crate::scene::model::{Model, SwitchSource};
 use crate::scene::user::models::PendingModel;
 use crate::scene::user::parts::ChainDescription;
 
@@ -53,7 +54,10 @@ pub fn build(
         path: file.to_string(),
         problem,
     };
-    let (center, radius) = pending.levels[0].bounding_sphere();
+    let Sphere {
+        centre: center,
+        radius,
+    } = pending.levels[0].bounding_sphere();
     let Some(info) = &pending.authored else {
         return generated(file, pending, view, seen_from, (center, radius));
     };
@@ -77,7 +81,7 @@ pub fn build(
         pending.color,
     )?;
     model.lod_colors = pending.lod_colors;
-    if let (Some(d), false) = (exact, model.switch_source == "override") {
+    if let (Some(d), false) = (exact, model.switch_source == SwitchSource::Override) {
         // Exact as written (the round trip through the pixel error may move the last bit), unless
         // --switch-distances or --switch-screen-sizes replaced them.
         view.cfg.user_schedule.check_switches(&pending.name, d)?;
@@ -115,7 +119,7 @@ fn generated(
     let errors: Vec<f32> = USER_SWITCH_FIT_MULTIPLES
         .iter()
         .map(|m| {
-            lod::error_at_distance(
+            error_at_distance(
                 m * seen_from,
                 1.0,
                 view.pixel_error,
@@ -145,7 +149,7 @@ fn generated(
         pending.name,
         chain,
         (center, radius),
-        "pixel-error",
+        SwitchSource::PixelError,
         pending.color,
     )?;
     model.lod_colors = pending.lod_colors;
@@ -217,36 +221,37 @@ fn authored_errors(
     meshes: &[Mesh],
     radius: f32,
     view: &View<'_>,
-) -> Result<(Vec<f32>, String, &'static str)> {
-    let to_errors = |d: &[f32]| -> Vec<f32> {
-        std::iter::once(0.0)
-            .chain(d.iter().map(|&d| {
-                lod::error_at_distance(d, 1.0, view.pixel_error, view.pv.height, view.fov_y)
-            }))
-            .collect()
-    };
+) -> Result<(Vec<f32>, String, SwitchSource)> {
+    let to_errors =
+        |d: &[f32]| -> Vec<f32> {
+            std::iter::once(0.0)
+                .chain(d.iter().map(|&d| {
+                    error_at_distance(d, 1.0, view.pixel_error, view.pv.height, view.fov_y)
+                }))
+                .collect()
+        };
     Ok(match (&chain.screen_coverage, exact) {
         (_, Some(d)) => (
             to_errors(d),
             format!("extras.lodbench_switch_distances {d:?} (lodbench export's exact distances)"),
-            "lodbench_switch_distances",
+            SwitchSource::ExportedDistances,
         ),
         (Some(c), None) if c.len() + 1 >= meshes.len() && meshes.len() > 1 => {
             let d: Vec<f32> = c[..meshes.len() - 1]
                 .iter()
-                .map(|&c| screen_size_distance(radius, c as f32, view.fov_y))
+                .map(|&c| distance_of(radius, c as f32, view.fov_y))
                 .collect();
             (
                 to_errors(&d),
                 format!("MSFT_screencoverage {c:?} (the last value, the cull threshold, not used)"),
-                "MSFT_screencoverage",
+                SwitchSource::ScreenCoverage,
             )
         }
         _ => (
             estimated_errors(file, meshes)?,
             "meshopt's error at each level's triangle count, projected to --pixel-error"
                 .to_string(),
-            "pixel-error (estimated)",
+            SwitchSource::PixelErrorEstimated,
         ),
     })
 }
@@ -278,7 +283,7 @@ fn finish(
     name: String,
     chain: LodChain,
     (center, radius): (glam::Vec3, f32),
-    source: &'static str,
+    source: SwitchSource,
     color: [f32; 3],
 ) -> Result<Model> {
     let (switches, switch_source) =
@@ -286,7 +291,7 @@ fn finish(
             .cfg
             .switch_override(&name, chain.lods.len(), radius, view.fov_y)?
         {
-            Some(s) => (s, "override"),
+            Some(s) => (s, SwitchSource::Override),
             None => (
                 lod::switch_distances(&chain, 1.0, view.pixel_error, view.pv.height, view.fov_y),
                 source,

@@ -4,7 +4,7 @@
 
 use crate::error::{Error, Result};
 use crate::geometry::gltf::{AnimatedCamera, Content};
-use crate::scene::bunny::fit_distance;
+use crate::geometry::projection::{fit_distance, Sphere};
 use crate::scene::camera_path::CameraPath;
 use crate::scene::config::SceneConfig;
 use crate::scene::kind::ProfileValues;
@@ -52,25 +52,16 @@ pub fn file_camera(
     Ok(Some((a, path)))
 }
 
-/// The smallest sphere around the box of the `spheres` (centre, radius): what the default flight shows whole.
-pub fn bounding_sphere(spheres: &[(Vec3, f32)]) -> (Vec3, f32) {
-    let (lo, hi) = spheres.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), &(c, r)| (lo.min(c - Vec3::splat(r)), hi.max(c + Vec3::splat(r))),
-    );
-    let centre = (lo + hi) * 0.5;
-    let radius = spheres
-        .iter()
-        .map(|&(c, r)| c.distance(centre) + r)
-        .fold(0.0f32, f32::max);
-    (centre, radius)
-}
-
 /// The default flight's first eye: on +z (glTF's front) of the scene sphere's centre, looking along -z, where
 /// the sphere fits the view.
-pub fn start(sphere: (Vec3, f32), pv: &ProfileValues, fov_y: f32) -> (Vec3, f32) {
-    let d = fit_distance(sphere.1.max(f32::MIN_POSITIVE), pv.width, pv.height, fov_y);
-    (sphere.0 + Vec3::Z * d, d)
+pub fn start(sphere: Sphere, pv: &ProfileValues, fov_y: f32) -> (Vec3, f32) {
+    let d = fit_distance(
+        sphere.radius.max(f32::MIN_POSITIVE),
+        pv.width,
+        pv.height,
+        fov_y,
+    );
+    (sphere.centre + Vec3::Z * d, d)
 }
 
 /// How far out the flight goes: every instance (`(position on the last frame, the last switch of its model)`)
@@ -111,12 +102,15 @@ mod tests {
 
     #[test]
     fn the_sphere_holds_every_sphere() {
-        let spheres = [(Vec3::ZERO, 1.0), (Vec3::new(10.0, 0.0, 0.0), 2.0)];
-        let (c, r) = bounding_sphere(&spheres);
-        assert_eq!(c, Vec3::new(5.5, 0.0, 0.0));
-        assert_eq!(r, 6.5);
-        for (s, sr) in spheres {
-            assert!(s.distance(c) + sr <= r + 1e-6);
+        let spheres = [
+            Sphere::new(Vec3::ZERO, 1.0),
+            Sphere::new(Vec3::new(10.0, 0.0, 0.0), 2.0),
+        ];
+        let all = Sphere::holding(&spheres);
+        assert_eq!(all.centre, Vec3::new(5.5, 0.0, 0.0));
+        assert_eq!(all.radius, 6.5);
+        for s in spheres {
+            assert!(s.centre.distance(all.centre) + s.radius <= all.radius + 1e-6);
         }
     }
 }

@@ -30,8 +30,8 @@ pub use parts::{ChainDescription, InstanceSource, UserParts};
 use crate::error::{Error, Result};
 use crate::geometry::gltf;
 use crate::geometry::mesh::read_mesh_file;
+use crate::geometry::projection::{fit_distance, Sphere};
 use crate::scene::animated::Animated;
-use crate::scene::bunny::fit_distance;
 use crate::scene::config::SceneConfig;
 use crate::scene::kind::{ProfileValues, SceneKind};
 use crate::scene::model::{CameraTrack, Instance, Layout, Model, ModelSet, Motion};
@@ -64,7 +64,7 @@ pub fn def(
 
     // The default flight's start: the whole scene on frame 0.
     let spheres = first_frame_spheres(clip.as_ref(), &rig, &collected, &deform_specs, &placed);
-    let sphere = flight::bounding_sphere(&spheres);
+    let sphere = Sphere::holding(&spheres);
     let (eye0, start) = flight::start(sphere, pv, fov_y);
 
     // The LOD chains, a generated chain's levels at multiples of the distance its model is first seen from.
@@ -102,15 +102,15 @@ pub fn def(
     // The flight's end, the clip planes, and what the camera does.
     let end = flight::end(
         cfg,
-        sphere.0,
+        sphere.centre,
         start,
         pv.frames,
         &last_places(&models, &instances, &placed, pv.frames),
     );
-    let (from, to) = (eye0, sphere.0 + Vec3::Z * end);
+    let (from, to) = (eye0, sphere.centre + Vec3::Z * end);
     let eyes = clip_eyes(&camera, cfg.camera_path.as_ref(), [from, to]);
     let (near, far) = clip_planes(&models, &instances, &placed, pv.frames, &camera, &eyes);
-    let camera_source = camera_source(&camera, [from, to], sphere.1);
+    let camera_source = camera_source(&camera, [from, to], sphere.radius);
     let parts = UserParts {
         materials,
         instance_count: instances.len(),
@@ -120,7 +120,7 @@ pub fn def(
         forward: [0.0, 0.0, -1.0],
         near,
         far,
-        scene_sphere: (sphere.0.to_array(), sphere.1),
+        scene_sphere: (sphere.centre.to_array(), sphere.radius),
         start,
         chains: chain_descriptions,
         fov_y: camera.as_ref().and_then(|c| c.0.yfov),
@@ -253,7 +253,7 @@ fn first_frame_spheres(
     collected: &models::Collected,
     deform_specs: &[Option<models::DeformSpec>],
     placed: &Placed,
-) -> Vec<(Vec3, f32)> {
+) -> Vec<Sphere> {
     let levels0: Vec<&crate::geometry::mesh::Mesh> =
         collected.models.iter().map(|m| &m.levels[0]).collect();
     let poses = match clip {
@@ -269,13 +269,13 @@ fn first_frame_spheres(
         .iter()
         .enumerate()
         .map(|(k, i)| {
-            let (c, r) = match &poses[i.model] {
-                Some(p) => bounding_sphere_of(p),
+            let sphere = match &poses[i.model] {
+                Some(p) => Sphere::around(p),
                 None => levels0[i.model].bounding_sphere(),
             };
             let m = placed.at(k, 0);
             let s = m.to_scale_rotation_translation().0.abs().max_element();
-            (m.transform_point3(c), r * s)
+            Sphere::new(m.transform_point3(sphere.centre), sphere.radius * s)
         })
         .collect()
 }
@@ -283,7 +283,7 @@ fn first_frame_spheres(
 /// Where each model is first seen from: the default flight's first eye (None with the file's camera or
 /// `--camera-path`) and every instance's sphere on frame 0.
 struct FirstSeen<'a> {
-    spheres: &'a [(Vec3, f32)],
+    spheres: &'a [Sphere],
     eye: Option<Vec3>,
 }
 
@@ -299,7 +299,7 @@ fn build_models(
 ) -> Result<(Vec<Model>, Vec<ChainDescription>, Vec<String>)> {
     let (mut models, mut descriptions, mut notes) = (Vec::new(), Vec::new(), Vec::new());
     for (m, p) in pending.into_iter().enumerate() {
-        let radius = p.levels[0].bounding_sphere().1;
+        let radius = p.levels[0].bounding_sphere().radius;
         let fit = fit_distance(radius, view.pv.width, view.pv.height, view.fov_y);
         let nearest = match seen.eye {
             Some(eye) => seen
@@ -307,7 +307,7 @@ fn build_models(
                 .iter()
                 .zip(instances)
                 .filter(|(_, i)| i.model == m)
-                .map(|(s, _)| s.0.distance(eye))
+                .map(|(s, _)| s.centre.distance(eye))
                 .fold(f32::INFINITY, f32::min),
             None => fit,
         };
@@ -386,20 +386,6 @@ fn clip_planes(
         file.and_then(|c| c.0).unwrap_or(smallest * 0.02),
         file.and_then(|c| c.1).unwrap_or(reach * 1.5),
     )
-}
-
-/// The centre of the box of `points` and the radius of the sphere around it that holds them all.
-fn bounding_sphere_of(points: &[[f32; 3]]) -> (Vec3, f32) {
-    let (lo, hi) = points.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(Vec3::from(*p)), hi.max(Vec3::from(*p))),
-    );
-    let c = (lo + hi) * 0.5;
-    let r = points
-        .iter()
-        .map(|p| Vec3::from(*p).distance(c))
-        .fold(0.0f32, f32::max);
-    (c, r)
 }
 
 /// The instances and camera of a user scene.

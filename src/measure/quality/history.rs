@@ -1,0 +1,118 @@
+//! lodpop's history: the schedule states of the last frames, and whether this frame can differ from its
+//! counterfactual.
+
+use crate::scene::schedule::InstanceState;
+use std::collections::VecDeque;
+
+/// The schedule states of the last frames, newest first: lodpop's history.
+pub(super) struct StateHistory {
+    /// How many earlier frames the method's counterfactual reads (`Counterfactual::lodpop_history`, at least 1).
+    pub(super) depth: usize,
+    pub(super) frames: VecDeque<Vec<InstanceState>>,
+}
+
+impl StateHistory {
+    pub(super) fn new(depth: usize) -> StateHistory {
+        StateHistory {
+            depth,
+            frames: VecDeque::with_capacity(depth + 1),
+        }
+    }
+
+    /// The previous frame's states (before [`StateHistory::push`] of this frame's).
+    pub(super) fn previous(&self) -> Option<&[InstanceState]> {
+        self.frames.front().map(Vec::as_slice)
+    }
+
+    pub(super) fn push(&mut self, states: &[InstanceState]) {
+        self.frames.push_front(states.to_vec());
+        self.frames.truncate(self.depth + 1);
+    }
+
+    /// Whether the frame after `push` can differ from its counterfactual: the states changed within the
+    /// history (an instance's state is not `same` as before), a transition is under way with a history
+    /// deeper than one frame, or the method says its selection changed (asked last).
+    pub(super) fn changed(
+        &self,
+        same: impl Fn(&InstanceState, &InstanceState) -> bool,
+        selection_changed: impl FnOnce() -> bool,
+    ) -> bool {
+        let h = &self.frames;
+        let same_frame = |a: &[InstanceState], b: &[InstanceState]| {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| same(x, y))
+        };
+        h.len() > 1
+            && (h.iter().skip(1).any(|s| !same_frame(s, &h[0]))
+                || (self.depth > 1 && h.iter().flatten().any(|s| s.in_transition()))
+                || selection_changed())
+    }
+
+    /// The earlier frames' states, newest first.
+    pub(super) fn earlier(&self) -> Vec<&[InstanceState]> {
+        self.frames.iter().skip(1).map(Vec::as_slice).collect()
+    }
+}
+
+/// Whether two states of an instance draw the same image of it (`Counterfactual::same_image_state`).
+pub(super) type SameImage<'m> = dyn Fn(&InstanceState, &InstanceState) -> bool + 'm;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn states(lods: &[(u32, u32, f32)]) -> Vec<InstanceState> {
+        lods.iter()
+            .map(|&(lod_from, lod_to, k)| InstanceState {
+                lod_from,
+                lod_to,
+                k,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_counterfactual_is_drawn_only_when_the_frame_can_differ() {
+        let steady = states(&[(1, 1, 0.0), (2, 2, 0.0)]);
+        let switched = states(&[(1, 1, 0.0), (3, 3, 0.0)]);
+        let mut h = StateHistory::new(1);
+        h.push(&steady);
+        assert!(
+            !h.changed(|a, b| a == b, || true),
+            "the first frame has no earlier frame"
+        );
+        assert_eq!(h.previous(), Some(steady.as_slice()));
+        h.push(&steady);
+        assert!(!h.changed(|a, b| a == b, || false), "the same states twice");
+        assert!(
+            h.changed(|a, b| a == b, || true),
+            "the method's own selection changed"
+        );
+        h.push(&switched);
+        assert!(h.changed(|a, b| a == b, || false), "an instance switched");
+        assert_eq!(
+            h.earlier(),
+            vec![steady.as_slice()],
+            "depth 1 keeps one earlier frame"
+        );
+    }
+
+    #[test]
+    fn a_deeper_history_counts_a_transition_under_way() {
+        let blending = states(&[(1, 2, 0.5)]);
+        let mut shallow = StateHistory::new(1);
+        let mut deep = StateHistory::new(2);
+        for _ in 0..3 {
+            shallow.push(&blending);
+            deep.push(&blending);
+        }
+        assert!(
+            !shallow.changed(|a, b| a == b, || false),
+            "one frame back, the same blend state"
+        );
+        assert!(
+            deep.changed(|a, b| a == b, || false),
+            "two frames back, a transition under way"
+        );
+        assert_eq!(deep.earlier().len(), 2);
+    }
+}
