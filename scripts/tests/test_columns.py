@@ -25,7 +25,7 @@ RECORDS = {
     results.ROUNDS_CSV: ("src/measure/records/summaries.rs", "RoundRecord"),
     results.PAIRS_CSV: ("src/measure/records/summaries.rs", "PairRecord"),
     results.PERCEPTUAL_CSV: ("src/commands/perceptual.rs", "PerceptualRecord"),
-    results.TUNE_CSV: ("src/measure/switch_tuning.rs", "Sample"),
+    results.TUNE_CSV: ("src/measure/switch_tuning/outcome.rs", "Sample"),
     results.RULES_CSV: ("src/commands/tune.rs", "RuleRow"),
     results.PROBE_CSV: ("src/measure/probe_rounds.rs", "ProbeRecord"),
     results.OVERHEAD_CSV: ("src/measure/overhead_rounds.rs", "OverheadRecord"),
