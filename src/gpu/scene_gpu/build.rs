@@ -34,18 +34,30 @@ pub struct SceneGpu {
     pub camera: CameraGpu,
     /// The shadow maps (`--shadows on`; only the placeholder otherwise).
     pub shadows: ShadowMapsGpu,
-    pub shader: wgpu::ShaderModule,
-    /// The flat surface's shader in a scene of materials ([`SceneGpu::flat_pipeline`]).
-    pub(super) flat_shader: Option<wgpu::ShaderModule>,
-    /// What the mesh shader's surface is: flat, or the scene's materials.
-    pub surface: Surface,
+    /// The mesh shader and what every mesh pipeline of the scene is built with.
+    pub shading: Shading,
     /// The material parts of every LOD ([`LodRange::parts`]).
     pub parts: Vec<PartRange>,
-    /// The classes of the parts (the plain class alone with the flat surface), each mesh pipeline's variants.
-    pub classes: Vec<MaterialClass>,
     /// The materials' textures, samplers and bind groups, and the surface vertex buffer (PBR surface).
     pub materials: Option<MaterialsGpu>,
     pub opaque_pipeline: MeshPipelines,
+    pub uploads: UploadCounters,
+    /// The deformed models' pose as [`SceneGpu::write_pose`] last wrote it, with its scratch.
+    pub(super) pose: std::cell::RefCell<PoseState>,
+    /// Counts the fragments of the passes begun while the quality pass counts a method's frame (None where the
+    /// device has no pipeline statistics queries).
+    pub fragments: Option<crate::gpu::fragments::FragmentQueries>,
+}
+
+/// The mesh shader and what every mesh pipeline of a scene is built with.
+pub struct Shading {
+    pub shader: wgpu::ShaderModule,
+    /// The flat surface's shader in a scene of materials ([`SceneGpu::flat_pipeline`]).
+    pub flat_shader: Option<wgpu::ShaderModule>,
+    /// What the mesh shader's surface is: flat, or the scene's materials.
+    pub surface: Surface,
+    /// The classes of the parts (the plain class alone with the flat surface), each mesh pipeline's variants.
+    pub classes: Vec<MaterialClass>,
     /// The scene has alpha-tested geometry: every mesh pipeline is built with `ALPHA_TEST` on.
     pub alpha_test: bool,
     /// Faces every mesh pipeline culls where its own descriptor says None: back faces in the unified scenes
@@ -53,12 +65,6 @@ pub struct SceneGpu {
     /// shows what lies behind the surface, as in an engine that culls a model's inside, and `crack_px` sees it;
     /// none elsewhere.
     pub cull: Option<wgpu::Face>,
-    pub uploads: UploadCounters,
-    /// The deformed models' pose as [`SceneGpu::write_pose`] last wrote it, with its scratch.
-    pub(super) pose: std::cell::RefCell<PoseState>,
-    /// Counts the fragments of the passes begun while the quality pass counts a method's frame (None where the
-    /// device has no pipeline statistics queries).
-    pub fragments: Option<crate::gpu::fragments::FragmentQueries>,
 }
 
 /// The mesh shader with the scene's `surface`, and (with the PBR surface) the flat one besides, built first.
@@ -100,13 +106,13 @@ impl SceneGpu {
     pub fn pipeline_context(&self) -> PipelineContext<'_> {
         PipelineContext {
             device: &self.device,
-            shader: &self.shader,
+            shader: &self.shading.shader,
             camera_layout: &self.camera.layout,
-            alpha_test: self.alpha_test,
-            surface: self.surface,
+            alpha_test: self.shading.alpha_test,
+            surface: self.shading.surface,
             material_layout: self.materials.as_ref().map(|m| &m.layout),
-            classes: &self.classes,
-            cull: self.cull,
+            classes: &self.shading.classes,
+            cull: self.shading.cull,
         }
     }
 
@@ -122,7 +128,11 @@ impl SceneGpu {
     pub fn flat_pipeline(&self, d: &MeshPipeline<'_>) -> MeshPipelines {
         mesh_pipelines(
             &PipelineContext {
-                shader: self.flat_shader.as_ref().unwrap_or(&self.shader),
+                shader: self
+                    .shading
+                    .flat_shader
+                    .as_ref()
+                    .unwrap_or(&self.shading.shader),
                 surface: Surface::Flat,
                 material_layout: None,
                 classes: &[MaterialClass::PLAIN],
@@ -223,15 +233,17 @@ impl SceneGpu {
                 maps: shadow_maps,
                 size: shadow_size,
             },
-            shader,
-            flat_shader,
-            surface,
+            shading: Shading {
+                shader,
+                flat_shader,
+                surface,
+                classes,
+                alpha_test,
+                cull,
+            },
             parts: geometry.parts,
-            classes,
             materials,
             opaque_pipeline,
-            alpha_test,
-            cull,
             uploads: UploadCounters::default(),
             pose: Default::default(),
             fragments: crate::gpu::fragments::FragmentQueries::new(device),
