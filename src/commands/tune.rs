@@ -403,47 +403,9 @@ fn write_rules(out: &Path, models: &[ModelSwitches]) -> Result<()> {
     write_whole(out, RULES_CSV, &rows).map(|_| ())
 }
 
-/// The cross-fading engines' files with blending methods' bands: `dithered` for Unity and Bevy, `blended` for
-/// Godot.
-fn write_fading(
-    out: &Path,
-    dithered: &[EngineModel],
-    blended: &[EngineModel],
-    fov_y: f32,
-) -> Result<()> {
-    let dir = out.join(ENGINES_DIR);
-    let unity: Vec<_> = dithered.iter().map(|m| engines::unity(m, fov_y)).collect();
-    let bevy: Vec<_> = dithered
-        .iter()
-        .map(|m| (m.name.clone(), engines::bevy(m)))
-        .collect();
-    let godot: Vec<_> = blended
-        .iter()
-        .map(|m| (m.name.clone(), engines::godot(m)))
-        .collect();
+/// Unity's, Unreal's, Godot's and Bevy's settings of `models`, as their files hold them (JSON).
+fn engine_json(models: &[EngineModel], fov_y: f32) -> [String; 4] {
     use erased::Json;
-    write(
-        &dir.join(EngineFile::UnityLodGroupCrossfade.name()),
-        unity.text().as_bytes(),
-    )?;
-    write(
-        &dir.join(EngineFile::BevyVisibilityRangesFade.name()),
-        bevy.text().as_bytes(),
-    )?;
-    write(
-        &dir.join(EngineFile::GodotVisibilityRangesFade.name()),
-        godot.text().as_bytes(),
-    )
-}
-
-/// The engine folder's README's text (docs/engines.md), after what the switches hold for.
-const ENGINES_README_TEXT: &str = include_str!("../../docs/engines.md");
-
-fn write_engines(out: &Path, models: &[EngineModel], viewing: &Viewing) -> Result<()> {
-    let fov_y = viewing.fov_y;
-    let dir: PathBuf = out.join(ENGINES_DIR);
-    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
-    let json = |v: &dyn erased::Json| v.text();
     let unity: Vec<_> = models.iter().map(|m| engines::unity(m, fov_y)).collect();
     let unreal: Vec<_> = models.iter().map(|m| engines::unreal(m, fov_y)).collect();
     let godot: Vec<_> = models
@@ -454,22 +416,46 @@ fn write_engines(out: &Path, models: &[EngineModel], viewing: &Viewing) -> Resul
         .iter()
         .map(|m| (m.name.clone(), engines::bevy(m)))
         .collect();
-    write(
-        &dir.join(EngineFile::UnityLodGroup.name()),
-        json(&unity).as_bytes(),
-    )?;
-    write(
-        &dir.join(EngineFile::UnrealScreenSizes.name()),
-        json(&unreal).as_bytes(),
-    )?;
-    write(
-        &dir.join(EngineFile::GodotVisibilityRanges.name()),
-        json(&godot).as_bytes(),
-    )?;
-    write(
-        &dir.join(EngineFile::BevyVisibilityRanges.name()),
-        json(&bevy).as_bytes(),
-    )?;
+    [unity.text(), unreal.text(), godot.text(), bevy.text()]
+}
+
+/// The cross-fading engines' files with blending methods' bands: `dithered` for Unity and Bevy, `blended` for
+/// Godot.
+fn write_fading(
+    out: &Path,
+    dithered: &[EngineModel],
+    blended: &[EngineModel],
+    fov_y: f32,
+) -> Result<()> {
+    let dir = out.join(ENGINES_DIR);
+    let [unity, _, _, bevy] = engine_json(dithered, fov_y);
+    let [_, _, godot, _] = engine_json(blended, fov_y);
+    for (file, text) in [
+        (EngineFile::UnityLodGroupCrossfade, unity),
+        (EngineFile::BevyVisibilityRangesFade, bevy),
+        (EngineFile::GodotVisibilityRangesFade, godot),
+    ] {
+        write(&dir.join(file.name()), text.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// The engine folder's README's text (docs/engines.md), after what the switches hold for.
+const ENGINES_README_TEXT: &str = include_str!("../../docs/engines.md");
+
+fn write_engines(out: &Path, models: &[EngineModel], viewing: &Viewing) -> Result<()> {
+    let fov_y = viewing.fov_y;
+    let dir: PathBuf = out.join(ENGINES_DIR);
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let files = [
+        EngineFile::UnityLodGroup,
+        EngineFile::UnrealScreenSizes,
+        EngineFile::GodotVisibilityRanges,
+        EngineFile::BevyVisibilityRanges,
+    ];
+    for (file, text) in files.into_iter().zip(engine_json(models, fov_y)) {
+        write(&dir.join(file.name()), text.as_bytes())?;
+    }
     let about = viewing.about(models);
     let mut header = vec![
         "lodbench tune: switch distances for three.js (THREE.LOD), from each model's bounding-sphere centre."
