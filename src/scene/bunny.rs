@@ -236,13 +236,12 @@ fn bunny_model(
     };
     let scale = 1.0;
     let (switches, switch_source) =
-        match cfg.switch_override("the bunny", chain.lods.len(), radius, fov_y)? {
-            Some(s) => (s, SwitchSource::Override),
-            None => (
+        cfg.switches_or("the bunny", (chain.lods.len(), radius, fov_y), || {
+            (
                 lod::switch_distances(&chain, scale, cfg.pixel_error(kind, height), height, fov_y),
                 SwitchSource::PixelError,
-            ),
-        };
+            )
+        })?;
     cfg.schedule.check_switches("bunny", &switches)?;
     Ok((
         Model {

@@ -2,6 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::scene::kind::{CameraMode, Profile, ProfileValues, SceneKind, SweepStart};
+use crate::scene::model::SwitchSource;
 use crate::scene::schedule::ScheduleParams;
 use serde::Serialize;
 
@@ -121,11 +122,26 @@ impl SceneConfig {
         }
     }
 
-    /// `--switch-distances` for model `what` of `lods` LODs: None without the flag, an error unless it gives
-    /// one distance for each LOD after LOD0.
-    /// With `--switch-screen-sizes`, the distances are `screen_size_distance(radius, size, fov_y)` for the
-    /// model's bounding-sphere `radius` (world units) and the vertical field of view `fov_y` (radians).
-    pub fn switch_override(
+    /// Model `what`'s switch distances and where they come from: `--switch-distances` or
+    /// `--switch-screen-sizes` where given (an error unless they give one value for each of its `lods` LODs after
+    /// LOD0), else `otherwise`'s. A screen size becomes the distance at which the model's bounding sphere
+    /// (`radius`, world units) has it under the vertical field of view `fov_y` (radians,
+    /// `geometry::projection::distance_of`).
+    pub fn switches_or(
+        &self,
+        what: &str,
+        (lods, radius, fov_y): (usize, f32, f32),
+        otherwise: impl FnOnce() -> (Vec<f32>, SwitchSource),
+    ) -> Result<(Vec<f32>, SwitchSource)> {
+        Ok(match self.switch_override(what, lods, radius, fov_y)? {
+            Some(s) => (s, SwitchSource::Override),
+            None => otherwise(),
+        })
+    }
+
+    /// `--switch-distances` (or `--switch-screen-sizes` as distances) for model `what` of `lods` LODs: None
+    /// without either flag ([`SceneConfig::switches_or`]).
+    fn switch_override(
         &self,
         what: &str,
         lods: usize,

@@ -31,17 +31,17 @@ pub fn def(kind: SceneKind, cfg: &SceneConfig, height: u32, fov_y: f32) -> Resul
         radius,
     } = chain.lods[0].mesh.bounding_sphere();
     let scale = 1.0;
-    let (switches, switch_source) = match (
-        cfg.switch_override(name, chain.lods.len(), radius * scale, fov_y)?,
-        kind,
-    ) {
-        (Some(s), _) => (s, SwitchSource::Override),
-        (None, SceneKind::Simple) => (vec![12.0 * radius], SwitchSource::Scene),
-        (None, _) => (
-            lod::switch_distances(&chain, scale, cfg.pixel_error(kind, height), height, fov_y),
-            SwitchSource::PixelError,
-        ),
-    };
+    let (switches, switch_source) = cfg.switches_or(
+        name,
+        (chain.lods.len(), radius * scale, fov_y),
+        || match kind {
+            SceneKind::Simple => (vec![12.0 * radius], SwitchSource::Scene),
+            _ => (
+                lod::switch_distances(&chain, scale, cfg.pixel_error(kind, height), height, fov_y),
+                SwitchSource::PixelError,
+            ),
+        },
+    )?;
     cfg.schedule.check_switches(name, &switches)?;
     let model = Model {
         name: name.trim_end_matches('s').to_string(),

@@ -54,12 +54,9 @@ pub fn build(
         path: file.to_string(),
         problem,
     };
-    let Sphere {
-        centre: center,
-        radius,
-    } = pending.levels[0].bounding_sphere();
+    let sphere = pending.levels[0].bounding_sphere();
     let Some(info) = &pending.authored else {
-        return generated(file, pending, view, seen_from, (center, radius));
+        return generated(file, pending, view, seen_from, sphere);
     };
     let chain = &info.chain;
     let meshes = pending.levels;
@@ -68,7 +65,7 @@ pub fn build(
         .as_ref()
         .filter(|d| d.len() + 1 == meshes.len());
     let (errors, thresholds, source) =
-        authored_errors(file, (chain, exact), &meshes, radius, view)?;
+        authored_errors(file, (chain, exact), &meshes, sphere.radius, view)?;
     let levels = meshes.len();
     let lod_chain = LodChain::from_meshes(&pending.name, meshes, &errors)
         .map_err(|e| bad(format!("LOD chain '{}': {e}", chain.name)))?;
@@ -76,7 +73,7 @@ pub fn build(
         view,
         pending.name.clone(),
         lod_chain,
-        (center, radius),
+        sphere,
         source,
         pending.color,
     )?;
@@ -110,7 +107,7 @@ fn generated(
     pending: PendingModel,
     view: &View<'_>,
     seen_from: f32,
-    (center, radius): (glam::Vec3, f32),
+    sphere: Sphere,
 ) -> Result<(Model, Option<ChainDescription>, Option<String>)> {
     let bad = |problem: String| Error::Mesh {
         path: file.to_string(),
@@ -148,7 +145,7 @@ fn generated(
         view,
         pending.name,
         chain,
-        (center, radius),
+        sphere,
         SwitchSource::PixelError,
         pending.color,
     )?;
@@ -282,21 +279,27 @@ fn finish(
     view: &View<'_>,
     name: String,
     chain: LodChain,
-    (center, radius): (glam::Vec3, f32),
+    Sphere {
+        centre: center,
+        radius,
+    }: Sphere,
     source: SwitchSource,
     color: [f32; 3],
 ) -> Result<Model> {
     let (switches, switch_source) =
-        match view
-            .cfg
-            .switch_override(&name, chain.lods.len(), radius, view.fov_y)?
-        {
-            Some(s) => (s, SwitchSource::Override),
-            None => (
-                lod::switch_distances(&chain, 1.0, view.pixel_error, view.pv.height, view.fov_y),
-                source,
-            ),
-        };
+        view.cfg
+            .switches_or(&name, (chain.lods.len(), radius, view.fov_y), || {
+                (
+                    lod::switch_distances(
+                        &chain,
+                        1.0,
+                        view.pixel_error,
+                        view.pv.height,
+                        view.fov_y,
+                    ),
+                    source,
+                )
+            })?;
     view.cfg.user_schedule.check_switches(&name, &switches)?;
     Ok(Model {
         color,
