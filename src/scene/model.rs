@@ -61,12 +61,6 @@ impl Serialize for SwitchSource {
     }
 }
 
-impl PartialEq<&str> for SwitchSource {
-    fn eq(&self, other: &&str) -> bool {
-        self.name() == *other
-    }
-}
-
 /// Seed of the procedural scenes' models and layouts (tree shapes, instance jitter and yaw, the terrain):
 /// fixed, so a scene is the same picture whatever `--seed` drives (the methods' noise).
 pub const SCENE_SEED: u64 = 2008;

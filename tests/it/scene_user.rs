@@ -4,6 +4,7 @@
 //! refused by name.
 
 use crate::common::{col, fails_with, lodbench, read_csv, run_into, scene_config};
+use lodbench::scene::model::SwitchSource;
 use lodbench::scene::{SceneDef, SceneKind};
 use std::path::{Path, PathBuf};
 
@@ -103,9 +104,9 @@ fn instances_share_one_model_and_both_forms_give_the_same_run() {
 #[test]
 fn authored_chains_are_the_models_lods() {
     for (file, source) in [
-        ("bunny-msft-lod.glb", "MSFT_screencoverage"),
-        ("bunny-msft-lod-in-scene.glb", "MSFT_screencoverage"),
-        ("bunny-lod-names.glb", "pixel-error (estimated)"),
+        ("bunny-msft-lod.glb", SwitchSource::ScreenCoverage),
+        ("bunny-msft-lod-in-scene.glb", SwitchSource::ScreenCoverage),
+        ("bunny-lod-names.glb", SwitchSource::PixelErrorEstimated),
     ] {
         let d = def(file, &["--profile", "quick"]);
         assert_eq!(d.models.len(), 1, "{file}");
@@ -119,7 +120,7 @@ fn authored_chains_are_the_models_lods() {
         assert_eq!(tris, [3674, 1836, 918], "{file}");
         assert_eq!(m.switch_source, source, "{file}");
         assert_eq!(d.instantiate(1).instances.len(), 1, "{file}");
-        if source == "MSFT_screencoverage" {
+        if source == SwitchSource::ScreenCoverage {
             let t = (60f32.to_radians() * 0.5).tan();
             for (s, c) in m.switches.iter().zip([0.5f32, 0.2]) {
                 let want = m.radius / (c * t);
@@ -393,7 +394,7 @@ fn switches_in_engine_terms_are_screen_sizes() {
         let want = m.radius / (size * t);
         assert!((s / want - 1.0).abs() < 1e-6, "{s} vs {want}");
     }
-    assert_eq!(m.switch_source, "override");
+    assert_eq!(m.switch_source, SwitchSource::Override);
     let out = lodbench(
         &[
             "describe",
@@ -478,7 +479,7 @@ fn msft_lod_levels_may_be_node_hierarchies() {
         .map(|l| l.mesh.triangle_count())
         .collect();
     assert_eq!(tris, [8, 4]);
-    assert_eq!(d.models[0].switch_source, "MSFT_screencoverage");
+    assert_eq!(d.models[0].switch_source, SwitchSource::ScreenCoverage);
     assert_eq!(d.instantiate(1).instances.len(), 1);
 }
 

@@ -76,11 +76,11 @@ pub struct Tables<'a> {
     pub pairs: Vec<CsvRow>,
     pub transitions: Vec<CsvRow>,
     pub budget_of: &'a dyn Fn(&[String]) -> Option<f64>,
-    pub perceptual_of: &'a dyn Fn(&[String]) -> Vec<CsvRow>,
+    pub perceptual_of: &'a dyn Fn(&[String]) -> Result<Vec<CsvRow>>,
 }
 
-/// The answer of `t`.
-pub fn answer(t: &Tables<'_>) -> AnswerFile {
+/// The answer of `t`; an error where a run's perceptual.csv cannot be read.
+pub fn answer(t: &Tables<'_>) -> Result<AnswerFile> {
     let variables = variables_of(&t.summary);
     let keys = block_keys(&t.summary, &variables);
     let blocks = keys
@@ -99,8 +99,8 @@ pub fn answer(t: &Tables<'_>) -> AnswerFile {
                 variables: &variables,
                 budget: (t.budget_of)(&key.0),
             });
-            let perceptual = (t.perceptual_of)(&key.0);
-            Block {
+            let perceptual = (t.perceptual_of)(&key.0)?;
+            Ok(Block {
                 name,
                 values: key.0.clone(),
                 scene: key.1.clone(),
@@ -109,16 +109,16 @@ pub fn answer(t: &Tables<'_>) -> AnswerFile {
                 budget: said.budget,
                 sentences: said.sentences,
                 rows: table::decision_rows(&rows, &t.transitions, &perceptual, &variables),
-            }
+            })
         })
-        .collect();
-    AnswerFile {
+        .collect::<Result<Vec<Block>>>()?;
+    Ok(AnswerFile {
         schema: SCHEMA,
         build: BuildVersion::this(),
         variables,
         columns: DECISION_COLUMNS,
         blocks,
-    }
+    })
 }
 
 /// summary.csv's columns before `scene`, `adapter` aside: an experiment folder's swept variables.
@@ -185,13 +185,13 @@ pub fn from_records(
     transitions: &[TransitionRecord],
     budget: Option<f64>,
 ) -> Result<AnswerFile> {
-    Ok(answer(&Tables {
+    answer(&Tables {
         summary: rows_of(summaries)?,
         pairs: rows_of(pairs)?,
         transitions: rows_of(transitions)?,
         budget_of: &|_| budget,
-        perceptual_of: &|_| Vec::new(),
-    }))
+        perceptual_of: &|_| Ok(Vec::new()),
+    })
 }
 
 /// The answer of results folder `dir` (a run's, an experiment's or a merged one): its summary.csv, pairs.csv
@@ -206,13 +206,16 @@ pub fn from_folder(dir: &Path) -> Result<AnswerFile> {
     let summary = read_rows(&dir.join(SUMMARY_CSV))?;
     let variables = variables_of(&summary);
     let run = |values: &[String]| run_folder_of(dir, &variables, values);
-    Ok(answer(&Tables {
+    answer(&Tables {
         summary,
         pairs: read_rows(&dir.join(PAIRS_CSV))?,
         transitions: read_rows(&dir.join(TRANSITIONS_CSV))?,
         budget_of: &|values| budget_lodpop(&run(values).join(RUN_JSON)),
-        perceptual_of: &|values| read_rows(&run(values).join(PERCEPTUAL_CSV)).unwrap_or_default(),
-    }))
+        perceptual_of: &|values| {
+            let path = run(values).join(PERCEPTUAL_CSV);
+            read_rows(&path).map_err(|e| Error::results(&path, format!("cannot be read ({e})")))
+        },
+    })
 }
 
 /// run.json's `config.budget_lodpop`; None where it has none or cannot be read.
