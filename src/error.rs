@@ -37,6 +37,8 @@ pub enum Error {
     Results { path: PathBuf, problem: String },
     #[error("ColorVideoVDP: {0}")]
     Perceptual(String),
+    #[error("calibration {}: {problem}", path.display())]
+    Calibration { path: PathBuf, problem: String },
     #[error("interrupted by signal")]
     Interrupted,
 }

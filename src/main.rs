@@ -2,8 +2,8 @@
 
 use lodbench::cli::{Cli, Command};
 use lodbench::commands::{
-    answer, clips, compare, describe, experiment, export, list, merge, overhead, perceptual, probe,
-    run, tune,
+    answer, calibrate, clips, compare, describe, experiment, export, list, merge, overhead,
+    perceptual, probe, run, tune,
 };
 use lodbench::Error;
 use std::process::ExitCode;
@@ -24,6 +24,7 @@ fn main() -> ExitCode {
         Command::Perceptual(args) => perceptual::execute(&args),
         Command::Clips(args) => clips::execute(&args),
         Command::Tune(args) => tune::execute(&args),
+        Command::Calibrate(args) => calibrate::execute(&args),
         Command::Probe(args) => probe::execute(&args),
         Command::Overhead(args) => overhead::execute(&args),
     };

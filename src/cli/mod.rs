@@ -10,6 +10,7 @@
 //! for developers to `//` comments. An enum flag takes `value_parser = names_only::<E>()`, so that its values'
 //! doc comments stay out of the help. The tests below check all three.
 
+pub mod calibration;
 pub mod experiment_file;
 pub mod run_config;
 
@@ -153,6 +154,10 @@ pub enum Command {
     /// alone from N directions at a range of distances; writes tune.csv, tune.json, the settings in each
     /// engine's units (engines/) and the scene rewritten with them (tuned.glb).
     Tune(TuneArgs),
+    /// Build a browser experiment that measures when a person sees an LOD switch (2AFC, one switch against the
+    /// same frames without it, over a ladder of pops): DIR/index.html beside its stimuli; `scripts/calibration.py
+    /// fit` turns the responses into calibration.json, which `tune --calibration` and `run --calibration` read.
+    Calibrate(CalibrateArgs),
     /// Measure the adapter's ceilings: triangle, vertex, fill, depth and compute-read rates, each with a check
     /// that doubling what it names doubles its time and changing anything else does not; writes probe.csv.
     Probe(ProbeArgs),
@@ -228,6 +233,13 @@ pub struct TuneArgs {
     /// The budget as ColorVideoVDP's JOD between the two frames: the least a switch may score (10: invisible).
     #[arg(long, help_heading = TUNING)]
     pub budget_jod: Option<f64>,
+    /// A calibration (calibration.json, `scripts/calibration.py fit`): the budget in JNDs of its lodpop
+    /// threshold (--budget-jnd), drawn at its display's size.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["budget_lodpop", "budget_jod"], help_heading = TUNING)]
+    pub calibration: Option<PathBuf>,
+    /// With --calibration: the budget in JNDs (1: the observer's 75 % threshold).
+    #[arg(long, value_name = "K", requires = "calibration", help_heading = TUNING)]
+    pub budget_jnd: Option<f64>,
     /// View directions per LOD pair: the scene's own (+z) and the rest from a seeded Fibonacci sphere.
     #[arg(long, default_value_t = 32, help_heading = TUNING)]
     pub views: u32,
@@ -288,6 +300,79 @@ pub struct ClipsArgs {
     /// MP4s with ffmpeg: auto (when ffmpeg is on the PATH), on (an error without it), off.
     #[arg(long, value_enum, value_parser = names_only::<Mp4>(), default_value = "auto")]
     pub mp4: Mp4,
+}
+
+/// The display a calibration is made for and holds on (`lodbench calibrate`): each flag defaults to a common
+/// desktop monitor, ColorVideoVDP's `standard_fhd` (24-inch 1920x1080 at 60 Hz, seen from 60 cm, 200 cd/m2).
+#[derive(Debug, Clone, Args)]
+pub struct DisplayArgs {
+    /// The display's width in pixels.
+    #[arg(long, default_value_t = 1920, help_heading = DISPLAY)]
+    pub display_width: u32,
+    /// The display's height in pixels.
+    #[arg(long, default_value_t = 1080, help_heading = DISPLAY)]
+    pub display_height: u32,
+    /// The display's refresh rate in Hz: the stimuli play one frame per refresh, and the page refuses a display
+    /// that refreshes at another rate.
+    #[arg(long, default_value_t = 60.0, help_heading = DISPLAY)]
+    pub refresh_hz: f64,
+    /// The display's diagonal in inches.
+    #[arg(long, default_value_t = 24.0, value_name = "INCHES", help_heading = DISPLAY)]
+    pub diagonal_in: f64,
+    /// The observer's distance from the screen in centimetres.
+    #[arg(long, default_value_t = 60.0, value_name = "CM", help_heading = DISPLAY)]
+    pub viewing_distance_cm: f64,
+    /// The display's peak luminance in cd/m2 (ColorVideoVDP's display model).
+    #[arg(long, default_value_t = 200.0, value_name = "CD_M2", help_heading = DISPLAY)]
+    pub peak_luminance: f64,
+}
+
+/// `calibrate`'s heading for the display flags.
+const DISPLAY: &str = "Display";
+
+#[derive(Debug, Clone, Args)]
+pub struct CalibrateArgs {
+    /// Scenes whose models make the stimuli (comma-separated): built-in names or glTF files; each scene's first
+    /// model with two LODs or more, alone, at rest, the camera dollying away from it through one switch.
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub scene: Vec<String>,
+    /// Transition methods of the stimuli (comma-separated): each scene and method is one staircase.
+    #[arg(long, value_delimiter = ',', default_value = "discrete,dither,alpha")]
+    pub method: Vec<String>,
+    #[command(flatten)]
+    pub display: DisplayArgs,
+    /// The stimulus's side in pixels: a square window of the display, drawn one image pixel per display pixel,
+    /// with the display's projection (its vertical field of view --fov over --display-height).
+    #[arg(long, default_value_t = 512)]
+    pub stimulus_size: u32,
+    /// Vertical field of view of the display's full frame in degrees.
+    #[arg(long, default_value_t = 60.0)]
+    pub fov: f32,
+    /// Length of each interval in milliseconds (frames: this times --refresh-hz).
+    #[arg(long, default_value_t = 500.0)]
+    pub interval_ms: f64,
+    /// Length of dither's and alpha's fade in milliseconds.
+    #[arg(long, default_value_t = 200.0)]
+    pub fade_ms: f64,
+    /// The ladder's switch distances, as multiples of the distance where the pair's error projects to one pixel
+    /// (comma-separated): nearer is a larger pop.
+    #[arg(long, value_delimiter = ',', default_value = "0.2,0.32,0.5,0.8,1.25,2")]
+    pub scales: Vec<f32>,
+    /// At most this many LOD pairs per model (0->1, 1->2, ...; 0: all).
+    #[arg(long, default_value_t = 0)]
+    pub pairs: u32,
+    /// Valid trials per staircase (scene and method).
+    #[arg(long, default_value_t = 40)]
+    pub trials_per_track: u32,
+    /// Seed of the page's random choices (which interval switches, which staircase goes next).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// GPU adapter, by index or name substring (`lodbench list`).
+    #[arg(long)]
+    pub adapter: Option<String>,
+    /// Output folder (default results/calibrate-<time>/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Args)]
@@ -501,6 +586,18 @@ pub struct RunArgs {
     /// The popping budget the printed answer is stated within (default: half discrete's largest lodpop).
     #[arg(long, help_heading = heading::MEASUREMENT)]
     pub budget_lodpop: Option<f64>,
+    /// A calibration (calibration.json, `scripts/calibration.py fit`): pops in JNDs of its lodpop threshold
+    /// (summary.csv's and transitions.csv's lodpop_max_jnd), the budget --budget-jnd JNDs, visible pops over
+    /// 1 JND. It holds for its display: the run draws at the display's size.
+    #[arg(long, value_name = "FILE", help_heading = heading::MEASUREMENT)]
+    pub calibration: Option<PathBuf>,
+    /// With --calibration: the answer's budget in JNDs [default: 1].
+    #[arg(long, value_name = "K", requires = "calibration", conflicts_with = "budget_lodpop",
+          help_heading = heading::MEASUREMENT)]
+    pub budget_jnd: Option<f64>,
+    /// The path's frame rate, for visible_pops_per_min (default: the calibration's refresh rate, else 60).
+    #[arg(long, value_name = "FPS", help_heading = heading::MEASUREMENT)]
+    pub path_fps: Option<f64>,
     /// Measure the adapter's ceilings (`lodbench probe`'s rates) before the blocks, for summary.csv's bound.
     #[arg(long, value_enum, default_value_t = OnOff::On, help_heading = heading::MEASUREMENT)]
     pub ceilings: OnOff,

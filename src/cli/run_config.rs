@@ -146,6 +146,30 @@ fn check_switches(a: &SceneArgs) -> Result<()> {
     Ok(())
 }
 
+/// `--calibration`'s lodpop JND, checked against every scene's viewport (a calibration holds for its display),
+/// and `--budget-jnd`'s range.
+fn calibration_of(
+    a: &RunArgs,
+    scenes: &[SceneKind],
+) -> Result<Option<crate::cli::calibration::Jnd>> {
+    use crate::cli::calibration::{Jnd, JndMetric};
+    let Some(path) = &a.calibration else {
+        return Ok(None);
+    };
+    if let Some(k) = a.budget_jnd.filter(|k| !(k.is_finite() && *k > 0.0)) {
+        return Err(Error::Config(format!(
+            "--budget-jnd {k}: a budget of JNDs is above 0"
+        )));
+    }
+    let jnd = Jnd::load(path, Some(JndMetric::Lodpop.name()), &[JndMetric::Lodpop])?;
+    let scene = SceneConfig::from_args(&a.scene_args)?;
+    for &kind in scenes {
+        let pv = scene.resolved(kind);
+        jnd.check_viewport(pv.width, pv.height, "--width, --height")?;
+    }
+    Ok(Some(jnd))
+}
+
 /// Everything a run does, validated. Serialised into run.json as `config`.
 #[derive(Debug, Clone, Serialize)]
 pub struct RunConfig {
@@ -165,6 +189,10 @@ pub struct RunConfig {
     /// `--budget-lodpop`: the popping budget of the answer printed and in report.html (None: half of the hard
     /// switch's largest lodpop, `results::answer`).
     pub budget_lodpop: Option<f64>,
+    /// `--calibration`: its lodpop JND (the budget is `--budget-jnd` of it, in `budget_lodpop`).
+    pub calibration: Option<crate::cli::calibration::Jnd>,
+    /// `--path-fps`, else the calibration's refresh rate, else 60: the frame rate of visible_pops_per_min.
+    pub path_fps: f64,
     /// `--ceilings`: measure the adapter's ceilings before the blocks.
     pub ceilings: OnOff,
     /// `--clock-warmup`: warm the GPU's clock before each timed segment.
@@ -191,6 +219,10 @@ pub struct RunConfig {
     pub dump_every: u32,
     /// With `dump_frames`: only frames with an instance in transition.
     pub dump_transitions: bool,
+    /// The scenes' notes are not printed (`lodbench calibrate`'s stimulus runs, whose switches are placed on
+    /// purpose where the dolly does not reach them). Not in run.json.
+    #[serde(skip)]
+    pub quiet: bool,
     pub msaa_samples: u32,
     pub color_format: String,
     pub depth_format: String,
@@ -343,6 +375,20 @@ impl RunConfig {
             None => None,
         };
         check_budget_and_outputs(a)?;
+        let calibration = calibration_of(a, &scenes)?;
+        let budget_lodpop = match &calibration {
+            Some(j) => Some(j.value_of(a.budget_jnd.unwrap_or(1.0))),
+            None => a.budget_lodpop,
+        };
+        let path_fps = a
+            .path_fps
+            .or(calibration.as_ref().map(|j| j.display.refresh_hz))
+            .unwrap_or(60.0);
+        if !(path_fps.is_finite() && path_fps > 0.0) {
+            return Err(Error::Config(format!(
+                "--path-fps {path_fps}: a frame rate above 0"
+            )));
+        }
         let mut cfg = RunConfig {
             scenes,
             methods,
@@ -352,7 +398,9 @@ impl RunConfig {
             seed: a.seed,
             rounds: a.rounds,
             baseline,
-            budget_lodpop: a.budget_lodpop,
+            budget_lodpop,
+            calibration,
+            path_fps,
             ceilings: a.ceilings,
             clock_warmup: a.clock_warmup,
             method_options: a.method_options,
@@ -367,6 +415,7 @@ impl RunConfig {
             dump_frames: a.dump_frames,
             dump_every: a.dump_every,
             dump_transitions: a.dump_transitions,
+            quiet: false,
             msaa_samples: MSAA_SAMPLES,
             color_format: format!("{COLOR_FORMAT:?}"),
             depth_format: format!("{DEPTH_FORMAT:?}"),

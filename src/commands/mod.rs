@@ -19,6 +19,7 @@ macro_rules! outln {
 // Defined before the modules, so every subcommand's file has them in scope.
 
 pub mod answer;
+pub mod calibrate;
 pub mod clips;
 pub mod compare;
 pub mod describe;

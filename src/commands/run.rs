@@ -6,8 +6,8 @@ use crate::cli::RunArgs;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::measure::records::{
-    pair_records, round_records, BlockInfo, Clock, FrameRecord, PairRecord, RoundRecord,
-    SummaryRecord, TransitionRecord,
+    pair_records, round_records, set_visible_pops, BlockInfo, Clock, FrameRecord, PairRecord,
+    RoundRecord, SummaryRecord, TransitionRecord, Visibility,
 };
 use crate::measure::{BlockOutput, BlockRunner, FrameImages, MethodSetup, QualityOptions};
 use crate::methods::{is_reference, Registry};
@@ -31,8 +31,40 @@ pub fn execute(args: &RunArgs) -> Result<()> {
     stop_on_signal();
     let summary = run(&cfg)?;
     out!("{}", summary_table(&summary));
+    outln!("{}", calibration_line(&cfg, &summary.summaries));
     outln!("results in {}", summary.out_dir.display());
     Ok(())
+}
+
+/// What the pops are measured in, and the visible pops per minute of each method: in JNDs of a calibration, or
+/// not calibrated (lodpop, over the budget).
+fn calibration_line(cfg: &RunConfig, summaries: &[SummaryRecord]) -> String {
+    let per_min: Vec<String> = summaries
+        .iter()
+        .filter_map(|s| {
+            let v = s.visible_pops_per_min?;
+            Some(format!(
+                "{} {} (n={})",
+                s.method,
+                crate::numbers::sig3(Some(v)),
+                s.count
+            ))
+        })
+        .collect();
+    let unit = match &cfg.calibration {
+        Some(j) => format!("pops in JNDs (summary.csv's lodpop_max_jnd): {}", j.describe()),
+        None => "not calibrated: pops are lodpop, visible ones those over the budget (lodbench calibrate and \
+                 --calibration give JNDs a person measured)"
+            .to_string(),
+    };
+    format!(
+        "{unit}\nvisible pops per minute of the path at {} fps: {}",
+        cfg.path_fps,
+        match per_min.is_empty() {
+            true => "- (no quality pass)".to_string(),
+            false => per_min.join(", "),
+        }
+    )
 }
 
 /// On Ctrl-C, the run stops after the frame in progress (run.json says interrupted); a second signal while
@@ -107,7 +139,7 @@ pub fn run_with(cfg: &RunConfig, registry: &Registry) -> Result<RunSummary> {
         .iter()
         .map(|&s| SceneDef::new(s, &cfg.scene))
         .collect::<Result<Vec<_>>>()?;
-    for note in defs.iter().flat_map(|d| d.notes()) {
+    for note in defs.iter().filter(|_| !cfg.quiet).flat_map(|d| d.notes()) {
         eprintln!("note: {note}");
     }
     let out_dir = cfg.out.clone().unwrap_or_else(|| {
@@ -235,6 +267,16 @@ fn run_blocks(
     for s in &mut output.summaries {
         s.set_ceiling(ceiling, manifest.fragment_ceiling);
     }
+    // Over 1 JND with a calibration (whatever the budget), else over the budget.
+    let visibility = Visibility {
+        threshold: match &cfg.calibration {
+            Some(j) => Some(j.value_of(1.0)),
+            None => cfg.budget_lodpop,
+        },
+        fps: cfg.path_fps,
+        jnd: cfg.calibration.as_ref().map(|j| j.threshold),
+    };
+    set_visible_pops(&mut output.summaries, &mut output.transitions, visibility);
     write_summary(out_dir, &output.summaries)?;
     write_transitions(out_dir, &output.transitions)?;
     write_rounds(out_dir, &output.rounds)?;

@@ -5,6 +5,7 @@
 //! MSFT_screencoverage and lodbench's exact distances, no camera: `lodbench run --scene tuned.glb` flies its
 //! default flight out through the chosen switches and measures what was chosen).
 
+use crate::cli::calibration::{Jnd, JndMetric};
 use crate::cli::TuneArgs;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
@@ -39,9 +40,44 @@ struct TuneManifest<'a> {
     views: Vec<[f32; 3]>,
     models: &'a [ModelSwitches],
     engines: Vec<EngineModel>,
+    /// `--calibration`: the JND the budget is counted in, and the budget in JNDs.
+    calibration: Option<&'a Jnd>,
+    budget_jnd: Option<f64>,
+    /// What the budget holds for: [`BUDGET_SCOPE`].
+    budget_scope: &'static str,
 }
 
-fn budget_of(args: &TuneArgs) -> Result<Budget> {
+/// tune's budget holds per model drawn alone, not per frame: said in tune.json and printed.
+const BUDGET_SCOPE: &str = "each switch of each model drawn alone: instances that switch on the same frame add \
+     up (lodpop over the frame grows with their number), so a frame along a path can exceed the budget; \
+     `lodbench run --scene tuned.glb` counts the pops along a path (summary.csv's visible_pops_per_min)";
+
+/// `--calibration`'s lodpop JND, checked against tune's viewport; tune draws at the display's size unless
+/// --width/--height say otherwise (then refused).
+fn calibration_of(args: &TuneArgs, cfg: &mut SceneConfig) -> Result<Option<Jnd>> {
+    let Some(path) = &args.calibration else {
+        return Ok(None);
+    };
+    let jnd = Jnd::load(path, Some(JndMetric::Lodpop.name()), &[JndMetric::Lodpop])?;
+    if let Some(k) = args.budget_jnd.filter(|k| !(k.is_finite() && *k > 0.0)) {
+        return Err(Error::Config(format!(
+            "--budget-jnd {k}: a budget of JNDs is above 0"
+        )));
+    }
+    let (w, h) = (jnd.display.width_px, jnd.display.height_px);
+    jnd.check_viewport(
+        cfg.width.unwrap_or(w),
+        cfg.height.unwrap_or(h),
+        "leave --width and --height out",
+    )?;
+    (cfg.width, cfg.height) = (Some(w), Some(h));
+    Ok(Some(jnd))
+}
+
+fn budget_of(args: &TuneArgs, jnd: Option<&Jnd>) -> Result<Budget> {
+    if let Some(j) = jnd {
+        return Ok(Budget::Lodpop(j.value_of(args.budget_jnd.unwrap_or(1.0))));
+    }
     match (args.budget_lodpop, args.budget_jod) {
         (Some(x), None) if x.is_finite() && x > 0.0 && x < 1.0 => Ok(Budget::Lodpop(x)),
         (Some(x), None) => Err(Error::Config(format!(
@@ -52,14 +88,14 @@ fn budget_of(args: &TuneArgs) -> Result<Budget> {
             "--budget-jod {j}: a JOD budget lies in (0, 10] (10: no visible difference)"
         ))),
         _ => Err(Error::Config(
-            "tune needs a budget: --budget-lodpop X (the largest lodpop a switch may cause, RMS over the frame in \
+            "tune needs a budget: --calibration FILE --budget-jnd K (JNDs of a calibration), --budget-lodpop X (the largest lodpop a switch may cause, RMS over the frame in \
              [0, 1]) or --budget-jod J (ColorVideoVDP's JOD a switch may not go below, 10 = invisible)"
                 .into(),
         )),
     }
 }
 
-fn settings_of(args: &TuneArgs, band: f32) -> Result<TuneSettings> {
+fn settings_of(args: &TuneArgs, band: f32, jnd: Option<&Jnd>) -> Result<TuneSettings> {
     if args.views == 0 || args.distances < 2 {
         return Err(Error::Config(format!(
             "tune: --views {} and --distances {}: at least one view and two distances",
@@ -79,7 +115,7 @@ fn settings_of(args: &TuneArgs, band: f32) -> Result<TuneSettings> {
         None => None,
     };
     Ok(TuneSettings {
-        budget: budget_of(args)?,
+        budget: budget_of(args, jnd)?,
         views: args.views,
         distances: args.distances,
         seed: args.seed,
@@ -121,8 +157,9 @@ fn engine_model(m: &ModelSwitches, blend: Option<&str>) -> EngineModel {
 /// `lodbench tune`.
 pub fn execute(args: &TuneArgs) -> Result<()> {
     let kind = SceneKind::from_name(&args.scene)?;
-    let cfg = SceneConfig::from_args(&args.scene_args)?;
-    let settings = settings_of(args, cfg.schedule.band)?;
+    let mut cfg = SceneConfig::from_args(&args.scene_args)?;
+    let jnd = calibration_of(args, &mut cfg)?;
+    let settings = settings_of(args, cfg.schedule.band, jnd.as_ref())?;
     let def = SceneDef::new(kind, &cfg)?;
     if kind.is_unified() {
         return Err(Error::Config(format!(
@@ -164,6 +201,9 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
         views: views.iter().map(|v| v.to_array()).collect(),
         models: &models,
         engines: engine_models.clone(),
+        calibration: jnd.as_ref(),
+        budget_jnd: jnd.as_ref().map(|_| args.budget_jnd.unwrap_or(1.0)),
+        budget_scope: BUDGET_SCOPE,
     };
     write(
         &out.join(TUNE_JSON),
@@ -171,6 +211,22 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
     )?;
     write_rules(&out, &models)?;
     print_results(&out, &models, &engine_models, &viewing);
+    if let Some(j) = &jnd {
+        outln!(
+            "budget: {} JND, {}",
+            args.budget_jnd.unwrap_or(1.0),
+            j.describe()
+        );
+        outln!(
+            "every method with these switches, pops in JNDs: lodbench run --scene {} --width {} --height {} \
+             --calibration {}",
+            out.join(TUNED_GLB).display(),
+            j.display.width_px,
+            j.display.height_px,
+            j.path.display()
+        );
+    }
+    outln!("the budget holds for {BUDGET_SCOPE}");
     Ok(())
 }
 

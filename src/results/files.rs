@@ -43,6 +43,12 @@ pub const TUNED_GLB: &str = "tuned.glb";
 pub const ENGINES_DIR: &str = "engines";
 /// The page in [`ENGINES_DIR`] that says how to use each file.
 pub const ENGINES_README: &str = "README.md";
+/// `lodbench calibrate`'s page, its stimuli (the page holds them too) and their frames' folder.
+pub const CALIBRATE_PAGE: &str = "index.html";
+pub const STIMULI_JSON: &str = "stimuli.json";
+pub const STIMULI_FRAMES_DIR: &str = "frames";
+/// The fit of a calibration's responses (`scripts/calibration.py fit`), which `--calibration` reads.
+pub const CALIBRATION_JSON: &str = "calibration.json";
 /// `lodbench probe`'s manifest and rows.
 pub const PROBE_JSON: &str = "probe.json";
 pub const PROBE_CSV: &str = "probe.csv";

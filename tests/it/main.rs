@@ -19,6 +19,7 @@ mod common;
 mod cli_help;
 mod cli_input;
 // src/commands: the subcommands through the binary.
+mod commands_calibrate;
 mod commands_clips;
 mod commands_compare;
 mod commands_experiment;

@@ -4,14 +4,17 @@
 //!
 //! - `rows.rs`: the frame rows and the block's sizes and rounds;
 //! - `summaries.rs`: the statistics (summary.csv, the clock, the paired ratios, rounds.csv, pairs.csv);
-//! - `transitions.rs`: transition detection (transitions.csv, the frames `--dump-transitions` dumps).
+//! - `transitions.rs`: transition detection (transitions.csv, the frames `--dump-transitions` dumps);
+//! - `events.rs`: transitions grouped into the pop events a person sees (summary.csv's visible pops).
 //!
 //! Every figure of the quality pass is an `Option`: empty (never 0) in a run without it (`--quality off`).
 
+mod events;
 mod rows;
 mod summaries;
 mod transitions;
 
+pub use events::*;
 pub use rows::*;
 pub use summaries::*;
 pub use transitions::*;

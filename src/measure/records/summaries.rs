@@ -39,6 +39,14 @@ pub struct SummaryRecord {
     pub lodpop_max: Option<f64>,
     pub lodpop_p95: Option<f64>,
     pub lodpop_sum: Option<f64>,
+    /// Pop events (transitions within a few frames of each other joined, `events.rs`) and how many a minute of
+    /// the path (at its frame rate) exceed `visible_pop_threshold`: 1 JND of `--calibration`, else the lodpop
+    /// budget (`--budget-lodpop`, else half of discrete's lodpop_max, the answer's default).
+    pub pop_events: Option<u32>,
+    pub visible_pop_threshold: Option<f64>,
+    pub visible_pops_per_min: Option<f64>,
+    /// With `--calibration`: lodpop_max in JNDs of the calibration's lodpop threshold.
+    pub lodpop_max_jnd: Option<f64>,
     /// Mean over frames of de2000_mean, and its largest frame (empty without `--metrics de2000`).
     pub de2000_mean: Option<f64>,
     pub de2000_max: Option<f64>,

@@ -96,6 +96,9 @@ pub struct TransitionRecord {
     /// `--shadows on`: the largest shadow_lodpop over the same frames (empty without shadows).
     #[serde(default)]
     pub shadow_lodpop_max: Option<f64>,
+    /// With `--calibration`: lodpop_max in JNDs of the calibration's lodpop threshold.
+    #[serde(default)]
+    pub lodpop_max_jnd: Option<f64>,
 }
 
 /// The transitions of one block: `rows` its frame records in frame order, `pairs` each frame's pair.
@@ -154,6 +157,7 @@ pub fn transitions(rows: &[FrameRecord], pairs: &[TransitionPair]) -> Vec<Transi
                 .map(|r| r.shadow_lodpop)
                 .collect::<Option<Vec<f64>>>()
                 .map(|v| v.into_iter().fold(0.0, f64::max)),
+            lodpop_max_jnd: None,
         });
     }
     out

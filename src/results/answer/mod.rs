@@ -75,7 +75,7 @@ pub struct Tables<'a> {
     pub summary: Vec<CsvRow>,
     pub pairs: Vec<CsvRow>,
     pub transitions: Vec<CsvRow>,
-    pub budget_of: &'a dyn Fn(&[String]) -> Option<f64>,
+    pub budget_of: &'a dyn Fn(&[String]) -> Option<rule::Given>,
     pub perceptual_of: &'a dyn Fn(&[String]) -> Result<Vec<CsvRow>>,
 }
 
@@ -189,7 +189,12 @@ pub fn from_records(
         summary: rows_of(summaries)?,
         pairs: rows_of(pairs)?,
         transitions: rows_of(transitions)?,
-        budget_of: &|_| budget,
+        budget_of: &|_| {
+            budget.map(|lodpop| rule::Given {
+                lodpop,
+                source: "--budget-lodpop".to_string(),
+            })
+        },
         perceptual_of: &|_| Ok(Vec::new()),
     })
 }
@@ -218,10 +223,33 @@ pub fn from_folder(dir: &Path) -> Result<AnswerFile> {
     })
 }
 
-/// run.json's `config.budget_lodpop`; None where it has none or cannot be read.
-fn budget_lodpop(path: &Path) -> Option<f64> {
+/// run.json's `config.budget_lodpop` and where it came from (`--budget-lodpop`, or `--budget-jnd` of
+/// `config.calibration`); None where it has none or cannot be read.
+fn budget_lodpop(path: &Path) -> Option<rule::Given> {
     let json: serde_json::Value = read_json(path).ok()?.ok()?;
-    json.get("config")?.get("budget_lodpop")?.as_f64()
+    let config = json.get("config")?;
+    let lodpop = config.get("budget_lodpop")?.as_f64()?;
+    let source = match config.get("calibration").filter(|c| !c.is_null()) {
+        Some(c) => {
+            let threshold = c.get("threshold")?.as_f64()?;
+            let simulated = c
+                .get("simulated")
+                .and_then(|s| s.as_bool())
+                .unwrap_or(false);
+            format!(
+                "{} JND of {}{}",
+                crate::numbers::sig3(Some(lodpop / threshold)),
+                if simulated {
+                    "a simulated observer, "
+                } else {
+                    ""
+                },
+                c.get("path")?.as_str()?
+            )
+        }
+        None => "--budget-lodpop".to_string(),
+    };
+    Some(rule::Given { lodpop, source })
 }
 
 /// Writes `dir/answer.json` from the folder's files, and returns it.

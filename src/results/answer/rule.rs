@@ -49,7 +49,7 @@ pub struct BlockInput<'a> {
     pub rows: &'a [&'a CsvRow],
     pub pairs: &'a [CsvRow],
     pub variables: &'a [String],
-    pub budget: Option<f64>,
+    pub budget: Option<Given>,
 }
 
 /// Whether a method shows LOD transitions (not a reference of any kind).
@@ -123,7 +123,7 @@ pub fn sentences(b: &BlockInput<'_>) -> Said {
     };
     let lodpop_of = |r: &CsvRow, op: Op| summary_value(r, b.variables, "lodpop_max", Fmt::Sig3, op);
     let mut first: Sentence = vec![];
-    let budget = budget_of(b.budget, hard, b.variables);
+    let budget = budget_of(b.budget.as_ref(), hard, b.variables);
     if candidates.len() == 1 {
         // Nothing to compare its popping with: say what it is, and a budget's verdict only where one was given.
         first.push(
@@ -178,13 +178,21 @@ struct Level {
     source: String,
 }
 
-/// The budget: `--budget-lodpop` (run.json), else half the hard switch's largest lodpop.
-fn budget_of(given: Option<f64>, hard: Option<&CsvRow>, variables: &[String]) -> Option<Level> {
+/// A budget the run was given (run.json): its lodpop and where it comes from (`--budget-lodpop`, or a number of
+/// JNDs of a calibration).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Given {
+    pub lodpop: f64,
+    pub source: String,
+}
+
+/// The budget: the run's (run.json), else half the hard switch's largest lodpop.
+fn budget_of(given: Option<&Given>, hard: Option<&CsvRow>, variables: &[String]) -> Option<Level> {
     match (given, hard) {
-        (Some(b), _) => Some(Level {
-            shown: budget_value(b),
-            lodpop: b,
-            source: "--budget-lodpop".to_string(),
+        (Some(g), _) => Some(Level {
+            shown: budget_value(g.lodpop),
+            lodpop: g.lodpop,
+            source: g.source.clone(),
         }),
         (None, Some(h)) => Some(Level {
             lodpop: h.num("lodpop_max")? / 2.0,
