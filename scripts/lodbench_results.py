@@ -56,6 +56,7 @@ READS = {
         "rmse_mean", "rmse_max", "de2000_mean", "de2000_max", "flip_mean", "lag_rmse_mean", "lag_rmse_max",
         "shadow_rmse_mean",
         "pop_max", "pop_p95", "lodpop_max", "lodpop_p95", "lodpop_sum", "shadow_lodpop_max",
+        "pop_events", "visible_pop_threshold", "visible_pops_per_min", "lodpop_max_jnd",
         "triangles_mean", "draw_calls_mean", "t_instances_mean", "transition_frames_min", "units_drawn_mean",
         "uncovered_px_mean",
         "crack_px_mean", "crack_px_max", "extra_target_bytes", "tri_alternation_max",

@@ -52,6 +52,11 @@ the popping budget, and the decision table) is the folder's answer.json, as the 
 without one (made before the binary wrote it), or with a perceptual.csv newer than it, gets it first from
 `lodbench answer FOLDER`: the binary is $LODBENCH (or $LODBENCH_BIN), else target/release/lodbench of this
 repository (under $CARGO_TARGET_DIR where set), else `lodbench` on the PATH.
+After the answer, "Visible pops": what the pops are measured in (JNDs of the run's `--calibration`, from run.json's
+config.calibration, each run's in an experiment or merged folder, a simulated observer said to be one; else not
+calibrated, plain lodpop) and per method its largest lodpop (in JNDs where calibrated) beside its visible pops per
+minute (summary.csv's pop_events, visible_pop_threshold, visible_pops_per_min; a folder made before them says they
+were not measured).
 """
 import argparse
 import json
@@ -689,6 +694,11 @@ def report(folder: Path, transition: str = "worst") -> list:
     # The answer first: answer.json's blocks, as the binary wrote them.
     answers = [{"name": b["name"], "sentences": b["sentences"], "columns": answer["columns"], "rows": b["rows"]}
                for b in answer["blocks"]]
+    # Then what the pops are measured in and how many a minute are visible (before the methods are relabelled
+    # below: the swept values have their own columns).
+    adapters = sorted({r["adapter"] for r in summary if "adapter" in r})
+    pops_lead = variables + (["adapter"] if len(adapters) > 1 else []) + ["scene", "method", "count"]
+    pops = visible_pops(summary, header, pops_lead, runs)
     if not variables:
         for (scene,), rows in group(summary, "scene").items():
             first_count = rows[0]["count"]
@@ -701,7 +711,6 @@ def report(folder: Path, transition: str = "worst") -> list:
         # Each combination of swept values is its own series, in the figures and the tables.
         for r in summary + frames + (transitions_csv or []):
             r["method"] = f"{r['method']} ({', '.join(f'{v} {r[v]}' for v in variables)})"
-    adapters = sorted({r["adapter"] for r in summary if "adapter" in r})
     if len(adapters) > 1:
         # Runs on different GPUs (merge --allow-adapters): each (method, adapter) is its own series.
         for r in summary + frames + (transitions_csv or []):
@@ -779,6 +788,10 @@ def report(folder: Path, transition: str = "worst") -> list:
         text += [f"## {a['name']}", ""] + [sentence_text(s) for s in a["sentences"]] + [""]
         text += ["| " + " | ".join(a["columns"]) + " |", "|" + "---|" * len(a["columns"])]
         text += ["| " + " | ".join(part_text(c) for c in row) + " |" for row in a["rows"]] + [""]
+    text += ["## Visible pops", ""] + [line for line, _ in pops["lines"] for line in (line, "")]
+    if pops["rows"] is not None:
+        text += [markdown_table(pops["rows"], pops["columns"], pops_lead), ""]
+    text += [pops["note"], ""]
     for name, caption in headline:
         text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
     for heading, rows, cols in sections:
@@ -787,8 +800,50 @@ def report(folder: Path, transition: str = "worst") -> list:
         text += [f"## {caption}", "", f"![{caption}](figures/{name})", ""]
     (folder / "report.md").write_text("\n".join(text))
     tables_html = [(heading, cols, table_cells(rows, cols, lead)) for heading, rows, cols in sections]
-    (folder / "report.html").write_text(report_html.page(title, answers, headline, tables_html, made, clips, runs))
+    pops_html = report_html.pops_html(
+        pops["lines"], pops["columns"],
+        None if pops["rows"] is None else table_cells(pops["rows"], pops["columns"], pops_lead), pops["note"],
+        open_table=pops["rows"] is None or len(pops["rows"]) <= POPS_OPEN_ROWS)
+    (folder / "report.html").write_text(report_html.page(title, answers, headline, tables_html, made, clips, runs,
+                                                         pops=pops_html))
     return headline + made
+
+
+# summary.csv's columns of the visible pops (pop events over a threshold, per minute of the path), beside the
+# largest lodpop; lodpop_max_jnd only where a run was calibrated.
+POPS_COLUMNS = ("lodpop_max", "lodpop_max_jnd", "pop_events", "visible_pop_threshold", "visible_pops_per_min")
+# The visible pops' table is open up to this many rows, folded beyond (a large experiment).
+POPS_OPEN_ROWS = 24
+
+
+def visible_pops(summary, header, lead, runs):
+    """The section after the answer: {"lines": what the pops are measured in (report_html.calibration_lines of the
+    folder's run.json files, `runs` = report_html.manifest()'s: the run's, or each run's of an experiment or merged
+    folder), "columns" and "rows" (the table: each summary row's largest lodpop, in JNDs where calibrated, its pop
+    events, the threshold they are counted visible over and the visible ones per minute; rows None where nothing
+    was measured), "note"}. A folder made before pop events has none of the columns: not measured."""
+    lines = report_html.calibration_lines(runs)
+    if "visible_pops_per_min" not in header:
+        return {"lines": lines, "columns": [], "rows": None,
+                "note": "Visible pops per minute: not measured (this summary.csv has no visible_pops_per_min: made "
+                        "by a lodbench before pop events; `lodbench run` again to count them)."}
+    if not any(r.get("pop_events") for r in summary):
+        return {"lines": lines, "columns": [], "rows": None,
+                "note": "Visible pops per minute: not measured (no transition has a lodpop: a run with "
+                        "`--quality off`?)."}
+    columns = lead + [c for c in POPS_COLUMNS if c in header and (c != "lodpop_max_jnd"
+                                                                   or any(r.get(c) for r in summary))]
+    fps = report_html.path_fps(runs)
+    at = (f"at {fps[0]:g} frames a second (run.json's path_fps)" if len(fps) == 1 else
+          "at each run's frame rate (its run.json's path_fps)" if fps else "at its frame rate")
+    note = ("visible_pops_per_min: a method's pop events (its transitions, those that start within 3 frames of the "
+            "last one's end joined into one event, scored by the root of the sum of their lodpop_max squared) "
+            "whose score exceeds visible_pop_threshold (1 JND of the calibration; without one the run's "
+            "`--budget-lodpop`, else half the hard switch's largest lodpop), per minute of the path "
+            f"{at}; pop_events counts them all. Empty: not measured (no threshold, or no lodpop). Full precision in "
+            "summary.csv.")
+    rows = [{c: r.get(c, "") for c in columns} for r in summary]
+    return {"lines": lines, "columns": columns, "rows": rows, "note": note}
 
 
 # summary.csv's columns in the report's folded tables, a table per group (each fits a window); the intervals are
@@ -800,7 +855,8 @@ SUMMARY_GROUPS = (
                        "ratio_to_baseline_steady")),
     ("image error", ("rmse_mean", "rmse_max", "de2000_mean", "de2000_max", "flip_mean", "lag_rmse_mean",
                      "lag_rmse_max", "shadow_rmse_mean")),
-    ("popping", ("pop_max", "pop_p95", "lodpop_max", "lodpop_p95", "lodpop_sum", "shadow_lodpop_max")),
+    ("popping", ("pop_max", "pop_p95", "lodpop_max", "lodpop_p95", "lodpop_sum", "shadow_lodpop_max",
+                 "lodpop_max_jnd", "pop_events", "visible_pop_threshold", "visible_pops_per_min")),
     ("geometry", ("triangles_mean", "draw_calls_mean", "t_instances_mean", "units_drawn_mean", "uncovered_px_mean",
                   "crack_px_mean", "crack_px_max", "extra_target_bytes", "tri_alternation_max")),
     ("ceilings", ("triangles_per_s", "triangle_ceiling_share", "fragments_mean", "fragments_per_s",
@@ -808,7 +864,7 @@ SUMMARY_GROUPS = (
 )
 # Counts, shown with thousands separators.
 COUNT_COLUMNS = {"frames", "rounds", "triangles_mean", "fragments_mean", "draw_calls_mean", "units_drawn_mean",
-                 "crack_px_max", "extra_target_bytes", "uncovered_px_mean", "crack_px_mean"}
+                 "pop_events", "crack_px_max", "extra_target_bytes", "uncovered_px_mean", "crack_px_mean"}
 
 
 def summary_groups(header, lead):

@@ -15,12 +15,13 @@ the clip's frames and toggles frame and error view at the same frame. An experim
 """
 import html
 import json
+import re
 from pathlib import Path, PurePosixPath
 from urllib.parse import quote
 
 from PIL import Image
 
-from lodbench_results import EXPERIMENT_JSON, INDEX_JSON, RUN_JSON, RUNS_DIR
+from lodbench_results import EXPERIMENT_JSON, INDEX_JSON, RUN_JSON, RUNS_DIR, sig3
 
 # The animations `lodbench clips` may write beside a clip's frames (index.json's key, what the link says); any may
 # be null (no MP4 without ffmpeg).
@@ -310,6 +311,75 @@ def figure_html(name, cap) -> str:
             f"<figcaption>{esc(cap)}</figcaption></figure>")
 
 
+# What the pops are measured in, without a calibration (run.json's config.calibration null or absent).
+NOT_CALIBRATED = ("Not calibrated: pops are lodpop (RMS of the frame's change), not a threshold a person measured; "
+                  "`lodbench calibrate` and `--calibration` give JNDs (docs/calibration.md)")
+
+
+def calibration_line(cal):
+    """What a run's pops are measured in, from its run.json's config.calibration (None or an object: path, metric,
+    threshold, ci95, simulated, label, display): (text, simulated). The text marks code with backticks."""
+    if not isinstance(cal, dict):
+        return NOT_CALIBRATED, False
+    ci = cal.get("ci95") if isinstance(cal.get("ci95"), list) and len(cal["ci95"]) == 2 else [None, None]
+    interval = (f" (95 % {sig3_or_dash(ci[0])} to {sig3_or_dash(ci[1])})" if None not in ci
+                else " (no 95 % interval)")
+    text = (f"Pops in JNDs: 1 JND = {cal.get('metric') or 'lodpop'} {sig3_or_dash(cal.get('threshold'))}{interval}, "
+            f"from {cal.get('path', '?')}: {cal.get('label', '?')}")
+    d = cal.get("display")
+    if isinstance(d, dict) and d.get("width_px") and d.get("height_px"):
+        hz = f" at {d['refresh_hz']:g} Hz" if isinstance(d.get("refresh_hz"), (int, float)) else ""
+        text += f"; measured for a {d['width_px']}x{d['height_px']} display{hz}"
+    simulated = cal.get("simulated") is True
+    if simulated:
+        text += ". Simulated observer, not human data"
+    return text, simulated
+
+
+def calibration_lines(m):
+    """What the pops of a folder's runs (m: manifest()'s, its runs [(label, run.json)]) are measured in:
+    [(text, simulated)], one line where every run says the same (or there is no run.json), else a line per
+    calibration naming its runs."""
+    groups = {}
+    for label, run in m["runs"]:
+        cal = (run.get("config") or {}).get("calibration")
+        groups.setdefault(json.dumps(cal, sort_keys=True), (cal, []))[1].append(label)
+    if len(groups) <= 1:
+        return [calibration_line(next(iter(groups.values()))[0] if groups else None)]
+    return [(f"{', '.join(labels)}: {text}", simulated)
+            for text, simulated, labels in ((*calibration_line(cal), labels) for cal, labels in groups.values())]
+
+
+def path_fps(m) -> list:
+    """The frame rates visible pops per minute are counted at (run.json's config.path_fps) of a folder's runs (m:
+    manifest()'s), each once; none for runs of a lodbench before pop events."""
+    return sorted({(run.get("config") or {}).get("path_fps") for _, run in m["runs"]} - {None})
+
+
+def sig3_or_dash(x) -> str:
+    """A number of run.json to 3 significant figures (lodbench_results.sig3), `-` where it is not a number."""
+    return sig3(float(x)) if isinstance(x, (int, float)) and not isinstance(x, bool) else "-"
+
+
+def with_code(text: str) -> str:
+    """Escaped text with its `backticked` parts as <code>."""
+    return re.sub(r"`([^`]*)`", r"<code>\1</code>", esc(text))
+
+
+def pops_html(lines, columns, cells, note, open_table=True) -> str:
+    """The visible-pops section that follows the answer: what the pops are measured in (calibration_lines()'s),
+    then the table (columns, rows of cell texts; None: nothing measured) and its note (text, code in backticks)."""
+    out = ['<section id="pops"><h2>Visible pops</h2>']
+    out += [f'<p class="unit{" simulated" if simulated else ""}">{with_code(text)}</p>' for text, simulated in lines]
+    if cells is not None:
+        out.append(f'<details open><summary>visible pops per minute, by method</summary>{table(columns, cells)}'
+                   '</details>' if open_table else
+                   f'<details><summary>visible pops per minute, by method ({len(cells)} rows)</summary>'
+                   f'{table(columns, cells)}</details>')
+    out.append(f'<p class="note">{with_code(note)}</p></section>')
+    return "\n".join(out)
+
+
 ANSWER_NOTE = ("Costs are paired round by round within the run and called different only where the 95 % interval "
                "excludes 1; the budget is the run's <code>--budget-lodpop</code>, else half the hard switch's "
                "largest lodpop; full precision in summary.csv and pairs.csv.")
@@ -318,22 +388,27 @@ TUNE_NOTE = ("The worst popping is over tune's views from each switch to the end
              "tune.json and rules.csv.")
 
 
-def page(title: str, answers, headline, tables, figures, clips, runs, players=True, note=ANSWER_NOTE) -> str:
+def page(title: str, answers, headline, tables, figures, clips, runs, players=True, note=ANSWER_NOTE,
+         pops=None) -> str:
     """report.html, the answer first. `answers`: [{name, sentences, columns, rows}] (a block of the folder's
     answer.json, its columns those of answer.json: sentences as lists of parts, rows of cells, each a str or a
     number's object, value_html); `headline`: [(file in figures/, caption)], the
     figures that follow the answer; `tables`: [(heading, columns, rows of cell texts)], folded (the
     "cheapest at or below a popping" tables of an experiment open); `figures`: the other figures; `clips`:
     load_clips()'s or None; `runs`: manifest()'s, or the manifest section's HTML; `players`: False leaves out the
-    players' section (a tune folder has no clips to play)."""
-    nav = [("answer", "Answer"), ("headline", "Cost and popping"), ("players", "Transition players"),
-           ("tables", "Tables"), ("figures", "More figures"), ("manifest", "Manifest")]
-    nav = [n for n in nav if (players or n[0] != "players") and (figures or n[0] != "figures")]
+    players' section (a tune folder has no clips to play); `pops`: pops_html()'s section, after the answer."""
+    nav = [("answer", "Answer"), ("pops", "Visible pops"), ("headline", "Cost and popping"),
+           ("players", "Transition players"), ("tables", "Tables"), ("figures", "More figures"),
+           ("manifest", "Manifest")]
+    nav = [n for n in nav if (players or n[0] != "players") and (figures or n[0] != "figures")
+           and (pops or n[0] != "pops")]
     body = [f"<h1>{esc(title)}</h1>",
             '<nav>' + " ".join(f'<a href="#{a}">{esc(t)}</a>' for a, t in nav) + "</nav>",
             '<div id="answer">']
     body += [answer_html(a) for a in answers] or ['<p class="note">summary.csv has no rows.</p>']
     body.append(f'<p class="note">{note}</p></div>')
+    if pops:
+        body.append(pops)
     body.append('<h2 id="headline">Cost and popping</h2>')
     body += [figure_html(name, cap) for name, cap in headline] or \
         ['<p class="note">No popping measured (a run with <code>--quality off</code>?).</p>']
@@ -404,6 +479,8 @@ details { margin: 6px 0; }
 details > summary { cursor: pointer; font-weight: 600; }
 .answer { margin: 4px 0 14px; }
 .answer h2 { margin-top: 10px; }
+#pops p.unit { margin: 4px 0; max-width: 1100px; }
+#pops p.unit.simulated { color: #8a1c1c; font-weight: 600; }
 .sentence { font-size: 15px; margin: 4px 0; max-width: 1100px; }
 .sentence .v, table.decision .v { font-variant-numeric: tabular-nums; }
 table.decision { font-size: 13px; margin-top: 6px; }
