@@ -51,27 +51,7 @@ impl TextureReadback {
         texture: &wgpu::Texture,
         aspect: wgpu::TextureAspect,
     ) {
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &self.buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(self.padded_row),
-                    rows_per_image: Some(self.height),
-                },
-            },
-            wgpu::Extent3d {
-                width: self.width,
-                height: self.height,
-                depth_or_array_layers: 1,
-            },
-        );
+        self.encode_copy_region(encoder, texture, aspect, [0, 0, self.width, self.height]);
     }
 
     /// Records the copy of a render target's colour.
@@ -79,10 +59,63 @@ impl TextureReadback {
         self.encode_copy_plane(encoder, &target.color, wgpu::TextureAspect::All);
     }
 
+    /// Records the copy of the rectangle `rect`, `[x, y, width, height]` (within this read-back's size), of a
+    /// render target's colour into the buffer, its rows from the buffer's start ([`TextureReadback::read_rect`]).
+    pub fn encode_copy_rect(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+        rect: [u32; 4],
+    ) {
+        self.encode_copy_region(encoder, &target.color, wgpu::TextureAspect::All, rect);
+    }
+
+    /// The rows of a rectangle `width` texels wide, padded to the copy alignment (no wider than `padded_row`).
+    fn padded_row_of(&self, width: u32) -> u32 {
+        (width * self.bytes_per_texel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT
+    }
+
+    fn encode_copy_region(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+        aspect: wgpu::TextureAspect,
+        [x, y, width, height]: [u32; 4],
+    ) {
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x, y, z: 0 },
+                aspect,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.padded_row_of(width)),
+                    rows_per_image: Some(height),
+                },
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+
     /// The copied plane, tightly packed, after the copy's submission (waits for the GPU).
     pub fn read(&self, ctx: &GpuContext) -> Result<Vec<u8>> {
-        let (h, row) = (self.height as usize, self.padded_row as usize);
-        let tight = (self.width * self.bytes_per_texel) as usize;
+        self.read_rect(ctx, [0, 0, self.width, self.height])
+    }
+
+    /// The rectangle `rect` copied by [`TextureReadback::encode_copy_rect`], tightly packed, after the copy's
+    /// submission (waits for the GPU).
+    pub fn read_rect(&self, ctx: &GpuContext, [_, _, width, height]: [u32; 4]) -> Result<Vec<u8>> {
+        let (h, row) = (height as usize, self.padded_row_of(width) as usize);
+        let tight = (width * self.bytes_per_texel) as usize;
         ctx.read_buffer(&self.buffer, |bytes| {
             let mut out = Vec::with_capacity(tight * h);
             for y in 0..h {

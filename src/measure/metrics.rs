@@ -46,8 +46,19 @@ pub fn rms_difference(a: &[u8], b: &[u8]) -> f64 {
 /// `background` in exactly one of the two images; shading, over the rest. Each is an RMS over every pixel, so
 /// `coverage^2 + shading^2 = rms^2`.
 pub fn rms_difference_parts(a: &[u8], b: &[u8], background: [u8; 3]) -> (f64, f64, f64) {
+    rms_difference_parts_over(a, b, background, a.len() / 4)
+}
+
+/// [`rms_difference_parts`] of two crops of frames of `pixels` pixels, the frames equal outside the crops (the
+/// same sums, over the whole frame's pixel count: bit for bit the figures of the whole frames).
+pub fn rms_difference_parts_over(
+    a: &[u8],
+    b: &[u8],
+    background: [u8; 3],
+    pixels: usize,
+) -> (f64, f64, f64) {
     assert_eq!(a.len(), b.len(), "images of different sizes");
-    let pixels = a.len() / 4;
+    assert!(a.len() / 4 <= pixels, "a crop larger than its frame");
     if pixels == 0 {
         return (0.0, 0.0, 0.0);
     }
@@ -418,6 +429,11 @@ mod tests {
         assert!((shading - (200.0f64 / scale).sqrt()).abs() < 1e-12);
         assert!((rms * rms - coverage * coverage - shading * shading).abs() < 1e-15);
         assert!((rms - rms_difference(&a, &b)).abs() < 1e-12);
+        // The two middle pixels as a crop of the four-pixel frames (the same outside): the same figures, bit
+        // for bit.
+        let crop = |x: &[u8]| x[4..12].to_vec();
+        let parts = rms_difference_parts_over(&crop(&a), &crop(&b), bg, 4);
+        assert_eq!(parts, (rms, coverage, shading));
     }
 
     use super::*;

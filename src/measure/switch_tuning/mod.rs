@@ -16,13 +16,16 @@
 //! [`NEAR_BUDGET`] of the budget, the switch moving past any distance that breaks it.
 //!
 //! One file per job: [`search`] (the search and its grid), [`camera`] (the camera that draws each model
-//! alone), [`model`] (the per-model driver), [`bands`] (the blending methods' bands) and [`outcome`] (what it
+//! alone), [`reset`] (its crops put back as a clear leaves them), [`frame_cache`] (frames one pair draws for the
+//! next), [`model`] (the per-model driver), [`bands`] (the blending methods' bands) and [`outcome`] (what it
 //! finds).
 
 pub mod bands;
 pub mod camera;
+pub mod frame_cache;
 pub mod model;
 pub mod outcome;
+pub mod reset;
 pub mod search;
 
 pub use camera::{FrameScore, ModelCamera, Switched};

@@ -6,9 +6,11 @@ use crate::geometry::projection::{fit_distance, screen_size, switch_distance};
 use crate::measure::engine_rules::RULES;
 use crate::scene::Scene;
 use glam::{Quat, Vec3};
+use std::collections::HashMap;
 
 use crate::measure::switch_tuning::bands::blend_bands;
-use crate::measure::switch_tuning::camera::{FrameScore, ModelCamera, Switched};
+use crate::measure::switch_tuning::camera::{FrameScore, ModelCamera};
+use crate::measure::switch_tuning::frame_cache::{FrameCache, FRAME_CACHE_BYTES};
 use crate::measure::switch_tuning::outcome::Budget;
 use crate::measure::switch_tuning::outcome::{
     ModelSwitches, PairSwitch, RuleAt, Sample, TuneSettings,
@@ -17,42 +19,6 @@ use crate::measure::switch_tuning::search::{
     close_excess, dense_points, first_switch, limiting_view, log_grid, nearest_within, Crossing,
     DENSE_PER_STEP,
 };
-
-/// The budget's figure at distance `d` for the pair (`lod`, `lod + 1`), the worst over `views` (the largest
-/// lodpop, the smallest JOD); None without views.
-#[allow(
-    clippy::too_many_arguments,
-    reason = "the pair, its pose and the measurement's settings"
-)]
-pub(super) fn worst_at(
-    camera: &mut ModelCamera<'_>,
-    model: u32,
-    lod: u32,
-    rotation: Quat,
-    views: &[Vec3],
-    d: f32,
-    settings: &TuneSettings,
-    jod: FrameScore<'_>,
-) -> Result<Option<f64>> {
-    let mut worst = None::<f64>;
-    for &dir in views {
-        let Switched {
-            lodpop: pop,
-            frames: [a, b],
-            ..
-        } = camera.switch_at(model, lod, rotation, dir, d)?;
-        let v = match settings.budget {
-            Budget::Jod(_) => jod(&a, &b)?,
-            Budget::Lodpop(_) => pop,
-        };
-        worst = Some(match (worst, settings.budget) {
-            (None, _) => v,
-            (Some(x), Budget::Lodpop(_)) => x.max(v),
-            (Some(x), Budget::Jod(_)) => x.min(v),
-        });
-    }
-    Ok(worst)
-}
 
 /// The switches of every pair of `model` (drawn by `camera`), each view's grid measured and refined, every sample
 /// appended to `samples`. `jod` scores two frames (RGBA bytes) when the budget is a JOD.
@@ -85,7 +51,10 @@ pub fn tune_model(
         views,
         jod,
         samples,
+        measured: HashMap::new(),
+        kept: FrameCache::new(FRAME_CACHE_BYTES),
     };
+    tuning.measure_grid(&range.grid)?;
     // Per blending method, where its previous band ends.
     let mut band_end = [0.0f32; 3];
     for lod in 0..m.chain.lods.len().saturating_sub(1) as u32 {
@@ -160,21 +129,114 @@ pub(super) struct ModelTuning<'t, 'c> {
     pub(super) views: &'t [Vec3],
     pub(super) jod: FrameScore<'t>,
     pub(super) samples: &'t mut Vec<Sample>,
+    /// Every pair's figures measured so far, by (the pair's first LOD, view, distance's bits): each is drawn and
+    /// scored once.
+    pub(super) measured: HashMap<(u32, u32, u32), Measured>,
+    /// The frames of each pair's coarser LOD drawn away from the grid, for the next pair.
+    pub(super) kept: FrameCache,
+}
+
+/// One pair's figures at one view and distance: lodpop and its coverage and shading parts, and ColorVideoVDP's
+/// JOD under a JOD budget.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Measured {
+    pub(super) lodpop: f64,
+    pub(super) coverage: f64,
+    pub(super) shading: f64,
+    pub(super) jod: Option<f64>,
+}
+
+impl Measured {
+    /// The budget's figure: JOD under a JOD budget, else lodpop.
+    pub(super) fn value(&self) -> f64 {
+        self.jod.unwrap_or(self.lodpop)
+    }
 }
 
 impl ModelTuning<'_, '_> {
-    /// [`worst_at`] for the pair (`lod`, `lod + 1`) at distance `d`.
+    /// The budget's figure at distance `d` for the pair (`lod`, `lod + 1`), the worst over the views (the
+    /// largest lodpop, the smallest JOD); None without views.
     pub(super) fn worst(&mut self, lod: u32, d: f32) -> Result<Option<f64>> {
-        worst_at(
-            self.camera,
-            self.model,
-            lod,
-            self.rotation,
-            self.views,
-            d,
-            self.settings,
-            self.jod,
-        )
+        let mut worst = None::<f64>;
+        for v in 0..self.views.len() {
+            let x = self.measure(lod, v, d)?.value();
+            worst = Some(worst.map_or(x, |w| self.settings.budget.worse(w, x)));
+        }
+        Ok(worst)
+    }
+
+    /// The pair (`lod`, `lod + 1`)'s figures at view `v` and distance `d`, drawn and scored unless they were
+    /// already.
+    pub(super) fn measure(&mut self, lod: u32, v: usize, d: f32) -> Result<Measured> {
+        let key = (lod, v as u32, d.to_bits());
+        if let Some(m) = self.measured.get(&key) {
+            return Ok(*m);
+        }
+        let a = match self.kept.take((lod, v as u32, d.to_bits())) {
+            Some(a) => a,
+            None => self.frame(lod, v, d)?,
+        };
+        let b = self.frame(lod + 1, v, d)?;
+        let m = self.figures(&a, &b)?;
+        self.measured.insert(key, m);
+        let lods = self.camera.scene.models[self.model as usize]
+            .chain
+            .lods
+            .len();
+        if lod as usize + 2 < lods {
+            // The next pair's finer LOD.
+            self.kept.put((lod + 1, v as u32, d.to_bits()), b);
+        }
+        Ok(m)
+    }
+
+    /// Every pair's figures at every view and grid distance, each LOD drawn once at each (a LOD ends one pair
+    /// and starts the next).
+    pub(super) fn measure_grid(&mut self, grid: &[f32]) -> Result<()> {
+        let lods = self.camera.scene.models[self.model as usize]
+            .chain
+            .lods
+            .len() as u32;
+        for v in 0..self.views.len() {
+            for &d in grid {
+                let mut previous = self.frame(0, v, d)?;
+                for lod in 1..lods {
+                    let frame = self.frame(lod, v, d)?;
+                    let m = self.figures(&previous, &frame)?;
+                    self.measured.insert((lod - 1, v as u32, d.to_bits()), m);
+                    previous = frame;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// LOD `lod` from view `v` at distance `d`: the whole frame under a JOD budget (ColorVideoVDP scores whole
+    /// frames), else the crop outside which it is the clear colour ([`ModelCamera::crop`]).
+    fn frame(&mut self, lod: u32, v: usize, d: f32) -> Result<Vec<u8>> {
+        let (model, rotation, dir) = (self.model, self.rotation, self.views[v]);
+        match self.settings.budget {
+            Budget::Jod(_) => self.camera.draw(model, lod, rotation, dir, d),
+            Budget::Lodpop(_) => {
+                let rect = self.camera.crop(model, d);
+                self.camera.draw_rect(model, lod, rotation, dir, d, rect)
+            }
+        }
+    }
+
+    /// The figures of a switch between two of [`ModelTuning::frame`]'s frames (the same view and distance).
+    fn figures(&mut self, a: &[u8], b: &[u8]) -> Result<Measured> {
+        let (lodpop, coverage, shading) = self.camera.pop_of(a, b);
+        let jod = match self.settings.budget {
+            Budget::Jod(_) => Some((self.jod)(a, b)?),
+            Budget::Lodpop(_) => None,
+        };
+        Ok(Measured {
+            lodpop,
+            coverage,
+            shading,
+            jod,
+        })
     }
 
     /// The pair (`lod`, `lod + 1`): each view's crossing, the switch (beyond the band of the `previous` pair's,
@@ -190,6 +252,7 @@ impl ModelTuning<'_, '_> {
     ) -> Result<PairSwitch> {
         let scene = self.camera.scene;
         let m = &scene.models[self.model as usize];
+        self.kept.drop_below(lod);
         let Curves { per_view, worst } = self.measure_views(lod, range)?;
         let limiting = limiting_view(&per_view, range.near);
         let switch = first_switch(limiting, previous, self.settings.band);
@@ -222,59 +285,22 @@ impl ModelTuning<'_, '_> {
     /// Every view's curve over the grid for the pair (`lod`, `lod + 1`), each sample recorded: each view's
     /// crossing (refined between grid distances), and the worst excess over the views at each grid distance.
     pub(super) fn measure_views(&mut self, lod: u32, range: &DistanceRange) -> Result<Curves> {
-        let scene = self.camera.scene;
-        let m = &scene.models[self.model as usize];
-        let (grid, near) = (&range.grid, range.near);
-        let ModelTuning {
-            camera,
-            model,
-            rotation,
-            settings,
-            views,
-            jod,
-            samples,
-        } = self;
-        let mut per_view = Vec::with_capacity(views.len());
+        let (grid, near, budget) = (&range.grid, range.near, self.settings.budget);
+        let mut per_view = Vec::with_capacity(self.views.len());
         let mut worst: Vec<(f32, f64)> = grid.iter().map(|&d| (d, 0.0)).collect();
-        for (v, &dir) in views.iter().enumerate() {
-            let mut measure = |d: f32, refined: bool| -> Result<f64> {
-                let Switched {
-                    lodpop: pop,
-                    coverage: cov,
-                    shading: shade,
-                    frames: [a, b],
-                } = camera.switch_at(*model, lod, *rotation, dir, d)?;
-                let j = match settings.budget {
-                    Budget::Jod(_) => Some(jod(&a, &b)?),
-                    Budget::Lodpop(_) => None,
-                };
-                samples.push(Sample {
-                    model: m.name.clone(),
-                    lod_from: lod,
-                    lod_to: lod + 1,
-                    view: v as u32,
-                    distance: d,
-                    screen_size: range.screen(d),
-                    lodpop: pop,
-                    lodpop_coverage: cov,
-                    lodpop_shading: shade,
-                    jod: j,
-                    refined,
-                });
-                Ok(j.unwrap_or(pop))
-            };
+        for v in 0..self.views.len() {
             let mut curve = Vec::with_capacity(grid.len());
             for &d in grid {
-                curve.push((d, measure(d, false)?));
+                curve.push((d, self.sample(lod, v, d, range, false)?));
             }
             for (w, c) in worst.iter_mut().zip(&curve) {
-                w.1 = match settings.budget {
+                w.1 = match budget {
                     Budget::Lodpop(_) => w.1.max(c.1),
                     Budget::Jod(_) => w.1.max(10.0 - c.1),
                 };
             }
             per_view.push(
-                match nearest_within(&curve, settings.budget, |d| measure(d, true))? {
+                match nearest_within(&curve, budget, |d| self.sample(lod, v, d, range, true))? {
                     Crossing::Everywhere => Some(near),
                     Crossing::From(d) => Some(d),
                     Crossing::Never => None,
@@ -282,6 +308,34 @@ impl ModelTuning<'_, '_> {
             );
         }
         Ok(Curves { per_view, worst })
+    }
+
+    /// The pair (`lod`, `lod + 1`)'s figure at view `v` and distance `d` ([`ModelTuning::measure`]), recorded as a
+    /// sample (`refined`: a bisection step).
+    fn sample(
+        &mut self,
+        lod: u32,
+        v: usize,
+        d: f32,
+        range: &DistanceRange,
+        refined: bool,
+    ) -> Result<f64> {
+        let m = self.measure(lod, v, d)?;
+        let name = self.camera.scene.models[self.model as usize].name.clone();
+        self.samples.push(Sample {
+            model: name,
+            lod_from: lod,
+            lod_to: lod + 1,
+            view: v as u32,
+            distance: d,
+            screen_size: range.screen(d),
+            lodpop: m.lodpop,
+            lodpop_coverage: m.coverage,
+            lodpop_shading: m.shading,
+            jod: m.jod,
+            refined,
+        });
+        Ok(m.value())
     }
 
     /// Every view at the switch: the views whose crossing lies nearer are within the budget at every grid
