@@ -172,12 +172,14 @@ impl Jnd {
         }
         let name = metric.unwrap_or(&file.best_metric);
         let names = |ms: &[JndMetric]| ms.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ");
-        let chosen = JndMetric::of(name).filter(|m| supported.contains(m)).ok_or_else(|| {
-            bad(format!(
-                "its metric {name} is not one this command measures ({}); choose one with --jnd-metric",
-                names(supported)
-            ))
-        })?;
+        let chosen = JndMetric::of(name)
+            .filter(|m| supported.contains(m))
+            .ok_or_else(|| {
+                bad(format!(
+                    "its metric {name} is not one this command measures ({})",
+                    names(supported)
+                ))
+            })?;
         let fit = file.metrics.get(name).ok_or_else(|| {
             bad(format!(
                 "holds no fit of {name} (it has: {})",

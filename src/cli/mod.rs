@@ -588,8 +588,8 @@ pub struct RunArgs {
     pub budget_lodpop: Option<f64>,
     /// A calibration (calibration.json, `scripts/calibration.py fit`): pops in JNDs of its lodpop threshold
     /// (summary.csv's and transitions.csv's lodpop_max_jnd), the budget --budget-jnd JNDs, visible pops over
-    /// 1 JND. It holds for its display: the run draws at the display's size.
-    #[arg(long, value_name = "FILE", help_heading = heading::MEASUREMENT)]
+    /// 1 JND. It holds for its display: a run at another --width/--height is refused.
+    #[arg(long, value_name = "FILE", conflicts_with = "budget_lodpop", help_heading = heading::MEASUREMENT)]
     pub calibration: Option<PathBuf>,
     /// With --calibration: the answer's budget in JNDs [default: 1].
     #[arg(long, value_name = "K", requires = "calibration", conflicts_with = "budget_lodpop",

@@ -57,6 +57,17 @@ pub fn asset_of(name: &str, work: &Path) -> Result<Asset> {
         let def = SceneDef::new(kind, &scene_config(name, &[])?)?;
         let mut scene = def.instantiate(def.counts[0]);
         scene.motion = crate::scene::Motion::Static;
+        // The model alone: the first instance of a model with LODs, no ground.
+        let lods =
+            |i: &crate::scene::Instance| scene.models[i.model as usize].chain.lods.len() >= 2;
+        scene.instances = scene
+            .instances
+            .iter()
+            .filter(|i| lods(i))
+            .take(1)
+            .cloned()
+            .collect();
+        scene.ground = None;
         let glb = crate::scene::export_glb::glb_with(&scene, false)?;
         let path = work.join(format!("{}.glb", def.name()));
         std::fs::write(&path, glb).map_err(|e| Error::io(&path, e))?;
@@ -68,6 +79,13 @@ pub fn asset_of(name: &str, work: &Path) -> Result<Asset> {
         &scene_config(&file_name, &[])?,
     )?;
     let scene = def.instantiate(def.counts[0]);
+    let placed = scene.instances.len() - usize::from(scene.ground.is_some());
+    if placed > 1 {
+        return Err(Error::Config(format!(
+            "calibrate: {name} places {placed} instances; the stimuli show one model alone: give a file of one \
+             node (one mesh instance)"
+        )));
+    }
     let (i, model) = scene
         .instances
         .iter()

@@ -13,7 +13,7 @@ mod stimulus;
 use crate::cli::calibration::Display;
 use crate::cli::CalibrateArgs;
 use crate::error::{Error, Result};
-use crate::results::files::{CALIBRATE_PAGE, STIMULI_FRAMES_DIR};
+use crate::results::files::{CALIBRATE_PAGE, STIMULI_FRAMES_DIR, STIMULI_JSON};
 use crate::results::manifest::BuildVersion;
 use asset::{asset_of, Asset};
 use colorvideovdp::{Cvvdp, DisplayModel, Execution, Geometry, Options};
@@ -28,27 +28,44 @@ pub use page::{hash64, PAGE, PLACEHOLDER};
 pub fn execute(args: &CalibrateArgs) -> Result<()> {
     let drawing = drawing_of(args)?;
     check_scales(&args.scales)?;
+    if args.trials_per_track == 0 {
+        return Err(Error::Config(
+            "--trials-per-track 0: a staircase needs at least one trial".into(),
+        ));
+    }
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| super::run::default_out_dir(&["calibrate"]));
     super::run::prepare_output(&out)?;
+    // Nothing of an earlier calibration in DIR survives to look like this one's.
+    for stale in [CALIBRATE_PAGE, STIMULI_JSON] {
+        let p = out.join(stale);
+        if p.exists() {
+            std::fs::remove_file(&p).map_err(|e| Error::io(&p, e))?;
+        }
+    }
     let work = out.join(".work");
     for dir in [out.join(STIMULI_FRAMES_DIR), work.clone()] {
+        if dir.exists() {
+            std::fs::remove_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+        }
         std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     }
     let jod = jod_metric(&drawing.display)?;
     let mut records = Vec::new();
     let mut kept = BTreeMap::new();
-    for name in &args.scene {
+    let rendered = args.scene.iter().try_for_each(|name| -> Result<()> {
         let asset = asset_of(name, &work)?;
         records.extend(ladder(
             &asset, args, &drawing, &jod, &work, &out, &mut kept,
         )?);
-    }
+        Ok(())
+    });
+    let _ = std::fs::remove_dir_all(&work);
+    rendered?;
     let stimuli = stimuli_of(args, &drawing, records)?;
     page::write(&out, &stimuli)?;
-    let _ = std::fs::remove_dir_all(&work);
     print_ladder(&stimuli);
     outln!(
         "{} stimuli, {} frames; open {} in a browser on a {} display",
@@ -108,6 +125,15 @@ fn drawing_of(args: &CalibrateArgs) -> Result<Drawing> {
 }
 
 fn check_scales(scales: &[f32]) -> Result<()> {
+    if let Some(s) = scales
+        .iter()
+        .enumerate()
+        .find_map(|(i, s)| scales[..i].contains(s).then_some(s))
+    {
+        return Err(Error::Config(format!(
+            "--scales: {s} is given twice: each step of the ladder is one stimulus"
+        )));
+    }
     match scales
         .iter()
         .find(|s| !(s.is_finite() && **s > 0.0 && **s <= 100.0))
@@ -229,7 +255,7 @@ fn stimuli_of(
         format: "lodbench-calibration-stimuli",
         version: 1,
         id: String::new(),
-        command: command_line(args),
+        command: command_line(),
         build: BuildVersion::this(),
         display: drawing.display.clone(),
         stimulus: StimulusWindow {
@@ -245,7 +271,7 @@ fn stimuli_of(
             target: 0.75,
             down_steps: 1,
             up_steps: 3,
-            trials_per_track: args.trials_per_track.max(1),
+            trials_per_track: args.trials_per_track,
             seed: args.seed,
         },
         ladder_metric: page::METRICS[0],
@@ -261,7 +287,7 @@ fn stimuli_of(
 }
 
 /// This process's command line, for stimuli.json.
-fn command_line(_args: &CalibrateArgs) -> String {
+fn command_line() -> String {
     let argv: Vec<String> = std::env::args().collect();
     let exe = PathBuf::from(argv.first().cloned().unwrap_or_default());
     let name = exe

@@ -142,7 +142,7 @@ pub fn write(out: &Path, stimuli: &Stimuli) -> Result<()> {
     ];
     for (name, text) in files {
         let path = out.join(name);
-        let partial = out.join(format!("{name}.partial"));
+        let partial = out.join(crate::results::files::partial(name));
         std::fs::write(&partial, text).map_err(|e| Error::io(&partial, e))?;
         std::fs::rename(&partial, &path).map_err(|e| Error::io(&path, e))?;
     }

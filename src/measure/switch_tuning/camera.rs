@@ -6,19 +6,10 @@ use crate::gpu::scene_gpu::ShadowMap;
 use crate::gpu::{
     DrawList, GpuContext, InstanceRaw, RenderTarget, SceneGpu, TextureReadback, View,
 };
-use crate::measure::metrics::{rms_difference_parts, rms_difference_parts_over};
+use crate::measure::metrics::rms_difference_parts_over;
 use crate::measure::switch_tuning::reset::RectReset;
 use crate::scene::{Camera, Model, Scene};
 use glam::{Mat4, Quat, Vec3};
-
-/// What a switch does to a model's frame: lodpop between the two LODs' frames and its coverage and shading
-/// parts, and the two frames (RGBA8).
-pub struct Switched {
-    pub lodpop: f64,
-    pub coverage: f64,
-    pub shading: f64,
-    pub frames: [Vec<u8>; 2],
-}
 
 /// Scores two frames (RGBA8): ColorVideoVDP's JOD under a JOD budget.
 pub type FrameScore<'f> = &'f mut dyn FnMut(&[u8], &[u8]) -> Result<f64>;
@@ -267,27 +258,6 @@ impl<'a> ModelCamera<'a> {
         );
     }
 
-    /// What switching from LOD `lod` to LOD `lod + 1` of `model` does to its frame from `direction` at
-    /// `distance`.
-    pub fn switch_at(
-        &mut self,
-        model: u32,
-        lod: u32,
-        rotation: Quat,
-        direction: Vec3,
-        distance: f32,
-    ) -> Result<Switched> {
-        let a = self.draw(model, lod, rotation, direction, distance)?;
-        let b = self.draw(model, lod + 1, rotation, direction, distance)?;
-        let (lodpop, coverage, shading) = rms_difference_parts(&a, &b, self.background);
-        Ok(Switched {
-            lodpop,
-            coverage,
-            shading,
-            frames: [a, b],
-        })
-    }
-
     /// lodpop and its coverage and shading parts between two crops (both [`ModelCamera::crop`]'s rectangle,
     /// [`ModelCamera::draw_rect`]) of this camera's frames: the whole frames' figures.
     pub fn pop_of(&self, a: &[u8], b: &[u8]) -> (f64, f64, f64) {
@@ -314,6 +284,7 @@ fn reach(m: &Model) -> f32 {
 mod tests {
     use super::*;
     use crate::cli::{Cli, Command};
+    use crate::measure::metrics::rms_difference_parts;
     use crate::scene::{SceneConfig, SceneDef, SceneKind};
     use clap::Parser;
 

@@ -28,7 +28,7 @@ pub mod outcome;
 pub mod reset;
 pub mod search;
 
-pub use camera::{FrameScore, ModelCamera, Switched};
+pub use camera::{FrameScore, ModelCamera};
 pub use model::tune_model;
 pub use outcome::Budget;
 pub use outcome::{BlendBand, ModelSwitches, PairSwitch, RuleAt, Sample, TuneSettings};
