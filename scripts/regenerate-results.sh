@@ -127,7 +127,7 @@ folders=(
 "tune-1080-bunny-export|5||\$LB export --scene bunny-sweep --out \$D/bunny.glb && \$LB tune --scene \$D/bunny.glb --budget-lodpop 0.004 --width 1920 --height 1080 --views 8 --out \$D && rm \$D/bunny.glb"
 "tune-jnd-damagedhelmet|10|GSA|\$LB tune --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --calibration results/cpu/calibration-simulated/calibration.json --budget-jnd 1 --views 8 --out \$D && \$LB run --scene \$D/tuned.glb --method discrete --width 1920 --height 1080 --frames 240 --rounds 2 --calibration results/cpu/calibration-simulated/calibration.json --out \$D/run"
 "tune-1080-damagedhelmet|10|GSA|\$LB tune --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --budget-lodpop 0.004 --width 1920 --height 1080 --views 8 --out \$D"
-"visible-pops-ci|40||\$LB experiment \$E/visible-pops-ci.toml --out \$D && $PLOT \$D"
+"visible-pops-ci|20||\$LB experiment \$E/visible-pops-ci.toml --out \$D && $PLOT \$D"
 )
 
 for name in "${only[@]}"; do
