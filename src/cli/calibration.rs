@@ -207,6 +207,20 @@ impl Jnd {
         })
     }
 
+    /// `--calibration FILE --budget-jnd K` as `run` and `tune` read them: the file's lodpop JND, and the budget
+    /// `K` JNDs (default 1) in lodpop; `K` must be above 0.
+    pub fn lodpop_budget(path: &Path, budget_jnd: Option<f64>) -> Result<(Jnd, f64)> {
+        let k = budget_jnd.unwrap_or(1.0);
+        if !(k.is_finite() && k > 0.0) {
+            return Err(Error::Config(format!(
+                "--budget-jnd {k}: a budget of JNDs is above 0"
+            )));
+        }
+        let jnd = Jnd::load(path, Some(JndMetric::Lodpop.name()), &[JndMetric::Lodpop])?;
+        let budget = jnd.value_of(k);
+        Ok((jnd, budget))
+    }
+
     /// A value of the metric in JNDs: lodpop over its threshold; a JOD's drop from 10 over the threshold's.
     pub fn of(&self, value: f64) -> f64 {
         match self.metric {

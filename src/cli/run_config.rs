@@ -151,23 +151,17 @@ fn check_switches(a: &SceneArgs) -> Result<()> {
 fn calibration_of(
     a: &RunArgs,
     scenes: &[SceneKind],
-) -> Result<Option<crate::cli::calibration::Jnd>> {
-    use crate::cli::calibration::{Jnd, JndMetric};
+) -> Result<Option<(crate::cli::calibration::Jnd, f64)>> {
     let Some(path) = &a.calibration else {
         return Ok(None);
     };
-    if let Some(k) = a.budget_jnd.filter(|k| !(k.is_finite() && *k > 0.0)) {
-        return Err(Error::Config(format!(
-            "--budget-jnd {k}: a budget of JNDs is above 0"
-        )));
-    }
-    let jnd = Jnd::load(path, Some(JndMetric::Lodpop.name()), &[JndMetric::Lodpop])?;
+    let (jnd, budget) = crate::cli::calibration::Jnd::lodpop_budget(path, a.budget_jnd)?;
     let scene = SceneConfig::from_args(&a.scene_args)?;
     for &kind in scenes {
         let pv = scene.resolved(kind);
         jnd.check_viewport(pv.width, pv.height, "--width, --height")?;
     }
-    Ok(Some(jnd))
+    Ok(Some((jnd, budget)))
 }
 
 /// Everything a run does, validated. Serialised into run.json as `config`.
@@ -375,10 +369,9 @@ impl RunConfig {
             None => None,
         };
         check_budget_and_outputs(a)?;
-        let calibration = calibration_of(a, &scenes)?;
-        let budget_lodpop = match &calibration {
-            Some(j) => Some(j.value_of(a.budget_jnd.unwrap_or(1.0))),
-            None => a.budget_lodpop,
+        let (calibration, budget_lodpop) = match calibration_of(a, &scenes)? {
+            Some((jnd, budget)) => (Some(jnd), Some(budget)),
+            None => (None, a.budget_lodpop),
         };
         let path_fps = a
             .path_fps

@@ -116,6 +116,11 @@ pub fn metric_on(display_name: &str) -> Result<Cvvdp> {
             "display {display_name}: {e} (the displays: {names})"
         ))
     })?;
+    metric_of(display)
+}
+
+/// ColorVideoVDP on `display`, run in parallel.
+pub fn metric_of(display: DisplayModel) -> Result<Cvvdp> {
     Cvvdp::new(
         display,
         Options::default().with_execution(Execution::Parallel),

@@ -5,7 +5,7 @@
 //! MSFT_screencoverage and lodbench's exact distances, no camera: `lodbench run --scene tuned.glb` flies its
 //! default flight out through the chosen switches and measures what was chosen).
 
-use crate::cli::calibration::{Jnd, JndMetric};
+use crate::cli::calibration::Jnd;
 use crate::cli::TuneArgs;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
@@ -54,16 +54,11 @@ const BUDGET_SCOPE: &str = "each switch of each model drawn alone: instances tha
 
 /// `--calibration`'s lodpop JND, checked against tune's viewport; tune draws at the display's size unless
 /// --width/--height say otherwise (then refused).
-fn calibration_of(args: &TuneArgs, cfg: &mut SceneConfig) -> Result<Option<Jnd>> {
+fn calibration_of(args: &TuneArgs, cfg: &mut SceneConfig) -> Result<Option<(Jnd, f64)>> {
     let Some(path) = &args.calibration else {
         return Ok(None);
     };
-    let jnd = Jnd::load(path, Some(JndMetric::Lodpop.name()), &[JndMetric::Lodpop])?;
-    if let Some(k) = args.budget_jnd.filter(|k| !(k.is_finite() && *k > 0.0)) {
-        return Err(Error::Config(format!(
-            "--budget-jnd {k}: a budget of JNDs is above 0"
-        )));
-    }
+    let (jnd, budget) = Jnd::lodpop_budget(path, args.budget_jnd)?;
     let (w, h) = (jnd.display.width_px, jnd.display.height_px);
     jnd.check_viewport(
         cfg.width.unwrap_or(w),
@@ -71,12 +66,13 @@ fn calibration_of(args: &TuneArgs, cfg: &mut SceneConfig) -> Result<Option<Jnd>>
         "leave --width and --height out",
     )?;
     (cfg.width, cfg.height) = (Some(w), Some(h));
-    Ok(Some(jnd))
+    Ok(Some((jnd, budget)))
 }
 
-fn budget_of(args: &TuneArgs, jnd: Option<&Jnd>) -> Result<Budget> {
-    if let Some(j) = jnd {
-        return Ok(Budget::Lodpop(j.value_of(args.budget_jnd.unwrap_or(1.0))));
+/// The budget: a calibration's (`calibrated`, in lodpop), else --budget-lodpop or --budget-jod.
+fn budget_of(args: &TuneArgs, calibrated: Option<f64>) -> Result<Budget> {
+    if let Some(b) = calibrated {
+        return Ok(Budget::Lodpop(b));
     }
     match (args.budget_lodpop, args.budget_jod) {
         (Some(x), None) if x.is_finite() && x > 0.0 && x < 1.0 => Ok(Budget::Lodpop(x)),
@@ -95,7 +91,7 @@ fn budget_of(args: &TuneArgs, jnd: Option<&Jnd>) -> Result<Budget> {
     }
 }
 
-fn settings_of(args: &TuneArgs, band: f32, jnd: Option<&Jnd>) -> Result<TuneSettings> {
+fn settings_of(args: &TuneArgs, band: f32, calibrated: Option<f64>) -> Result<TuneSettings> {
     if args.views == 0 || args.distances < 2 {
         return Err(Error::Config(format!(
             "tune: --views {} and --distances {}: at least one view and two distances",
@@ -115,7 +111,7 @@ fn settings_of(args: &TuneArgs, band: f32, jnd: Option<&Jnd>) -> Result<TuneSett
         None => None,
     };
     Ok(TuneSettings {
-        budget: budget_of(args, jnd)?,
+        budget: budget_of(args, calibrated)?,
         views: args.views,
         distances: args.distances,
         seed: args.seed,
@@ -158,8 +154,9 @@ fn engine_model(m: &ModelSwitches, blend: Option<&str>) -> EngineModel {
 pub fn execute(args: &TuneArgs) -> Result<()> {
     let kind = SceneKind::from_name(&args.scene)?;
     let mut cfg = SceneConfig::from_args(&args.scene_args)?;
-    let jnd = calibration_of(args, &mut cfg)?;
-    let settings = settings_of(args, cfg.schedule.band, jnd.as_ref())?;
+    let calibrated = calibration_of(args, &mut cfg)?;
+    let settings = settings_of(args, cfg.schedule.band, calibrated.as_ref().map(|c| c.1))?;
+    let jnd = calibrated.map(|c| c.0);
     let def = SceneDef::new(kind, &cfg)?;
     if kind.is_unified() {
         return Err(Error::Config(format!(

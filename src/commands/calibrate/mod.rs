@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::results::files::{CALIBRATE_PAGE, STIMULI_FRAMES_DIR, STIMULI_JSON};
 use crate::results::manifest::BuildVersion;
 use asset::{asset_of, Asset};
-use colorvideovdp::{Cvvdp, DisplayModel, Execution, Geometry, Options};
+use colorvideovdp::{Cvvdp, DisplayModel, Geometry};
 use page::{Procedure, Stimuli, StimulusRecord, StimulusWindow, Track};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -159,11 +159,7 @@ fn jod_metric(d: &Display) -> Result<Cvvdp> {
         d.viewing_distance_cm / 100.0,
     )
     .map_err(perceptual)?;
-    Cvvdp::new(
-        model,
-        Options::default().with_execution(Execution::Parallel),
-    )
-    .map_err(perceptual)
+    super::perceptual::metric_of(model)
 }
 
 /// Every step of `asset`'s ladder, rendered and measured: each LOD pair (up to --pairs) at each scale.
