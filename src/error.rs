@@ -35,6 +35,8 @@ pub enum Error {
     Image { path: PathBuf, problem: String },
     #[error("results folder {}: {problem}", path.display())]
     Results { path: PathBuf, problem: String },
+    #[error("score folder {}: {problem}", path.display())]
+    Score { path: PathBuf, problem: String },
     #[error("ColorVideoVDP: {0}")]
     Perceptual(String),
     #[error("calibration {}: {problem}", path.display())]
@@ -56,6 +58,14 @@ impl Error {
     /// A results folder that is not what a command needs (`lodbench perceptual`, `lodbench clips`).
     pub fn results(path: impl Into<PathBuf>, problem: impl Into<String>) -> Self {
         Error::Results {
+            path: path.into(),
+            problem: problem.into(),
+        }
+    }
+
+    /// A score folder (`lodbench score`) that breaks the protocol.
+    pub fn score(path: impl Into<PathBuf>, problem: impl Into<String>) -> Self {
+        Error::Score {
             path: path.into(),
             problem: problem.into(),
         }

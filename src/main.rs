@@ -3,7 +3,7 @@
 use lodbench::cli::{Cli, Command};
 use lodbench::commands::{
     answer, calibrate, clips, compare, describe, experiment, export, list, merge, overhead,
-    perceptual, probe, run, tune,
+    perceptual, probe, run, score, tune,
 };
 use lodbench::Error;
 use std::process::ExitCode;
@@ -25,6 +25,7 @@ fn main() -> ExitCode {
         Command::Clips(args) => clips::execute(&args),
         Command::Tune(args) => tune::execute(&args),
         Command::Calibrate(args) => calibrate::execute(&args),
+        Command::Score(args) => score::execute(&args),
         Command::Probe(args) => probe::execute(&args),
         Command::Overhead(args) => overhead::execute(&args),
     };

@@ -158,6 +158,11 @@ pub enum Command {
     /// same frames without it, over a ladder of pops): DIR/index.html beside its stimuli; `scripts/calibration.py
     /// fit` turns the responses into calibration.json, which `tune --calibration` and `run --calibration` read.
     Calibrate(CalibrateArgs),
+    /// Score another renderer's frames: from a folder of its frames, their counterfactuals (each pose drawn with
+    /// the previous frame's LOD selection), optionally the high-poly reference and a CSV of the levels drawn,
+    /// the figures a run computes (rmse, pop, lodpop and its parts, FLIP, transitions), in frames.csv,
+    /// transitions.csv, summary.csv and run.json (docs/measurement.md, "Scoring another renderer's frames").
+    Score(ScoreArgs),
     /// Measure the adapter's ceilings: triangle, vertex, fill, depth and compute-read rates, each with a check
     /// that doubling what it names doubles its time and changing anything else does not; writes probe.csv.
     Probe(ProbeArgs),
@@ -268,6 +273,23 @@ pub struct TuneArgs {
 
 /// `tune`'s own heading: the budget and the search.
 const TUNING: &str = "Budget and search";
+
+#[derive(Debug, Clone, Args)]
+pub struct ScoreArgs {
+    /// The score folder: score.json, lods.csv, frame/, counterfactual/, and optionally reference/ and stats.csv.
+    pub dir: PathBuf,
+    /// Where frames.csv, transitions.csv, summary.csv, run.json and frames/ (the pictures under a run's dump
+    /// names, for `clips` and `perceptual`) go (default: DIR itself).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Image metrics per frame, as `run --metrics` (rmse, pop and lodpop always; de2000: the CPU's CIEDE2000;
+    /// flip: NVIDIA FLIP); those against the reference are empty without reference/.
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Metric::Rmse, Metric::Pop])]
+    pub metrics: Vec<Metric>,
+    /// The popping budget: a transition over it counts as a visible pop, and the answer is stated within it.
+    #[arg(long)]
+    pub budget_lodpop: Option<f64>,
+}
 
 #[derive(Debug, Clone, Args)]
 pub struct ClipsArgs {
@@ -704,6 +726,11 @@ pub struct DescribeArgs {
     /// Print instead the camera of frame F as JSON: eye, view matrix, field of view, clip planes, viewport.
     #[arg(long, value_name = "F", help_heading = heading::OUTPUT)]
     pub camera_json: Option<u32>,
+    /// Print instead every frame's camera as one JSON object: the field of view, clip planes, viewport, light and
+    /// ambient once, then per frame its eye, view and projection matrices (what a renderer needs to fly the
+    /// run's camera path, `scripts/three_lod.py`).
+    #[arg(long, conflicts_with = "camera_json", help_heading = heading::OUTPUT)]
+    pub cameras_json: bool,
 }
 
 #[derive(Debug, Clone, Args)]

@@ -5,6 +5,32 @@ use crate::cli::DescribeArgs;
 use crate::error::Result;
 use crate::scene::{SceneConfig, SceneDef, SceneDescription, SceneKind};
 
+/// What every frame's camera shares: field of view, clip planes, viewport, the light and the ambient.
+fn view_json(scene: &crate::scene::Scene) -> serde_json::Value {
+    serde_json::json!({
+        "fov_y_deg": scene.fov_y.to_degrees(),
+        "near": scene.near,
+        "far": scene.far,
+        "width": scene.width,
+        "height": scene.height,
+        "light_direction": glam::Vec3::from(crate::gpu::LIGHT_DIR).normalize().to_array(),
+        "ambient": crate::gpu::AMBIENT,
+    })
+}
+
+/// Frame `f`'s camera: its eye, view matrix and projection matrix (column-major).
+fn frame_camera(scene: &crate::scene::Scene, f: u32) -> serde_json::Map<String, serde_json::Value> {
+    let c = scene.camera(f);
+    let mut m = serde_json::Map::new();
+    m.insert("eye".into(), serde_json::json!(c.eye.to_array()));
+    m.insert("view".into(), serde_json::json!(c.view.to_cols_array()));
+    m.insert(
+        "projection".into(),
+        serde_json::json!(c.proj.to_cols_array()),
+    );
+    m
+}
+
 /// Prints the description of the scene `args` name, with its flags.
 pub fn execute(args: &DescribeArgs) -> Result<()> {
     let cfg = SceneConfig::from_args(&args.scene_args)?;
@@ -18,23 +44,26 @@ pub fn execute(args: &DescribeArgs) -> Result<()> {
                 scene.frames.saturating_sub(1)
             )));
         }
-        let c = scene.camera(f);
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::json!({
-                "frame": f,
-                "eye": c.eye.to_array(),
-                "view": c.view.to_cols_array(),
-                "projection": c.proj.to_cols_array(),
-                "fov_y_deg": scene.fov_y.to_degrees(),
-                "near": scene.near,
-                "far": scene.far,
-                "width": scene.width,
-                "height": scene.height,
-                "light_direction": glam::Vec3::from(crate::gpu::LIGHT_DIR).normalize().to_array(),
-                "ambient": crate::gpu::AMBIENT,
-            }))?
-        );
+        let mut camera = view_json(&scene);
+        camera["frame"] = serde_json::json!(f);
+        if let Some(o) = camera.as_object_mut() {
+            o.extend(frame_camera(&scene, f));
+        }
+        outln!("{}", serde_json::to_string_pretty(&camera)?);
+        return Ok(());
+    }
+    if args.cameras_json {
+        let scene = def.instantiate(def.counts[0]);
+        let mut cameras = view_json(&scene);
+        cameras["frames"] = (0..scene.frames)
+            .map(|f| {
+                let mut c = serde_json::Map::new();
+                c.insert("frame".into(), serde_json::json!(f));
+                c.extend(frame_camera(&scene, f));
+                serde_json::Value::Object(c)
+            })
+            .collect();
+        outln!("{}", serde_json::to_string(&cameras)?);
         return Ok(());
     }
     let d = match args.deviation {

@@ -1,5 +1,5 @@
 //! One file per subcommand: what `lodbench run`, `experiment`, `merge`, `compare`, `answer`, `clips`, `perceptual`,
-//! `list`, `describe`, `export`, `tune`, `probe` and `overhead` do, from the parsed flags to a results folder or a printed report. Each file's `execute` is what
+//! `list`, `describe`, `export`, `tune`, `calibrate`, `score`, `probe` and `overhead` do, from the parsed flags to a results folder or a printed report. Each file's `execute` is what
 //! the binary calls.
 
 /// `print!` / `println!` to stdout that give up quietly when stdout is gone (`lodbench describe ... | head`):
@@ -31,4 +31,5 @@ pub mod overhead;
 pub mod perceptual;
 pub mod probe;
 pub mod run;
+pub mod score;
 pub mod tune;

@@ -19,6 +19,7 @@ pub mod diff_kernel;
 pub mod driver;
 pub mod effects;
 pub mod engine_rules;
+pub mod frame_figures;
 pub mod metric_kernel;
 pub mod metrics;
 pub mod overhead_rounds;

@@ -25,6 +25,7 @@ mod commands_compare;
 mod commands_experiment;
 mod commands_overhead;
 mod commands_probe;
+mod commands_score;
 mod commands_tune;
 // src/geometry: the projection every layer computes with.
 mod geometry_projection;
