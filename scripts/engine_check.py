@@ -38,8 +38,8 @@ engines/threejs-lod.js, tuned.glb); ASSET is its name without a leading `tune-`.
      lodbench run of that one makes --dump-frames --dump-transitions);
   6. DIR/report.md: the status counts, per asset the table of switches, the fidelity, the commands.
 
-Then, unless --keep-pictures, every run's and score's PNG folders (frames/, frame/, counterfactual/, reference/),
-answer.json and frames.csv (but under the tune rule's runs) are deleted, and fidelity's pictures are left in a
+Then, unless --keep-pictures, every run's and score's PNG folders (frames/, frame/, counterfactual/, reference/)
+and frames.csv (but under the tune rule's runs) are deleted, and fidelity's pictures are left in a
 temporary folder: what stays is CSVs, run.json, score.json, lods.csv, the figures and report.md.
 
 frame_diff is frame_three - frame_lodbench. Needs Chromium and `npm ci --prefix scripts/threejs` (as three_lod.py).
@@ -63,7 +63,7 @@ PATHS = (("axis", (0.0, 0.0, 1.0)), ("diagonal", DIAGONAL))
 FADES = ("default", "time", "distance")
 PICTURE_DIRS = ("frames", "frame", "counterfactual", "reference")
 # What a kept-small lodbench-fade-* folder keeps.
-FADE_KEEP = ("transitions.csv", "summary.csv")
+FADE_KEEP = ("transitions.csv", "summary.csv", "answer.json")
 COLUMNS = [
     "asset", "path", "rule", "variant", "lodbench_fade", "pair", "order", "switch_distance",
     "frame_lodbench", "frame_three", "frame_diff", "distance_lodbench", "distance_three", "anchor_distance_three",
@@ -470,13 +470,13 @@ def report(out: Path, rows, fidelity, notes, commands, argv, seconds):
 
 
 def clean(out: Path):
-    """Every run's and score's PNG folders and answer.json under `out`; the fade runs keep FADE_KEEP only."""
+    """Every run's and score's PNG folders under `out`, and frames.csv but under the tune rule's runs; the fade runs
+    keep FADE_KEEP only."""
     for folder in out.glob("*/*-*/*"):
         if not folder.is_dir():
             continue
         for name in PICTURE_DIRS:
             shutil.rmtree(folder / name, ignore_errors=True)
-        (folder / "answer.json").unlink(missing_ok=True)
         # frames.csv is kept for the tune rule's runs alone (the lodpop figures'): engine_check.csv holds every
         # switch of the others.
         if not folder.parent.name.endswith("-tune"):
