@@ -7,6 +7,27 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
+LONG_SUITE = "python3 -m pytest -q -n auto scripts/tests --long -m long"
+
+
+def pytest_addoption(parser):
+    parser.addoption("--long", action="store_true",
+                     help=f"also run the long suite, the tests marked long (alone: {LONG_SUITE}; .ci/run runs it)")
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "long: the long suite: whole browser sessions and results rebuilt, which the "
+                            f"README's test command leaves out and .ci/run runs ({LONG_SUITE})")
+
+
+def pytest_collection_modifyitems(config, items):
+    """Without --long, the tests marked long are skipped with the command that runs them."""
+    if config.getoption("--long"):
+        return
+    skip = pytest.mark.skip(reason=f"the long suite: {LONG_SUITE}")
+    for item in items:
+        if "long" in item.keywords:
+            item.add_marker(skip)
 
 
 @functools.lru_cache(maxsize=1)

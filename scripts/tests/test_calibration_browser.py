@@ -30,6 +30,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import calibration  # noqa: E402
 from browser import Browser, chromium_binary  # noqa: E402
 
+# The long suite (conftest.py): a whole browser session per test.
+pytestmark = pytest.mark.long
+
 TIMEOUT_S = 45
 HEADLESS_HZ = 60.0
 CAL = "window.lodbenchCalibration"

@@ -21,6 +21,9 @@ from conftest import lodbench_binary
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from browser import Browser, chromium_binary  # noqa: E402
 
+# The long suite (conftest.py): a whole browser session per test.
+pytestmark = pytest.mark.long
+
 SCRIPT = Path(__file__).resolve().parents[1] / "plot.py"
 # The whole browser session of a test, start-up included: a hung browser fails the test instead of hanging CI.
 TIMEOUT_S = 60

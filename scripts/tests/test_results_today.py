@@ -4,7 +4,7 @@ scripts/regenerate-results.sh, equal the committed ones cell for cell on their i
 
 The remake is compared exactly: the image figures are exact integer sums on the same adapter and driver, so any
 difference is a change of the code's output (on another adapter the comparison is skipped, with the reason; the
-regression set, tests/it/regress.rs, holds the cross-adapter tolerance). Timing columns are not compared."""
+regression set, tests/long/regress.rs, holds the cross-adapter tolerance). Timing columns are not compared."""
 import csv
 import json
 import os
@@ -71,6 +71,7 @@ def adapter(run_json: Path):
     return a.get("name"), a.get("driver"), a.get("driver_info")
 
 
+@pytest.mark.long
 @pytest.mark.parametrize("name", FOLDERS)
 def test_a_committed_folder_is_what_the_code_makes(name, tmp_path):
     committed = ROOT / "results" / "cpu" / name

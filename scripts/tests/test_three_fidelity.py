@@ -22,6 +22,9 @@ from conftest import ROOT, lodbench_binary
 sys.path.insert(0, str(ROOT / "scripts"))
 from browser import chromium_binary  # noqa: E402
 
+# The long suite (conftest.py): a whole browser session per test.
+pytestmark = pytest.mark.long
+
 SCRIPT = ROOT / "scripts" / "three_fidelity.py"
 FILES = ["TextureSettingsTest.glb", "VertexColorTest.glb"]
 TOLERANCE = 0.06

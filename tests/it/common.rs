@@ -1,6 +1,6 @@
 //! Helpers every integration test shares: one way to build a run's or a scene's configuration from the flags a
 //! user would type, one way to run it (in-process or through the binary), one GPU context, one CSV reader, the
-//! sRGB transfer functions, and the regression set's run, which several files read.
+//! sRGB transfer functions. The long suite (tests/long/) shares this file.
 
 use clap::Parser;
 use glam::Vec3;
@@ -10,7 +10,7 @@ use lodbench::scene::{Motion, Scene, SceneConfig, SceneDef, SceneKind};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Output;
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 /// Runs the lodbench binary with ARGS and the environment variables ENV added; its output.
 pub fn lodbench(args: &[&str], env: &[(&str, &str)]) -> Output {
@@ -33,26 +33,6 @@ pub fn fails_with(out: &Output, needles: &[&str]) {
     for n in needles {
         assert!(lines[0].contains(n), "'{n}' not in: {stderr}");
     }
-}
-
-/// The regression set (`--profile regress`, every scene and method at 96x72, with the transitions' dumps), run
-/// once per test binary into the target's temporary folder; the regression tests and the clips tests read it.
-pub fn regress_run() -> &'static PathBuf {
-    static OUT: OnceLock<PathBuf> = OnceLock::new();
-    OUT.get_or_init(|| {
-        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("regress");
-        run_into(
-            &out,
-            &[
-                "--profile",
-                "regress",
-                "--metrics",
-                "rmse,pop,de2000",
-                "--dump-frames",
-                "--dump-transitions",
-            ],
-        )
-    })
 }
 
 /// The GPU context of the tests (lavapipe on a machine without a GPU).

@@ -20,7 +20,6 @@ mod cli_help;
 mod cli_input;
 // src/commands: the subcommands through the binary.
 mod commands_calibrate;
-mod commands_clips;
 mod commands_compare;
 mod commands_experiment;
 mod commands_overhead;
@@ -51,9 +50,8 @@ mod scene_user;
 mod effects_shadows;
 mod effects_taa;
 
-// The suites: whole runs against results/baseline/ and the snapshots.
+// The suites: whole runs against the snapshots and the ci profile (the regression set is in tests/long/).
 mod ci_profile;
-mod regress;
 mod render;
 
 // The fuzz targets' corpora replayed (tests/fuzz/).

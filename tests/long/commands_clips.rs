@@ -1,7 +1,8 @@
 //! `lodbench clips`: the clips of the regression run's transitions (its dumps, `--dump-transitions`), checked
 //! against the dumps they are made of, pixel for pixel; and its bad input.
 
-use crate::common::{fails_with, lodbench, regress_run, run_into};
+use crate::common::{fails_with, lodbench, run_into};
+use crate::regress_run;
 use lodbench::commands::clips::{make, ClipSettings, Mp4};
 use lodbench::measure::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
 use lodbench::results::png::FrameDumper;

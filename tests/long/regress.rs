@@ -16,7 +16,8 @@
 //! results/baseline/regress/). The full ci profile is a user command (`lodbench run --profile ci`) and the
 //! `ci_profile` module's ignored test.
 
-use crate::common::{read_csv, regress_run, scene_config, snapshot_problem, Row};
+use crate::common::{read_csv, scene_config, snapshot_problem, Row};
+use crate::regress_run;
 use lodbench::measure::FrameDriver;
 use lodbench::scene::{SceneDef, SceneKind};
 use std::collections::HashMap;

@@ -1,0 +1,43 @@
+//! lodbench's long suite (`cargo test --release --test long`): the tests that are whole experiments by nature,
+//! which `cargo test` leaves out (`test = false` in Cargo.toml) and `.ci/run` runs after the README's test
+//! command. Both must pass for a change to land. The helpers are tests/it/common.rs's, shared.
+//!
+//! - `regress`: the regression set, every scene and method at 96x72 against results/baseline/regress/ (about
+//!   a minute and a half on lavapipe);
+//! - `commands_clips`: `lodbench clips` on the regression set's dumps.
+
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "a test fails by panicking"
+)]
+
+#[path = "../it/common.rs"]
+#[allow(dead_code, reason = "the long suite uses a few of the shared helpers")]
+mod common;
+
+mod commands_clips;
+mod regress;
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// The regression set (`--profile regress`, every scene and method at 96x72, with the transitions' dumps), run
+/// once per test binary into the target's temporary folder; the regression tests and the clips tests read it.
+pub fn regress_run() -> &'static PathBuf {
+    static OUT: OnceLock<PathBuf> = OnceLock::new();
+    OUT.get_or_init(|| {
+        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("regress");
+        common::run_into(
+            &out,
+            &[
+                "--profile",
+                "regress",
+                "--metrics",
+                "rmse,pop,de2000",
+                "--dump-frames",
+                "--dump-transitions",
+            ],
+        )
+    })
+}
