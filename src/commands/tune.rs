@@ -523,8 +523,41 @@ fn write_engines(out: &Path, models: &[EngineModel], viewing: &Viewing) -> Resul
         &dir.join(EngineFile::ThreejsLod.name()),
         engines::threejs(models, &header).as_bytes(),
     )?;
-    let readme = format!("{}\n\n{ENGINES_README_TEXT}", about.join("\n\n"));
+    let readme = format!(
+        "{}\n\n{}",
+        about.join("\n\n"),
+        outside_links(ENGINES_README_TEXT)
+    );
     write(&dir.join(ENGINES_README), readme.as_bytes())
+}
+
+/// `text` with each relative Markdown link `[label](page.md#anchor)` written as `label (lodbench's
+/// docs/page.md#anchor)`: the page is copied into a tune folder, where a link relative to docs/ names nothing.
+fn outside_links(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(open) = rest.find('[') {
+        let after = &rest[open..];
+        let link = after.find("](").and_then(|mid| {
+            let close = after[mid..].find(')')? + mid;
+            let (label, target) = (&after[1..mid], &after[mid + 2..close]);
+            let relative = !target.contains(':') && !label.contains('[') && !label.contains('\n');
+            relative.then(|| (close, label, target))
+        });
+        match link {
+            Some((close, label, target)) => {
+                out.push_str(&rest[..open]);
+                out.push_str(&format!("{label} (lodbench's docs/{target})"));
+                rest = &rest[open + close + 1..];
+            }
+            None => {
+                out.push_str(&rest[..open + 1]);
+                rest = &rest[open + 1..];
+            }
+        }
+    }
+    out.push_str(rest);
+    out
 }
 
 /// Serialising what `write_engines` writes, whatever its type.
@@ -625,4 +658,22 @@ pub fn rules_table(models: &[ModelSwitches], figure: &str) -> String {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The engines' README copied into a tune folder keeps no link relative to docs/ (it would name nothing
+    /// there), and leaves absolute links and brackets that are no links alone.
+    #[test]
+    fn the_copied_readme_names_its_links_outside_the_folder() {
+        let text = outside_links(ENGINES_README_TEXT);
+        assert!(!text.contains("](methods.md"), "{text}");
+        assert!(text.contains("(lodbench's docs/methods.md#choosing-thresholds-lodbench-tune)"));
+        assert_eq!(
+            outside_links("a [x](y.md#z) b [c] d [e](https://f) g"),
+            "a x (lodbench's docs/y.md#z) b [c] d [e](https://f) g"
+        );
+    }
 }
