@@ -542,7 +542,7 @@ fn outside_links(text: &str) -> String {
             let close = after[mid..].find(')')? + mid;
             let (label, target) = (&after[1..mid], &after[mid + 2..close]);
             let relative = !target.contains(':') && !label.contains('[') && !label.contains('\n');
-            relative.then(|| (close, label, target))
+            relative.then_some((close, label, target))
         });
         match link {
             Some((close, label, target)) => {

@@ -8,6 +8,7 @@ use crate::gpu::compute::{bind_group, kernel_lanes, results_buffers, uniform_buf
 use crate::gpu::context::GpuContext;
 use crate::gpu::targets::RenderTarget;
 use crate::measure::coverage::PixelRect;
+use crate::measure::metrics::rms_of_sum;
 
 pub const DIFF_WGSL: &str = include_str!("../../shaders/diff.wgsl");
 
@@ -158,7 +159,7 @@ impl DiffKernel {
 
     /// The difference of frames `0..frames` with its coverage and shading parts.
     pub fn read_parts(&self, ctx: &GpuContext, frames: u32) -> Result<Vec<DiffFigure>> {
-        let scale = 3.0 * 255.0 * 255.0 * self.width as f64 * self.height as f64;
+        let pixels = self.width as f64 * self.height as f64;
         let n = frames.min(self.frames) as usize;
         let sums = ctx.read_u64_sums(&self.sums, &self.readback, 2 * n)?;
         Ok(sums
@@ -166,9 +167,9 @@ impl DiffKernel {
             .map(|s| {
                 let (all, coverage) = (s[0], s[1].min(s[0]));
                 DiffFigure {
-                    rms: (all as f64 / scale).sqrt(),
-                    coverage: (coverage as f64 / scale).sqrt(),
-                    shading: ((all - coverage) as f64 / scale).sqrt(),
+                    rms: rms_of_sum(all, pixels),
+                    coverage: rms_of_sum(coverage, pixels),
+                    shading: rms_of_sum(all - coverage, pixels),
                 }
             })
             .collect())

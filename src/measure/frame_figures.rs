@@ -1,9 +1,11 @@
 //! The quality pass's image figures of frames that are already pictures (another renderer's, `lodbench score`),
 //! computed on the CPU from the same exact integer sums the GPU kernels add (`shaders/metrics.wgsl`,
-//! `shaders/diff.wgsl`) and turned into figures by the same expressions (`metric_kernel.rs`, `diff_kernel.rs`),
+//! `shaders/diff.wgsl`) and turned into figures by the same functions (`metrics::rmse_of_sum`, `rms_of_sum`),
 //! so a run's dumped frames scored here give its frames.csv figures bit for bit.
 
-use super::metrics::{crack_pixels, de2000_mean, flip_mean, rms_difference_parts};
+use super::metrics::{
+    crack_pixels, de2000_mean, flip_mean, rms_difference_parts, rms_of_sum, rmse_of_sum,
+};
 
 /// One frame's images, RGBA8, all `width` x `height`.
 pub struct FramePictures<'a> {
@@ -79,9 +81,8 @@ impl SequenceFigures {
             _ => 0,
         };
         self.previous_error = Some(error);
-        f.rmse =
-            Some((rmse_sum(p.frame, reference) as f64 / (9.0 * 255.0 * 255.0 * pixels)).sqrt());
-        f.pop = Some((pop_sum as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt());
+        f.rmse = Some(rmse_of_sum(rmse_sum(p.frame, reference), pixels));
+        f.pop = Some(rms_of_sum(pop_sum, pixels));
         let (uncovered, cracks) =
             crack_pixels(p.frame, reference, self.width, self.height, self.background);
         f.uncovered_px = Some(uncovered);

@@ -258,8 +258,8 @@ impl MetricKernel {
         Ok(sums
             .chunks_exact(4)
             .map(|s| FrameMetrics {
-                rmse: (s[0] as f64 / (9.0 * 255.0 * 255.0 * pixels)).sqrt(),
-                pop: (s[1] as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt(),
+                rmse: super::metrics::rmse_of_sum(s[0], pixels),
+                pop: super::metrics::rms_of_sum(s[1], pixels),
                 de2000: s[2] as f64 / (65536.0 * pixels),
                 uncovered_px: s[3] & 0xffff_ffff,
                 crack_px: s[3] >> 32,

@@ -24,6 +24,18 @@ pub fn rmse_srgb(method: &[u8], reference: &[u8]) -> f64 {
     (sum / pixels as f64).sqrt()
 }
 
+/// rmse from the metric kernel's exact sum over `pixels` pixels of (the sum over R, G, B of |a - b|, in bytes)
+/// squared: the one expression the GPU's figures and `lodbench score`'s are made by.
+pub fn rmse_of_sum(sum: u64, pixels: f64) -> f64 {
+    (sum as f64 / (9.0 * 255.0 * 255.0 * pixels)).sqrt()
+}
+
+/// An RMS over `pixels` pixels and R, G, B from an exact sum of squared byte differences (pop, lodpop and its
+/// parts, lag_rmse): the one expression the kernels' figures and `lodbench score`'s are made by.
+pub fn rms_of_sum(sum: u64, pixels: f64) -> f64 {
+    (sum as f64 / (3.0 * 255.0 * 255.0 * pixels)).sqrt()
+}
+
 /// Root mean square over pixels and R, G, B of `a - b` (encoded values in [0, 1]): lodpop, a method's frame
 /// against the same frame rendered with the previous frame's LOD schedule, and lag_rmse (the oracle of
 /// `shaders/diff.wgsl`).
@@ -70,11 +82,11 @@ pub fn rms_difference_parts_over(
             coverage += e;
         }
     }
-    let scale = 3.0 * 255.0 * 255.0 * pixels as f64;
+    let pixels = pixels as f64;
     (
-        (all as f64 / scale).sqrt(),
-        (coverage as f64 / scale).sqrt(),
-        ((all - coverage) as f64 / scale).sqrt(),
+        rms_of_sum(all, pixels),
+        rms_of_sum(coverage, pixels),
+        rms_of_sum(all - coverage, pixels),
     )
 }
 

@@ -35,8 +35,11 @@ pub fn execute(args: &ScoreArgs) -> Result<()> {
     let figures = figures_of(&folder, (flip, de2000))?;
     prepare_output(&out)?;
     let (scene, method) = names(&folder);
-    let rows = records(&folder, &figures, (&scene, &method));
-    let pairs = frame_pairs(&folder.selections);
+    let moving: Vec<_> = (0..folder.selections.len())
+        .map(|f| in_transition(&folder.selections, f))
+        .collect();
+    let rows = records(&folder, (&figures, &moving), (&scene, &method));
+    let pairs = frame_pairs(&moving);
     let mut found = transitions(&rows, &pairs);
     let mut summaries: Vec<SummaryRecord> =
         SummaryRecord::from_frames(&rows, 0, 1, Clock::of(&rows))
@@ -133,20 +136,23 @@ fn load(path: &Path) -> Result<image::RgbaImage> {
     Ok(img.to_rgba8())
 }
 
-/// Per frame, the pair of levels its objects in transition go between.
-fn frame_pairs(selections: &[Vec<Selection>]) -> Vec<TransitionPair> {
-    (0..selections.len())
-        .map(|f| {
-            in_transition(selections, f)
-                .into_iter()
-                .fold(TransitionPair::None, |p, (from, to, _)| p.with(from, to))
+/// A frame's objects in transition: (from, to, k) of each ([`in_transition`]).
+type Moving = Vec<(u32, u32, f64)>;
+
+/// Per frame, the pair of levels its objects in transition (`moving`, [`in_transition`]) go between.
+fn frame_pairs(moving: &[Moving]) -> Vec<TransitionPair> {
+    moving
+        .iter()
+        .map(|m| {
+            m.iter()
+                .fold(TransitionPair::None, |p, &(from, to, _)| p.with(from, to))
         })
         .collect()
 }
 
 /// The objects in transition on frame `f`: (from, to, k) of each that blends, or that draws another level than
 /// on the frame before (k = 1: the switch is whole).
-fn in_transition(selections: &[Vec<Selection>], f: usize) -> Vec<(u32, u32, f64)> {
+fn in_transition(selections: &[Vec<Selection>], f: usize) -> Moving {
     selections[f]
         .iter()
         .enumerate()
@@ -161,11 +167,11 @@ fn in_transition(selections: &[Vec<Selection>], f: usize) -> Vec<(u32, u32, f64)
         .collect()
 }
 
-/// frames.csv's rows: the selections, the renderer's stats (or its frame period where it gave none) and the
-/// figures.
+/// frames.csv's rows: the selections and the objects in transition (`moving`), the renderer's stats (or its
+/// frame period where it gave none) and the figures.
 fn records(
     folder: &ScoreFolder,
-    figures: &[ImageFigures],
+    (figures, moving): (&[ImageFigures], &[Moving]),
     (scene, method): (&str, &str),
 ) -> Vec<FrameRecord> {
     let period = 1000.0 / folder.manifest.fps;
@@ -175,7 +181,7 @@ fn records(
         .enumerate()
         .map(|(f, fig)| {
             let stats = folder.stats.as_ref().map(|s| s[f]).unwrap_or_default();
-            let moving = in_transition(&folder.selections, f);
+            let moving = &moving[f];
             let lod_mean = folder.selections[f]
                 .iter()
                 .map(|s| {
