@@ -187,6 +187,12 @@ def test_lodbench_scores_the_folders(folder, dither, tune):
     switch = next(f for f in range(1, FRAMES) if lods[f] != lods[f - 1])
     row = next(r for r in frames if int(r["frame"]) == switch)
     assert float(row["lodpop"]) > 0, row
+    # The scored folder reads as a run's: plot.py draws its figures and report.html, and clips finds the pictures
+    # under their dump names.
+    run(sys.executable, ROOT / "scripts" / "plot.py", folder)
+    assert (folder / "report.html").is_file() and any((folder / "figures").glob("*.png"))
+    run(binary, "clips", folder, "--mp4", "off")
+    assert (folder / "clips" / "index.json").is_file()
     # The dithered fade is one transition over its frames.
     run(binary, "score", dither)
     (transition,) = read_csv(dither / "transitions.csv")
