@@ -254,43 +254,6 @@ pub fn snapshot_problem(actual: &image::RgbaImage, snap: &Path) -> Option<String
     ))
 }
 
-/// The built-in bunny with every triangle split into four at its edge midpoints, `levels` times (3,674 x 4^levels
-/// triangles), each new vertex moved off the face by up to +-`amplitude` / 2 along its normal (a fixed hash of
-/// its index), as OBJ text: a denser mesh of the same shape with a scan's fine noise, which its LODs lose.
-pub fn subdivided_bunny_obj(levels: u32, amplitude: f32) -> String {
-    let m = lodbench::geometry::mesh::Mesh::parse_obj("bunny", lodbench::scene::BUNNY_OBJ).unwrap();
-    let mut positions: Vec<Vec3> = m.positions.iter().map(|p| Vec3::from(*p)).collect();
-    let mut indices = m.indices.clone();
-    for _ in 0..levels {
-        let mut mid = HashMap::new();
-        let mut next = Vec::with_capacity(indices.len() * 4);
-        for t in indices.chunks_exact(3) {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
-            let n = (b - a).cross(c - a).normalize_or_zero();
-            let mut m_of = |a: u32, b: u32| {
-                *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                    let i = positions.len() as u64;
-                    let h = ((i * 2_654_435_761) % (1 << 32)) as f32 / (1u64 << 32) as f32 - 0.5;
-                    let p = (positions[a as usize] + positions[b as usize]) * 0.5;
-                    positions.push(p + n * amplitude * h);
-                    i as u32
-                })
-            };
-            let (ab, bc, ca) = (m_of(t[0], t[1]), m_of(t[1], t[2]), m_of(t[2], t[0]));
-            next.extend_from_slice(&[t[0], ab, ca, ab, t[1], bc, ca, bc, t[2], ab, bc, ca]);
-        }
-        indices = next;
-    }
-    let mut obj = String::new();
-    for p in &positions {
-        obj += &format!("v {} {} {}\n", p.x, p.y, p.z);
-    }
-    for t in indices.chunks_exact(3) {
-        obj += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
-    }
-    obj
-}
-
 /// Frame `frame` of `method` on `scene`, from its quality pass (RGBA8, sRGB-encoded bytes).
 pub fn render_frame(
     ctx: &lodbench::gpu::GpuContext,
