@@ -57,7 +57,8 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from tune_rules import DIAGONAL, RULES, camera_eye, write_path  # noqa: E402
+from lodbench_results import read_csv  # noqa: E402
+from tune_rules import DIAGONAL, RULES, camera_eye, markdown, write_path  # noqa: E402
 
 PATHS = (("axis", (0.0, 0.0, 1.0)), ("diagonal", DIAGONAL))
 FADES = ("default", "time", "distance")
@@ -149,11 +150,6 @@ def three_lods(lods_rows, obj=None):
 
 # ---- Running things ----
 
-def read_rows(path: Path):
-    with open(path, newline="") as fh:
-        return list(csv.DictReader(fh))
-
-
 def call(args, what: str):
     done = subprocess.run([str(a) for a in args], capture_output=True, text=True)
     if done.returncode != 0:
@@ -187,7 +183,7 @@ class Asset:
         self.model = models[0]
         self.width, self.height = int(self.meta["width"]), int(self.meta["height"])
         self.tuned = self.tune_dir / "tuned.glb"
-        rules = read_rows(self.tune_dir / "rules.csv")
+        rules = read_csv(self.tune_dir / "rules.csv")
         # The distances as rules.csv writes them (f32's shortest text): lodbench reads the same f32 three.js gets.
         self.switch_text = {r: [x["distance"] for x in sorted((x for x in rules if x["rule"] == r),
                                                                key=lambda x: int(x["lod_from"]))] for r in RULES}
@@ -262,10 +258,10 @@ def fade_label(folder: Path) -> str:
 
 def compare(asset: Asset, path: str, rule: str, variant: str, lb: Path, three: Path):
     """The rows of engine_check.csv of one lodbench run against one score folder, and notes on what looks off."""
-    lb_frames, th_frames = read_rows(lb / "frames.csv"), read_rows(three / "frames.csv")
+    lb_frames, th_frames = read_csv(lb / "frames.csv"), read_csv(three / "frames.csv")
     ours = discrete_lods(lb_frames)
     th_method = json.loads((three / "score.json").read_text())["method"]
-    theirs = three_lods(read_rows(three / "lods.csv"))
+    theirs = three_lods(read_csv(three / "lods.csv"))
     score = json.loads((three / "score.json").read_text())
     anchor = score["notes"]["objects"][0]["position"]
     notes = []
@@ -401,12 +397,6 @@ def switch_figure(asset: Asset, row: dict, lb: Path, three: Path, out: Path):
 
 
 # ---- Report ----
-
-def markdown(rows, columns):
-    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    lines += ["| " + " | ".join(str(r.get(c, "")) for c in columns) + " |" for r in rows]
-    return "\n".join(lines)
-
 
 def shell(args):
     """A command as one line: python3 for this interpreter, paths under the working folder relative to it."""

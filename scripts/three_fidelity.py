@@ -75,22 +75,31 @@ class _Quiet(http.server.SimpleHTTPRequestHandler):
         pass
 
 
-def three_frame(chromium, scene: Path, camera: dict, work: Path) -> tuple:
-    """three.js's frame of `scene` with lodbench's `camera` (RGBA8 array) and the milliseconds the page took."""
-    site = work / "site"
+def serve_page(site: Path, page: str, links: dict, job: dict):
+    """A page of scripts/threejs/ served from the new folder `site` on localhost: the page and lighting.js (the
+    renderer and lighting every page shares) copied, node_modules and each of `links` (name: path) linked, `job`
+    as job.json. Returns the server (shut it down when done) and the page's URL."""
     site.mkdir(parents=True)
-    shutil.copy(THREEJS / "render.html", site / "render.html")
+    for name in (page, "lighting.js"):
+        shutil.copy(THREEJS / name, site / name)
     os.symlink(THREEJS / "node_modules", site / "node_modules")
-    os.symlink(scene.resolve().parent, site / "asset")
-    job = {**camera, "background": BACKGROUND, "model": f"asset/{scene.name}"}
+    for name, target in links.items():
+        os.symlink(target, site / name)
     (site / "job.json").write_text(json.dumps(job))
     server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(_Quiet, directory=str(site)))
     threading.Thread(target=server.serve_forever, daemon=True).start()
+    return server, f"http://127.0.0.1:{server.server_address[1]}/{page}"
+
+
+def three_frame(chromium, scene: Path, camera: dict, work: Path) -> tuple:
+    """three.js's frame of `scene` with lodbench's `camera` (RGBA8 array) and the milliseconds the page took."""
+    job = {**camera, "background": BACKGROUND, "model": f"asset/{scene.name}"}
+    server, url = serve_page(work / "site", "render.html", {"asset": scene.resolve().parent}, job)
     t0 = time.monotonic()
     browser = Browser(chromium, work / "profile", t0 + BROWSER_TIMEOUT_S, viewport=(camera["width"],
                       camera["height"]), webgl=True)
     try:
-        browser.open(f"http://127.0.0.1:{server.server_address[1]}/render.html")
+        browser.open(url)
         browser.until("window.result || window.error", "three.js's frame")
         error = browser.js("window.error || null")
         if error:

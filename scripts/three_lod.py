@@ -59,15 +59,11 @@ Needs Chromium and `npm ci --prefix scripts/threejs` (.ci/setup-tests does both)
 import argparse
 import base64
 import csv
-import functools
-import http.server
 import json
-import os
 import shutil
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 
@@ -76,11 +72,9 @@ from PIL import Image
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 from browser import Browser, chromium_binary  # noqa: E402
+from three_fidelity import BACKGROUND, THREEJS, serve_page  # noqa: E402
 
-THREEJS = HERE / "threejs"
 ROOT = HERE.parent
-# lodbench's clear colour in linear RGB (src/scene/model.rs BACKGROUND), as scripts/three_fidelity.py uses it.
-BACKGROUND = [0.045, 0.05, 0.06]
 RULES = ["tune", "unreal", "godot", "meshopt"]
 # Browser start-up and the file's loading; then each frame (up to three pictures on SwiftShader) gets FRAME_S.
 START_S = 120
@@ -92,11 +86,6 @@ OUT_FILES = ("score.json", "lods.csv", "stats.csv")
 # What `lodbench score DIR` writes into DIR: stale once the folder is written again.
 SCORED_FILES = ("frames.csv", "transitions.csv", "summary.csv", "run.json", "answer.json", "pairs.csv", "rounds.csv")
 SCORED_DIRS = ("frames",)
-
-
-class _Quiet(http.server.SimpleHTTPRequestHandler):
-    def log_message(self, *args):
-        pass
 
 
 def fail(message: str):
@@ -215,24 +204,17 @@ def main() -> int:
         (f"-dither{a.fade_frames}" if a.fade == "dither" else "")
     lods_rows, stats_rows, changes = [], [], []
     with tempfile.TemporaryDirectory() as tmp:
-        site = Path(tmp) / "site"
-        site.mkdir()
-        shutil.copy(THREEJS / "lod.html", site / "lod.html")
-        os.symlink(THREEJS / "node_modules", site / "node_modules")
-        os.symlink(tune_dir, site / "tune")
         job = {key: cams[key] for key in ("fov_y_deg", "near", "far", "width", "height", "light_direction",
                                           "ambient")}
         job.update(frames=[{"view": c["view"]} for c in cams["frames"]], background=BACKGROUND,
                    model="tune/tuned.glb", anchor=a.anchor, distances=distances, reference=a.reference,
                    fade=a.fade, fade_frames=a.fade_frames)
-        (site / "job.json").write_text(json.dumps(job))
-        server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(_Quiet, directory=str(site)))
-        threading.Thread(target=server.serve_forever, daemon=True).start()
+        server, url = serve_page(Path(tmp) / "site", "lod.html", {"tune": tune_dir}, job)
         browser = Browser(chromium, Path(tmp) / "profile", time.monotonic() + START_S + FRAME_S * frames,
                           viewport=(width, height), webgl=True)
         try:
             chromium_version = browser.call("Browser.getVersion", session=False)["product"]
-            browser.open(f"http://127.0.0.1:{server.server_address[1]}/lod.html")
+            browser.open(url)
             browser.until("window.ready || window.error", "three.js's set-up")
             error = browser.js("window.error || null")
             if error:

@@ -84,8 +84,9 @@ def summarise(folder: Path, budget: float):
 
 
 def markdown(rows, columns):
+    """A Markdown table of `rows` (dicts) in `columns`' order, a cell a row lacks left empty."""
     lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    lines += ["| " + " | ".join(str(r[c]) for c in columns) + " |" for r in rows]
+    lines += ["| " + " | ".join(str(r.get(c, "")) for c in columns) + " |" for r in rows]
     return "\n".join(lines)
 
 

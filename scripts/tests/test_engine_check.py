@@ -16,7 +16,7 @@ def write(path, columns, rows):
         w = csv.writer(fh)
         w.writerow(columns)
         w.writerows(rows)
-    return ec.read_rows(path)
+    return ec.read_csv(path)
 
 
 def frames_csv(tmp_path, lod_means):
