@@ -43,6 +43,13 @@ NOT_COLUMNS = {
         "lodbench_triangles", "lodbench_lodpop_max", "lodbench_lodpop_coverage", "lodbench_lodpop_shading",
         "gltfpack_triangles", "gltfpack_lodpop_max", "gltfpack_lodpop_coverage", "gltfpack_lodpop_shading",
     },
+    "engine_check.py": TUNE_JSON_KEYS | {
+        "eye",  # `lodbench describe --cameras-json`
+        "scenes", "schedule", "fade", "fade_frames",  # run.json's config and the score folder's job
+        "notes", "objects", "position",  # score.json's notes, which three_lod.py writes
+        "object", "lod",  # lods.csv, the score folder's (written by three_lod.py, read by `lodbench score`)
+        "flip_mean_flat", "flip_covered",  # three_fidelity.py's rows
+    },
     "equal_error.py": {"triangles", "cost"},  # its points' values, named by COLUMNS
     "frontier.py": {"axes.prop_cycle", "color"},  # matplotlib's rcParams
     "plot.py": TUNE_JSON_KEYS | {
