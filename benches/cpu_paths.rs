@@ -112,6 +112,7 @@ fn csv_export(c: &mut Criterion) {
             select_cpu_ms: None,
             round: f / 360,
             fragments: None,
+            view_pop: None,
         })
         .collect();
     let dir = tempfile::tempdir().unwrap();

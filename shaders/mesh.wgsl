@@ -31,12 +31,31 @@ struct Camera {
     // --shader-work (src/gpu/scene_gpu.rs): x: ALU iterations per shaded fragment; y: the weight their result is
     // added with (0 in every run: the image is unchanged; a uniform, so the loop cannot be compiled away).
     work: vec4<f32>,
+    // --impostor: the eye (world) the impostors select their frames by: the camera's own, or the previous
+    // frame's in view_pop's counterfactual. While an atlas is baked: the model's bounding sphere (object space).
+    impostor_eye: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 // The shadow map the draw is lit by (a 1x1 placeholder without shadows, never read then).
 @group(0) @binding(1) var shadow_map: texture_depth_2d;
 @group(0) @binding(2) var shadow_sampler: sampler_comparison;
+// --impostor (src/gpu/impostor_atlas.rs): the atlases, two layers each per impostor: sRGB (base colour with
+// coverage, emissive) and linear (normal with depth, occlusion-roughness-metallic); 1x1 placeholders without.
+@group(0) @binding(3) var impostor_srgb: texture_2d_array<f32>;
+@group(0) @binding(4) var impostor_linear: texture_2d_array<f32>;
+@group(0) @binding(5) var impostor_sampler: sampler;
+
+struct Impostors {
+    // x: frames a side (N); y: layout (0 full, 1 hemi); z: frames a pixel blends (1 or 3); w: parallax (0 or 1).
+    settings: vec4<f32>,
+    // x: texels a frame's side over the atlas's side.
+    atlas: vec4<f32>,
+    // Per impostor slot: its model's bounding-sphere centre (object space) and radius (object space).
+    spheres: array<vec4<f32>, 64>,
+};
+
+@group(0) @binding(6) var<uniform> impostors: Impostors;
 
 struct InstanceIn {
     @location(2) model_0: vec4<f32>,
@@ -51,8 +70,12 @@ const KIND_LEAF: f32 = 1.0;
 const KIND_LEAF_CLUSTER: f32 = 2.0;
 const KIND_BLADE: f32 = 3.0;
 const KIND_DEFORMED: f32 = 4.0;
+const KIND_IMPOSTOR: f32 = 5.0;
 
 fn transform(position: vec3<f32>, normal: vec3<f32>, aux: vec4<f32>, inst: InstanceIn) -> VsOut {
+    if (aux.z == KIND_IMPOSTOR) {
+        return impostor_card(aux, inst);
+    }
     var p = position;
     var n = normal;
     if (aux.z == KIND_BLADE) {
@@ -106,9 +129,12 @@ fn leaf_cluster_mask(uv: vec2<f32>) -> bool {
     return leaf_mask(uv * 3.0 - c);
 }
 
-// True where an alpha-tested leaf card (aux kinds 1 and 2) has no leaf (the fragment is discarded by every
-// method).
+// True where an alpha-tested leaf card (aux kinds 1 and 2) has no leaf, or an impostor's card no model (the
+// fragment is discarded by every method).
 fn aux_masked(in: VsOut) -> bool {
+    if (in.kind == KIND_IMPOSTOR) {
+        return impostor_masked(in);
+    }
     if (in.kind == KIND_LEAF) {
         return !leaf_mask(in.uv);
     }
@@ -147,6 +173,229 @@ fn lit(world: vec3<f32>) -> f32 {
         }
     }
     return sum / 9.0;
+}
+
+// Octahedral impostors (src/geometry/impostor.rs holds the same maps and selection on the CPU, with their
+// tests: keep the two in step). A card's vertex has aux = (corner x, corner y, KIND_IMPOSTOR, slot); the card is
+// spread across the view on the plane through the model's centre, as large as its bounding sphere's silhouette.
+// Lighting happens in object space (instances are scaled uniformly, so angles are kept): `normal` carries the
+// light's direction there, `imp_ray` the ray from the eye to the card point, `imp_eye` the selecting eye.
+
+fn impostor_sign(v: vec2<f32>) -> vec2<f32> {
+    return select(vec2<f32>(-1.0), vec2<f32>(1.0), v >= vec2<f32>(0.0));
+}
+
+fn impostor_encode(d: vec3<f32>) -> vec2<f32> {
+    let p = d / (abs(d.x) + abs(d.y) + abs(d.z));
+    var q: vec2<f32>;
+    if (impostors.settings.y > 0.5) {
+        q = vec2<f32>(p.x + p.z, p.x - p.z);
+    } else if (p.y >= 0.0) {
+        q = p.xz;
+    } else {
+        q = (vec2<f32>(1.0) - abs(p.zx)) * impostor_sign(p.xz);
+    }
+    return q * 0.5 + vec2<f32>(0.5);
+}
+
+fn impostor_decode(uv: vec2<f32>) -> vec3<f32> {
+    let a = uv * 2.0 - vec2<f32>(1.0);
+    if (impostors.settings.y > 0.5) {
+        let x = (a.x + a.y) * 0.5;
+        let z = (a.x - a.y) * 0.5;
+        return normalize(vec3<f32>(x, max(1.0 - abs(x) - abs(z), 0.0), z));
+    }
+    let y = 1.0 - abs(a.x) - abs(a.y);
+    if (y >= 0.0) {
+        return normalize(vec3<f32>(a.x, y, a.y));
+    }
+    let q = (vec2<f32>(1.0) - abs(a.yx)) * impostor_sign(a);
+    return normalize(vec3<f32>(q.x, y, q.y));
+}
+
+// A frame's image axes (right, up) for view direction f.
+fn impostor_basis(f: vec3<f32>) -> mat2x3<f32> {
+    let up_ref = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, -1.0), abs(f.y) > 0.999);
+    let right = normalize(cross(up_ref, f));
+    return mat2x3<f32>(right, cross(f, right));
+}
+
+fn impostor_card(aux: vec4<f32>, inst: InstanceIn) -> VsOut {
+    let slot = u32(aux.w + 0.5);
+    let sphere = impostors.spheres[slot];
+    let model = mat4x4<f32>(inst.model_0, inst.model_1, inst.model_2, inst.model_3);
+    let m3 = mat3x3<f32>(model[0].xyz, model[1].xyz, model[2].xyz);
+    let inv = transpose(m3) * (1.0 / dot(m3[0], m3[0]));
+    let eye = inv * (camera.eye.xyz - model[3].xyz);
+    let to_eye = eye - sphere.xyz;
+    let d = max(length(to_eye), 1e-6);
+    let axes = impostor_basis(to_eye / d);
+    let r = sphere.w;
+    // The silhouette's radius on the centre's plane; 4 radii from inside the sphere.
+    let half = select(4.0 * r, min(r * d / sqrt(d * d - r * r), 4.0 * r), d > r * 1.0001);
+    let p = sphere.xyz + (axes[0] * aux.x + axes[1] * aux.y) * half;
+    let world = model * vec4<f32>(p, 1.0);
+    var out: VsOut;
+    out.clip = camera.view_proj * world;
+    out.normal = normalize(transpose(m3) * camera.light.xyz);
+    out.color = inst.color;
+    out.params = inst.params;
+    out.uv = vec2<f32>(f32(slot), 0.0);
+    out.kind = KIND_IMPOSTOR;
+    out.object = p;
+    out.world = world.xyz;
+    out.imp_ray = p - eye;
+    out.imp_eye = inv * (camera.impostor_eye.xyz - model[3].xyz);
+    return out;
+}
+
+// What the atlas holds at a card's fragment: coverage (the frames' weighted share of covered texels), and the
+// covered texels' base colour, object-space normal, occlusion-roughness-metallic and emissive.
+struct ImpostorTexel {
+    coverage: f32,
+    base: vec4<f32>,
+    normal: vec3<f32>,
+    orm: vec3<f32>,
+    emissive: vec3<f32>,
+};
+
+// Where the ray from `eye` along `ray` meets frame `fd`'s plane through the centre, offset `z` along fd, in the
+// frame's unit square (outside it: no texel).
+fn impostor_frame_uv(eye: vec3<f32>, ray: vec3<f32>, sphere: vec4<f32>, fd: vec3<f32>, z: f32) -> vec2<f32> {
+    let axes = impostor_basis(fd);
+    let denom = dot(ray, fd);
+    let t = dot(sphere.xyz + fd * z - eye, fd) / select(-1e-6, denom, abs(denom) > 1e-6);
+    let local = eye + ray * t - sphere.xyz;
+    let xy = vec2<f32>(dot(local, axes[0]), dot(local, axes[1])) / sphere.w;
+    return vec2<f32>(xy.x * 0.5 + 0.5, 0.5 - xy.y * 0.5);
+}
+
+// The frames a view selects, as grid coordinates and weights (src/geometry/impostor.rs `select`).
+struct ImpostorFrames {
+    cells: array<vec2<f32>, 3>,
+    weights: vec3<f32>,
+};
+
+fn impostor_frames(from_centre: vec3<f32>) -> ImpostorFrames {
+    var d = normalize(from_centre);
+    if (impostors.settings.y > 0.5 && d.y < 0.0) {
+        let h = vec3<f32>(d.x, 0.0, d.z);
+        d = select(vec3<f32>(1.0, 0.0, 0.0), normalize(h), dot(h, h) > 0.0);
+    }
+    let top = impostors.settings.x - 1.0;
+    let g = impostor_encode(d) * top;
+    var out: ImpostorFrames;
+    if (impostors.settings.z < 1.5) {
+        out.cells[0] = clamp(round(g), vec2<f32>(0.0), vec2<f32>(top));
+        out.weights = vec3<f32>(1.0, 0.0, 0.0);
+        return out;
+    }
+    let cell = clamp(floor(g), vec2<f32>(0.0), vec2<f32>(top - 1.0));
+    let f = g - cell;
+    if (f.x + f.y < 1.0) {
+        out.cells = array<vec2<f32>, 3>(cell, cell + vec2<f32>(1.0, 0.0), cell + vec2<f32>(0.0, 1.0));
+        out.weights = vec3<f32>(1.0 - f.x - f.y, f.x, f.y);
+    } else {
+        out.cells = array<vec2<f32>, 3>(cell + vec2<f32>(1.0), cell + vec2<f32>(0.0, 1.0), cell + vec2<f32>(1.0, 0.0));
+        out.weights = vec3<f32>(f.x + f.y - 1.0, 1.0 - f.x, 1.0 - f.y);
+    }
+    return out;
+}
+
+fn impostor_texel(in: VsOut) -> ImpostorTexel {
+    let slot = u32(in.uv.x + 0.5);
+    let sphere = impostors.spheres[slot];
+    let eye = in.object - in.imp_ray;
+    let ray = normalize(in.imp_ray);
+    let frames = impostor_frames(in.imp_eye - sphere.xyz);
+    let top = impostors.settings.x - 1.0;
+    let scale = impostors.atlas.x;
+    // Half a texel in from the frame's edge, so the filter never reads the neighbouring frame.
+    let margin = 0.5 / (scale * f32(textureDimensions(impostor_srgb).x));
+    let layer = i32(slot) * 2;
+    var sum = ImpostorTexel(0.0, vec4<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    for (var k = 0; k < 3; k++) {
+        let w = frames.weights[k];
+        if (w <= 0.0) {
+            continue;
+        }
+        let cell = frames.cells[k];
+        let fd = impostor_decode(cell / top);
+        var uv = impostor_frame_uv(eye, ray, sphere, fd, 0.0);
+        if (impostors.settings.w > 0.5) {
+            // One parallax step: the depth the frame holds where the card's ray meets it.
+            let a = (cell + clamp(uv, vec2<f32>(margin), vec2<f32>(1.0 - margin))) * scale;
+            let nd = textureSampleLevel(impostor_linear, impostor_sampler, a, layer, 0.0);
+            let cov = textureSampleLevel(impostor_srgb, impostor_sampler, a, layer, 0.0).a;
+            if (cov > 0.0) {
+                uv = impostor_frame_uv(eye, ray, sphere, fd, (nd.a / cov * 2.0 - 1.0) * sphere.w);
+            }
+        }
+        if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0))) {
+            continue;
+        }
+        let a = (cell + clamp(uv, vec2<f32>(margin), vec2<f32>(1.0 - margin))) * scale;
+        let base = textureSampleLevel(impostor_srgb, impostor_sampler, a, layer, 0.0);
+        let emissive = textureSampleLevel(impostor_srgb, impostor_sampler, a, layer + 1, 0.0);
+        let nd = textureSampleLevel(impostor_linear, impostor_sampler, a, layer, 0.0);
+        let orm = textureSampleLevel(impostor_linear, impostor_sampler, a, layer + 1, 0.0);
+        sum.coverage += w * base.a;
+        sum.base += w * vec4<f32>(base.rgb, 1.0);
+        sum.normal += w * nd.xyz;
+        sum.orm += w * orm.xyz;
+        sum.emissive += w * emissive.rgb;
+    }
+    // Uncovered texels hold zeros, so a filtered value over the covered share is the covered texels' mean.
+    let c = max(sum.coverage, 1e-6);
+    var out: ImpostorTexel;
+    out.coverage = sum.coverage;
+    out.base = vec4<f32>(sum.base.rgb / c, 1.0);
+    let n = sum.normal / c * 2.0 - vec3<f32>(1.0);
+    out.normal = select(vec3<f32>(0.0, 0.0, 1.0), normalize(n), dot(n, n) > 1e-12);
+    out.orm = sum.orm / c;
+    out.emissive = sum.emissive / c;
+    return out;
+}
+
+// True where a card's fragment shows no part of the model (under half the frames' weighted coverage).
+fn impostor_masked(in: VsOut) -> bool {
+    return impostor_texel(in).coverage < 0.5;
+}
+
+// --impostor's baking (src/gpu/impostor_atlas.rs): a frame's channels. The camera's eye is on the frame's
+// direction, impostor_eye holds the bounding sphere; depth is the signed distance along the frame's direction
+// over the radius, mapped to [0, 1].
+// What a surface gives the bake (each surface's `bake_surface`): linear base colour, the object-space normal as
+// seen (flipped on back faces), occlusion-roughness-metallic, emissive.
+struct BakeSurface {
+    base: vec3<f32>,
+    normal: vec3<f32>,
+    orm: vec3<f32>,
+    emissive: vec3<f32>,
+};
+
+struct BakeOut {
+    @location(0) base: vec4<f32>,
+    @location(1) emissive: vec4<f32>,
+    @location(2) normal_depth: vec4<f32>,
+    @location(3) orm: vec4<f32>,
+};
+
+@fragment
+fn fs_bake(in: VsOut, @builtin(front_facing) front: bool) -> BakeOut {
+    if (masked(in)) {
+        discard;
+    }
+    let s = bake_surface(in, front);
+    let sphere = camera.impostor_eye;
+    let f = normalize(camera.eye.xyz - sphere.xyz);
+    let depth = clamp(0.5 + 0.5 * dot(in.world - sphere.xyz, f) / sphere.w, 0.0, 1.0);
+    var out: BakeOut;
+    out.base = vec4<f32>(s.base.rgb, 1.0);
+    out.emissive = vec4<f32>(s.emissive, 1.0);
+    out.normal_depth = vec4<f32>(s.normal * 0.5 + vec3<f32>(0.5), depth);
+    out.orm = vec4<f32>(s.orm, 1.0);
+    return out;
 }
 
 @fragment

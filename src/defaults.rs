@@ -28,6 +28,8 @@ pub mod heading {
     pub const SWITCHES: &str = "Switches and transitions";
     /// TAA, shadows and extra shading work.
     pub const EFFECTS: &str = "Effects";
+    /// The impostor that ends every chain (`--impostor`).
+    pub const IMPOSTORS: &str = "Impostors";
     /// The methods' own flags.
     pub const METHODS: &str = "Methods";
     /// How the timing and the quality pass are made.

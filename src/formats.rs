@@ -6,6 +6,11 @@
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
 /// Depth format of every render target (recorded in run.json).
+/// `--impostor`'s atlas layers (src/gpu/impostor_atlas.rs): base colour with coverage and emissive in sRGB,
+/// normal with depth and occlusion-roughness-metallic linear.
+pub const IMPOSTOR_SRGB_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+pub const IMPOSTOR_LINEAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// MSAA samples of every render target (recorded in run.json).

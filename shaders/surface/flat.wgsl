@@ -25,6 +25,9 @@ struct VsOut {
     @location(5) object: vec3<f32>,
     // World-space position (the shadow lookup).
     @location(6) world: vec3<f32>,
+    // An impostor card's ray from the eye and its selecting eye, object space (shaders/mesh.wgsl).
+    @location(7) imp_ray: vec3<f32>,
+    @location(8) imp_eye: vec3<f32>,
 };
 
 fn vertex(v: VertexIn, inst: InstanceIn) -> VsOut {
@@ -53,18 +56,31 @@ fn masked(in: VsOut) -> bool {
 }
 
 // The instance's colour lit by the directional light (its share through the shadow map under --shadows on)
-// and the ambient term; alpha 1.
+// and the ambient term; alpha 1. An impostor's card: its atlas's normal under the light, both in object space.
 fn shade(in: VsOut, front: bool) -> vec4<f32> {
     var n = normalize(in.normal);
-    // Two-sided lighting: scanned meshes have holes, so back faces can be seen.
-    if (!front) {
+    var l = camera.light.xyz;
+    var albedo = in.color.rgb;
+    if (in.kind == KIND_IMPOSTOR) {
+        let t = impostor_texel(in);
+        n = t.normal;
+        l = in.normal;
+        albedo = albedo * t.base.rgb;
+    } else if (!front) {
+        // Two-sided lighting: scanned meshes have holes, so back faces can be seen.
         n = -n;
     }
-    var lambert = max(dot(n, camera.light.xyz), 0.0);
+    var lambert = max(dot(n, l), 0.0);
     if (camera.shadow.x > 0.5) {
         lambert = lambert * lit(in.world);
     }
     let ambient = camera.light.w;
-    let rgb = in.color.rgb * (ambient + (1.0 - ambient) * lambert) + shader_work(in.world);
+    let rgb = albedo * (ambient + (1.0 - ambient) * lambert) + shader_work(in.world);
     return vec4<f32>(rgb, 1.0);
+}
+
+// The bake's channels: white (the instance's colour multiplies it when the card is drawn), the normal as lit.
+fn bake_surface(in: VsOut, front: bool) -> BakeSurface {
+    let n = normalize(in.normal) * select(-1.0, 1.0, front);
+    return BakeSurface(vec3<f32>(1.0), n, vec3<f32>(1.0, 1.0, 0.0), vec3<f32>(0.0));
 }

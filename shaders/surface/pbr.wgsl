@@ -59,6 +59,9 @@ struct VsOut {
     // World-space tangent, w its sign.
     @location(8) tangent: vec4<f32>,
     @location(9) vcolor: vec4<f32>,
+    // An impostor card's ray from the eye and its selecting eye, object space (shaders/mesh.wgsl).
+    @location(10) imp_ray: vec3<f32>,
+    @location(11) imp_eye: vec3<f32>,
 };
 
 struct Material {
@@ -155,6 +158,9 @@ fn masked(in: VsOut) -> bool {
     if (aux_masked(in)) {
         return true;
     }
+    if (in.kind == KIND_IMPOSTOR) {
+        return false;
+    }
     return material.alpha.x == 1.0 && base_color(in).a < material.alpha.y;
 }
 
@@ -176,12 +182,19 @@ fn env_brdf(roughness: f32, nv: f32) -> vec2<f32> {
     return mix(bottom, top, t.y);
 }
 
-fn shade(in: VsOut, front: bool) -> vec4<f32> {
+// A surface point's inputs to the BRDF.
+struct PbrSurface {
+    base: vec3<f32>,
+    metallic: f32,
+    roughness: f32,
+    // The shading normal, as seen (flipped on back faces).
+    n: vec3<f32>,
+    occlusion: f32,
+    emissive: vec3<f32>,
+};
+
+fn pbr_surface(in: VsOut, front: bool) -> PbrSurface {
     let base = base_color(in);
-    let alpha = select(1.0, base.a, material.alpha.x == 2.0);
-    if (material.alpha.z > 0.5) {
-        return vec4<f32>(base.rgb, alpha);
-    }
     var metallic = material.factors.x;
     var roughness = material.factors.y;
     if (has(METALLIC_ROUGHNESS)) {
@@ -214,17 +227,21 @@ fn shade(in: VsOut, front: bool) -> vec4<f32> {
     if (has(EMISSIVE)) {
         emissive = emissive * textureSample(emissive_texture, emissive_sampler, uv_of(EMISSIVE, in)).rgb;
     }
+    return PbrSurface(base.rgb, metallic, roughness, n, occlusion, emissive);
+}
 
-    let v = normalize(camera.eye.xyz - in.world);
-    let l = camera.light.xyz;
+// The light a surface point reflects towards `v` (unit, towards the eye) from the light `l` and the ambient
+// environment, plus its emission; `world` is where the shadow map is read.
+fn pbr_light(s: PbrSurface, v: vec3<f32>, l: vec3<f32>, world: vec3<f32>) -> vec3<f32> {
+    let n = s.n;
     let h = normalize(l + v);
     let nl = clamp(dot(n, l), 0.0, 1.0);
     let nv = clamp(abs(dot(n, v)), 1e-4, 1.0);
     let nh = clamp(dot(n, h), 0.0, 1.0);
     let vh = clamp(dot(v, h), 0.0, 1.0);
-    let c_diff = mix(base.rgb, vec3<f32>(0.0), metallic);
-    let f0 = mix(vec3<f32>(0.04), base.rgb, metallic);
-    let a = roughness * roughness;
+    let c_diff = mix(s.base, vec3<f32>(0.0), s.metallic);
+    let f0 = mix(vec3<f32>(0.04), s.base, s.metallic);
+    let a = s.roughness * s.roughness;
     let a2 = max(a * a, 1e-7);
     let f = f0 + (vec3<f32>(1.0) - f0) * pow(1.0 - vh, 5.0);
     let dd = nh * nh * (a2 - 1.0) + 1.0;
@@ -235,16 +252,39 @@ fn shade(in: VsOut, front: bool) -> vec4<f32> {
     let ambient = camera.light.w;
     var irradiance = PI * (1.0 - ambient) * nl;
     if (camera.shadow.x > 0.5) {
-        irradiance = irradiance * lit(in.world);
+        irradiance = irradiance * lit(world);
     }
-    let ab = env_brdf(roughness, nv);
+    let ab = env_brdf(s.roughness, nv);
     let single = f0 * ab.x + vec3<f32>(ab.y);
     let e_ss = ab.x + ab.y;
     let f_avg = f0 + (vec3<f32>(1.0) - f0) / 21.0;
     let multiple = single * f_avg / (vec3<f32>(1.0) - (1.0 - e_ss) * f_avg) * (1.0 - e_ss);
     let specular = single + multiple;
     let diffuse = c_diff * (1.0 - max(max(specular.r, specular.g), specular.b));
-    let indirect = (specular + diffuse) * ambient * occlusion;
-    let rgb = brdf * irradiance + indirect + emissive + shader_work(in.world);
-    return vec4<f32>(rgb, alpha);
+    let indirect = (specular + diffuse) * ambient * s.occlusion;
+    return brdf * irradiance + indirect + s.emissive + shader_work(world);
+}
+
+// An impostor's card is lit from its atlas in object space (`normal` holds the light's direction there); its
+// material's alpha mode and unlit flag are the baked model's, not applied again.
+fn shade(in: VsOut, front: bool) -> vec4<f32> {
+    if (in.kind == KIND_IMPOSTOR) {
+        let t = impostor_texel(in);
+        let s = PbrSurface(t.base.rgb, t.orm.z, t.orm.y, t.normal, t.orm.x, t.emissive);
+        return vec4<f32>(pbr_light(s, normalize(-in.imp_ray), in.normal, in.world), 1.0);
+    }
+    let base = base_color(in);
+    let alpha = select(1.0, base.a, material.alpha.x == 2.0);
+    if (material.alpha.z > 0.5) {
+        return vec4<f32>(base.rgb, alpha);
+    }
+    let s = pbr_surface(in, front);
+    return vec4<f32>(pbr_light(s, normalize(camera.eye.xyz - in.world), camera.light.xyz, in.world), alpha);
+}
+
+// The bake's channels: the surface as `shade` lights it (an unlit material is baked as its base colour and lit
+// when drawn: said in docs/methods.md).
+fn bake_surface(in: VsOut, front: bool) -> BakeSurface {
+    let s = pbr_surface(in, front);
+    return BakeSurface(s.base, s.n, vec3<f32>(s.occlusion, s.roughness, s.metallic), s.emissive);
 }

@@ -567,6 +567,9 @@ pub struct SceneArgs {
     #[command(flatten)]
     #[serde(flatten)]
     pub shadow: crate::effects::shadow::ShadowArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub impostor: crate::geometry::impostor::ImpostorArgs,
 }
 
 impl Default for SceneArgs {

@@ -112,6 +112,7 @@ impl SceneConfig {
             camera: a.camera,
             taa: a.taa.resolve()?,
             shadows: a.shadow.resolve()?,
+            impostor: a.impostor.params()?,
         })
     }
 }
@@ -255,6 +256,13 @@ fn check_scene_flags(a: &RunArgs, scenes: &[SceneKind]) -> Result<()> {
             )));
         }
     }
+    if a.scene_args.shadow.shadows == OnOff::On && a.scene_args.impostor.impostor {
+        return Err(Error::Config(
+            "--shadows on with --impostor: an impostor's card faces the camera, not the light, so it casts no \
+             shadow of its model; run one or the other"
+                .into(),
+        ));
+    }
     if a.scene_args.shadow.shadows == OnOff::On {
         if let Some(scene) = scenes.iter().find(|k| k.is_unified()) {
             return Err(Error::Config(format!(
@@ -267,8 +275,21 @@ fn check_scene_flags(a: &RunArgs, scenes: &[SceneKind]) -> Result<()> {
     Ok(())
 }
 
-/// The named methods that need a kind of scene: a unified one, or the terrain's height field.
+/// The named methods that need a kind of scene: a unified one, or the terrain's height field; and those that
+/// cannot draw a transition into an impostor under `--impostor`.
 fn check_methods_fit(a: &RunArgs, scenes: &[SceneKind], methods: &[String]) -> Result<()> {
+    if a.scene_args.impostor.impostor {
+        if let Some(m) = methods
+            .iter()
+            .find(|m| crate::methods::not_with_impostor(m))
+        {
+            return Err(Error::Config(format!(
+                "method {m} cannot move into an impostor (it morphs the finer LOD's vertices onto the coarser \
+                 LOD's surface, and an impostor's card has none): run it without --impostor, or run discrete, \
+                 dither, alpha or alpha-2pass"
+            )));
+        }
+    }
     if let Some(scene) = scenes.iter().find(|k| !k.is_unified()) {
         if let Some(m) = methods.iter().find(|m| crate::methods::needs_unified(m)) {
             return Err(Error::Config(format!(
@@ -449,12 +470,14 @@ impl RunConfig {
         }
         let builtin = crate::methods::names();
         let defaults = crate::methods::defaults_for(scene.is_unified());
+        let impostor = self.scene.impostor.is_some();
         self.methods
             .iter()
             .filter(|m| {
                 defaults.contains(&m.as_str())
                     || (!builtin.contains(&m.as_str()) && !scene.is_unified())
             })
+            .filter(|m| !(impostor && crate::methods::not_with_impostor(m)))
             .cloned()
             .collect()
     }

@@ -233,9 +233,19 @@ fn print_models(d: &SceneDescription) {
     }
 }
 
-/// The pixel error, the camera path, the motion and the notes.
+/// The pixel error, the impostors' atlas, the camera path, the motion and the notes.
 fn print_path(d: &SceneDescription) -> Result<()> {
     outln!("pixel error: {}", d.pixel_error);
+    if let Some(imp) = &d.impostor {
+        outln!(
+            "impostor atlas: {}; {} model{}, {:.1} MiB in all; views at most {:.1} deg from a frame drawn",
+            imp.line,
+            imp.models,
+            if imp.models == 1 { "" } else { "s" },
+            imp.bytes as f64 / (1024.0 * 1024.0),
+            imp.max_view_angle_deg
+        );
+    }
     let s = &d.schedule;
     outln!(
         "transitions: {}{}",

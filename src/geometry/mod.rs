@@ -7,6 +7,7 @@ pub mod blocks;
 pub mod cluster_dag;
 pub mod deform;
 pub mod gltf;
+pub mod impostor;
 pub mod lod;
 pub mod material;
 pub mod mesh;

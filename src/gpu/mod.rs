@@ -6,6 +6,7 @@ pub mod compute;
 pub mod context;
 pub mod draw_list;
 pub mod fragments;
+pub mod impostor_atlas;
 pub mod instances;
 pub mod pipelines;
 pub mod probe_kernels;

@@ -246,11 +246,15 @@ fn build(ctx: &PipelineContext<'_>, d: &MeshPipeline<'_>, shadow: bool) -> MeshP
         if class.blends() && (shadow || d.fragment.is_none()) {
             continue;
         }
-        variants[class.index()] = Some(mesh_pipeline_from(ctx, d, shadow, class));
+        let targets = mesh_color_targets(d, class);
+        variants[class.index()] = Some(mesh_pipeline_from(ctx, d, shadow, class, &targets));
     }
     let first = match variants.iter().flatten().next() {
         Some(p) => p.clone(),
-        None => mesh_pipeline_from(ctx, d, shadow, MaterialClass::PLAIN),
+        None => {
+            let targets = mesh_color_targets(d, MaterialClass::PLAIN);
+            mesh_pipeline_from(ctx, d, shadow, MaterialClass::PLAIN, &targets)
+        }
     };
     MeshPipelines {
         variants,
@@ -361,16 +365,47 @@ fn mesh_cull(
     }
 }
 
+/// `--impostor`'s bake (`fs_bake`, src/gpu/impostor_atlas.rs) in each class of `ctx`: four colour targets (base
+/// colour and emissive in sRGB, normal-depth and occlusion-roughness-metallic linear), nothing blended.
+pub(crate) fn bake_pipelines(ctx: &PipelineContext<'_>) -> MeshPipelines {
+    let d = MeshPipeline {
+        fragment: Some("fs_bake"),
+        ..MeshPipeline::opaque("impostor bake")
+    };
+    let target = |format| {
+        Some(wgpu::ColorTargetState {
+            format,
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        })
+    };
+    let (srgb, linear) = (
+        crate::formats::IMPOSTOR_SRGB_FORMAT,
+        crate::formats::IMPOSTOR_LINEAR_FORMAT,
+    );
+    let targets = [target(srgb), target(srgb), target(linear), target(linear)];
+    let mut variants: [Option<wgpu::RenderPipeline>; 4] = Default::default();
+    for &class in ctx.classes {
+        variants[class.index()] = Some(mesh_pipeline_from(ctx, &d, false, class, &targets));
+    }
+    let first = mesh_pipeline_from(ctx, &d, false, MaterialClass::PLAIN, &targets);
+    MeshPipelines {
+        variants,
+        first,
+        surface: ctx.surface,
+    }
+}
+
 fn mesh_pipeline_from(
     ctx: &PipelineContext<'_>,
     d: &MeshPipeline<'_>,
     shadow: bool,
     class: MaterialClass,
+    targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
     let device = ctx.device;
     let layout = mesh_pipeline_layout(ctx, d);
     let buffers = mesh_vertex_buffers(ctx, d);
-    let targets = mesh_color_targets(d, class);
     let constants: &[(&str, f64)] = if ctx.alpha_test {
         &[("ALPHA_TEST", 1.0)]
     } else {
@@ -384,7 +419,7 @@ fn mesh_pipeline_from(
     let (fragment, targets): (Option<&str>, &[Option<wgpu::ColorTargetState>]) =
         match (d.fragment, ctx.alpha_test) {
             (Some(f), _) if shadow => (Some(f), &[]),
-            (Some(f), _) => (Some(f), &targets),
+            (Some(f), _) => (Some(f), targets),
             (None, true) => (Some("fs_depth_masked"), &[]),
             (None, false) => (None, &[]),
         };

@@ -322,6 +322,7 @@ impl<'a> BlockRunner<'a> {
                 select_cpu_ms: timed.stats[f].selection.map(|s| s.cpu_ns as f64 * 1e-6),
                 round: timed.round[f],
                 fragments: quality.and_then(|q| q.fragments.get(f).copied().flatten()),
+                view_pop: quality.and_then(|q| q.view_pop.as_ref().map(|v| v[f])),
             })
             .collect()
     }

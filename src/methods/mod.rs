@@ -219,6 +219,16 @@ pub const UNIFIED_DEFAULT: [&str; 5] = [
 /// another method's, or they ablate one).
 pub const NOT_DEFAULT: [&str; 4] = ["reference-flat", "alpha-sorted", "dither-skip", "fsi-blend"];
 
+/// Built-in methods that cannot draw a transition into an impostor (`--impostor`): geomorph moves the finer
+/// LOD's vertices onto the coarser LOD's surface, and a card has no surface to move them onto. A run with
+/// `--impostor` leaves them out of its defaults and refuses them by name.
+pub const NOT_WITH_IMPOSTOR: [&str; 1] = ["geomorph"];
+
+/// Whether the method of `label` cannot draw a transition into an impostor.
+pub fn not_with_impostor(label: &str) -> bool {
+    NOT_WITH_IMPOSTOR.contains(&base_name(label))
+}
+
 /// Whether the method of `label` needs a unified scene.
 pub fn needs_unified(label: &str) -> bool {
     UNIFIED_ONLY.contains(&base_name(label))

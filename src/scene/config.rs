@@ -47,6 +47,8 @@ pub struct SceneConfig {
     pub taa: Option<crate::effects::taa::Taa>,
     /// `--shadows on`: the shadow map (and a ground under the bunny scenes).
     pub shadows: Option<crate::effects::shadow::Shadows>,
+    /// `--impostor`: every model's chain ends in an octahedral impostor (`scene/impostors.rs`).
+    pub impostor: Option<crate::geometry::impostor::Impostor>,
 }
 
 /// `--animation`: which of a glTF scene's animations plays over the frames.

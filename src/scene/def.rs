@@ -32,6 +32,8 @@ pub struct SceneDef {
     pub family: Family,
     pub taa: Option<crate::effects::taa::Taa>,
     pub shadows: Option<crate::effects::shadow::Shadows>,
+    /// `--impostor`: the impostor every model's chain ends in.
+    pub impostor: Option<crate::geometry::impostor::Impostor>,
     /// `--shader-work`: extra ALU iterations per shaded fragment.
     pub shader_work: u32,
     /// `--camera-path`: replaces the family's camera.
@@ -57,7 +59,7 @@ impl SceneDef {
     pub fn new(kind: SceneKind, cfg: &SceneConfig) -> Result<SceneDef> {
         let pv = cfg.resolved(kind);
         let mut fov_y = cfg.fov_deg.to_radians();
-        let (set, family) = if kind.is_unified() {
+        let (mut set, family) = if kind.is_unified() {
             let (set, parts) = unified::def(kind, cfg, &pv, fov_y)?;
             (set, Family::Unified(Arc::new(parts)))
         } else if kind.is_user() {
@@ -73,6 +75,23 @@ impl SceneDef {
                 Family::Procedural,
             )
         };
+        let schedule = cfg.schedule(kind)?;
+        if let Some(imp) = &cfg.impostor {
+            if kind.is_unified() {
+                return Err(crate::error::Error::Config(format!(
+                    "--impostor: scene {} is one large mesh in blocks, whose blocks have no impostor; run it on \
+                     another scene",
+                    kind.name()
+                )));
+            }
+            let view = crate::scene::impostors::SwitchView {
+                pixel_error: cfg.pixel_error(kind, pv.height),
+                height: pv.height,
+                fov_y,
+            };
+            let notes = crate::scene::impostors::append(&mut set.models, imp, &view, &schedule)?;
+            set.notes.extend(notes);
+        }
         Ok(SceneDef {
             kind,
             models: Arc::from(set.models),
@@ -80,7 +99,7 @@ impl SceneDef {
             width: pv.width,
             height: pv.height,
             fov_y,
-            schedule: cfg.schedule(kind)?,
+            schedule,
             counts: cfg.counts(kind),
             camera_mode: cfg.camera,
             mesh_source: set.mesh_source,
@@ -88,6 +107,7 @@ impl SceneDef {
             family,
             taa: cfg.taa,
             shadows: cfg.shadows,
+            impostor: cfg.impostor,
             shader_work: cfg.shader_work,
             camera_path: cfg.camera_path.clone().map(Arc::new),
             model_notes: set.notes,
@@ -239,6 +259,7 @@ impl SceneDef {
             unified: layout.unified,
             taa: self.taa,
             shadows: self.shadows,
+            impostor: self.impostor,
             shader_work: self.shader_work,
             shader_work_weight: 0.0,
             ground: None,

@@ -54,6 +54,27 @@ pub struct SceneDescription {
     pub user: Option<crate::scene::user::UserParts>,
     /// How the scene's triangles are shaded, and the light.
     pub surface: SurfaceDescription,
+    /// `--impostor`: the atlas every model's impostor is baked into.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub impostor: Option<ImpostorDescription>,
+}
+
+/// An impostor's atlas as `describe` shows it (`geometry/impostor.rs`, `gpu/impostor_atlas.rs`).
+#[derive(Debug, Clone, Serialize)]
+pub struct ImpostorDescription {
+    #[serde(flatten)]
+    pub settings: crate::geometry::impostor::Impostor,
+    /// Frames per atlas (N x N) and texels along a frame's side.
+    pub frames_total: u32,
+    pub frame_texels: u32,
+    /// Models with an impostor, and the bytes of each one's atlas and of them all.
+    pub models: usize,
+    pub bytes_per_model: u64,
+    pub bytes: u64,
+    /// The largest angle between a view and the frame(s) drawn for it, degrees.
+    pub max_view_angle_deg: f32,
+    /// The whole description in a line.
+    pub line: String,
 }
 
 /// How a scene is shaded (docs/methods.md, "Materials as engines draw them").
@@ -210,6 +231,28 @@ impl SceneDef {
             cut: self.unified().map(|u| cut_along_path(&first, &u.data)),
             hierarchy: self.unified().and_then(|u| hierarchy(&u.data)),
             user: self.user().cloned(),
+            impostor: self.impostor.map(|imp| {
+                let models = self
+                    .models
+                    .iter()
+                    .filter(|m| {
+                        m.chain
+                            .lods
+                            .last()
+                            .is_some_and(|l| crate::geometry::impostor::is_card(&l.mesh))
+                    })
+                    .count();
+                ImpostorDescription {
+                    settings: imp,
+                    frames_total: imp.frames * imp.frames,
+                    frame_texels: imp.frame_texels(),
+                    models,
+                    bytes_per_model: imp.atlas_bytes(),
+                    bytes: imp.atlas_bytes() * models as u64,
+                    max_view_angle_deg: imp.max_view_angle().to_degrees(),
+                    line: imp.describe(),
+                }
+            }),
             surface: SurfaceDescription {
                 kind: if first.materials.is_empty() {
                     "flat"

@@ -17,6 +17,7 @@ pub mod def;
 pub mod description;
 pub mod export_glb;
 pub mod export_obj;
+pub mod impostors;
 pub mod kind;
 pub mod model;
 pub mod procedural;

@@ -219,6 +219,8 @@ pub struct Scene {
     pub taa: Option<crate::effects::taa::Taa>,
     /// `--shadows on`: the shadow map's settings (`effects/shadow.rs`).
     pub shadows: Option<crate::effects::shadow::Shadows>,
+    /// `--impostor`: the impostor the models' chains end in (their last level's card, `geometry/impostor.rs`).
+    pub impostor: Option<crate::geometry::impostor::Impostor>,
     /// `--shader-work`: extra ALU iterations per shaded fragment (`shade` in shaders/mesh.wgsl; 0: none).
     pub shader_work: u32,
     /// The weight the shader work's result is added to the colour with: 0 in every run (the image unchanged);

@@ -39,6 +39,7 @@ mod measure_reference_cache;
 mod measure_timing;
 // src/methods: one method (or a family of variants) in images.
 mod methods_fsi;
+mod methods_impostor;
 mod methods_registry;
 mod methods_variants;
 // src/scene: the scenes' paths, animation and the unified scenes.

@@ -218,6 +218,7 @@ fn records(
                 lag_rmse: None,
                 shadow_rmse: None,
                 shadow_lodpop: None,
+                view_pop: None,
                 splits: None,
                 merges: None,
                 select_cpu_ms: None,

@@ -4,6 +4,7 @@
 use crate::error::Result;
 use crate::gpu::context::GpuContext;
 use crate::gpu::draw_list::DrawList;
+use crate::gpu::impostor_atlas::{Baker, ImpostorAtlas};
 use crate::gpu::instances::{InstanceBuffer, UploadCounters};
 use crate::gpu::pipelines::{
     mesh_pipelines, mesh_wgsl, MaterialClass, MeshPipeline, MeshPipelines, PipelineContext, Surface,
@@ -47,6 +48,8 @@ pub struct SceneGpu {
     /// Counts the fragments of the passes begun while the quality pass counts a method's frame (None where the
     /// device has no pipeline statistics queries).
     pub fragments: Option<crate::gpu::fragments::FragmentQueries>,
+    /// `--impostor`'s atlases, baked (placeholders without impostors).
+    pub impostors: ImpostorAtlas,
 }
 
 /// The mesh shader and what every mesh pipeline of a scene is built with.
@@ -88,9 +91,10 @@ pub(super) fn mesh_shaders(
     (shader, flat_shader)
 }
 
-/// Whether the scene has alpha-tested geometry: masked materials, or leaf cards.
+/// Whether the scene has alpha-tested geometry: masked materials, leaf cards, or impostors' cards.
 pub(super) fn needs_alpha_test(scene: &Scene) -> bool {
-    scene.materials.any_mask()
+    scene.impostor.is_some()
+        || scene.materials.any_mask()
         || scene.models.iter().any(|m| {
             m.chain.lods.iter().any(|l| {
                 l.mesh.aux.iter().any(|a| {
@@ -180,13 +184,10 @@ impl SceneGpu {
             .map(|t| t.create_view(&Default::default()))
             .collect();
         let shadow_sampler = shadow_sampler(device);
-        let camera_groups = camera_groups(
-            device,
-            &camera_layout,
-            &camera_buffer,
-            &shadow_views,
-            &shadow_sampler,
-        );
+        let impostors = ImpostorAtlas::new(device, &ctx.queue, scene)?;
+        let shadows = (&shadow_views[..], &shadow_sampler);
+        let camera_groups =
+            camera_groups(device, &camera_layout, &camera_buffer, shadows, &impostors);
         let surface = if pbr { Surface::Pbr } else { Surface::Flat };
         let (shader, flat_shader) = mesh_shaders(device, surface);
         let alpha_test = needs_alpha_test(scene);
@@ -247,9 +248,44 @@ impl SceneGpu {
             uploads: UploadCounters::default(),
             pose: Default::default(),
             fragments: crate::gpu::fragments::FragmentQueries::new(device),
+            impostors,
         };
         gpu.write_work(scene.shader_work, scene.shader_work_weight);
+        gpu.bake_impostors(ctx)?;
         Ok(gpu)
+    }
+
+    /// `--impostor`: bakes the atlases (none without), through a camera group of its own over placeholders.
+    fn bake_impostors(&self, ctx: &GpuContext) -> Result<()> {
+        if self.impostors.impostor.is_none() {
+            return Ok(());
+        }
+        let device = &self.device;
+        let empty = ImpostorAtlas::empty(device, &self.queue);
+        let buffer = camera_buffer(device);
+        let views = [self.shadows.views[0].clone()];
+        let sampler = shadow_sampler(device);
+        let groups = camera_groups(
+            device,
+            &self.camera.layout,
+            &buffer,
+            (&views, &sampler),
+            &empty,
+        );
+        let pipelines = crate::gpu::pipelines::bake_pipelines(&self.pipeline_context());
+        let instance = self.create_instance_buffer("impostor bake instance", 1);
+        let baker = Baker {
+            device,
+            queue: &self.queue,
+            pipelines: &pipelines,
+            camera_group: &groups[0],
+            camera_buffer: &buffer,
+            instance: &instance,
+        };
+        self.impostors.bake(&baker, &|pass, list| {
+            self.draw(pass, &instance, 0, list, &[&pipelines]);
+        })?;
+        ctx.wait_idle()
     }
 
     /// The bytes (R, G, B) a target cleared to the background holds on this device: the sRGB encoding the

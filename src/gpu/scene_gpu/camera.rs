@@ -1,6 +1,7 @@
 //! The camera uniform (view-projection, eye, light, the shadow map's matrix, `--shader-work`), its bind groups
 //! (one per shadow map) and the shadow maps themselves.
 
+use crate::gpu::impostor_atlas::ImpostorAtlas;
 use crate::gpu::scene_gpu::view::ShadowMap;
 use crate::gpu::targets::{texture_2d, ATTACHMENT_READ};
 pub use crate::scene::model::{AMBIENT, LIGHT_DIR};
@@ -34,6 +35,8 @@ pub(super) struct CameraRaw {
     pub(super) shadow: [f32; 4],
     /// `--shader-work`: (iterations, weight of their result, 0, 0); written once, by [`SceneGpu::write_work`].
     pub(super) work: [f32; 4],
+    /// `--impostor`: the eye the impostors select their frames by ([`SceneGpu::write_impostor_eye`]).
+    pub(super) impostor_eye: [f32; 4],
 }
 
 /// Byte offset of `light_view_proj` in the camera uniform (what [`SceneGpu::write_camera`] leaves alone).
@@ -41,6 +44,9 @@ pub(super) const LIGHT_OFFSET: u64 = 64 + 16 + 16;
 
 /// Byte offset of `work` in the camera uniform.
 pub(super) const WORK_OFFSET: u64 = LIGHT_OFFSET + 64 + 16;
+
+/// Byte offset of `impostor_eye` in the camera uniform.
+pub(super) const IMPOSTOR_EYE_OFFSET: u64 = WORK_OFFSET + 16;
 
 /// The camera uniform buffer ([`CameraRaw`]).
 pub(super) fn camera_buffer(device: &wgpu::Device) -> wgpu::Buffer {
@@ -52,7 +58,8 @@ pub(super) fn camera_buffer(device: &wgpu::Device) -> wgpu::Buffer {
     })
 }
 
-/// Group 0's layout: the camera uniform, a shadow map and its comparison sampler.
+/// Group 0's layout: the camera uniform, a shadow map and its comparison sampler, the impostors' atlases, their
+/// sampler and table (`gpu/impostor_atlas.rs`).
 pub(super) fn camera_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("camera layout"),
@@ -83,8 +90,39 @@ pub(super) fn camera_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
                 count: None,
             },
+            atlas_entry(3),
+            atlas_entry(4),
+            wgpu::BindGroupLayoutEntry {
+                binding: 5,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 6,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
         ],
     })
+}
+
+fn atlas_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        },
+        count: None,
+    }
 }
 
 /// The shadow maps: the 1x1 placeholder, then `lit` maps of `shadow_size` texels a side under `--shadows on`.
@@ -131,8 +169,8 @@ pub(super) fn camera_groups(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     camera_buffer: &wgpu::Buffer,
-    shadow_views: &[wgpu::TextureView],
-    shadow_sampler: &wgpu::Sampler,
+    (shadow_views, shadow_sampler): (&[wgpu::TextureView], &wgpu::Sampler),
+    atlas: &ImpostorAtlas,
 ) -> Vec<wgpu::BindGroup> {
     shadow_views
         .iter()
@@ -152,6 +190,22 @@ pub(super) fn camera_groups(
                     wgpu::BindGroupEntry {
                         binding: 2,
                         resource: wgpu::BindingResource::Sampler(shadow_sampler),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&atlas.srgb_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: wgpu::BindingResource::TextureView(&atlas.linear_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: wgpu::BindingResource::Sampler(&atlas.sampler),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: atlas.table.as_entire_binding(),
                     },
                 ],
             })

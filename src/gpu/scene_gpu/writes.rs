@@ -3,7 +3,7 @@
 
 use crate::gpu::pipelines::{SurfaceVertex, Vertex};
 use crate::gpu::scene_gpu::build::SceneGpu;
-use crate::gpu::scene_gpu::camera::{CameraRaw, LIGHT_OFFSET, WORK_OFFSET};
+use crate::gpu::scene_gpu::camera::{CameraRaw, IMPOSTOR_EYE_OFFSET, LIGHT_OFFSET, WORK_OFFSET};
 use crate::gpu::scene_gpu::geometry::surface_vertex;
 use crate::gpu::scene_gpu::pose::{deformed_vertex, PoseState};
 use crate::gpu::scene_gpu::view::ShadowMap;
@@ -23,10 +23,22 @@ impl SceneGpu {
             light_view_proj: [[0.0; 4]; 4],
             shadow: [0.0; 4],
             work: [0.0; 4],
+            impostor_eye: [0.0; 4],
         };
         let bytes = bytemuck::bytes_of(&raw);
         self.queue
             .write_buffer(&self.camera.buffer, 0, &bytes[..LIGHT_OFFSET as usize]);
+        self.write_impostor_eye(camera.eye);
+    }
+
+    /// `--impostor`: the eye the impostors select their frames by (the camera's, written by
+    /// [`SceneGpu::write_camera`]; view_pop's counterfactual writes the previous frame's).
+    pub fn write_impostor_eye(&self, eye: Vec3) {
+        self.queue.write_buffer(
+            &self.camera.buffer,
+            IMPOSTOR_EYE_OFFSET,
+            bytemuck::cast_slice(&eye.extend(1.0).to_array()),
+        );
     }
 
     /// `--shader-work`: every shaded fragment runs `iterations` dependent ALU iterations and adds their result

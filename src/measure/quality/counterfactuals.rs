@@ -187,6 +187,38 @@ impl QualityStage {
         })
     }
 
+    /// `--impostor`: view_pop's counterfactual, in a submission of its own: the method's frame (this frame's
+    /// schedule, through its counterfactual with the whole history as this frame's) drawn with the impostors'
+    /// frames selected from the previous frame's eye, and its difference from the method's frame. Not drawn
+    /// where the eye and every instance held still (the frame is then the same: view_pop 0). The selecting eye
+    /// is the previous frame's, in the instance's current placement (docs/measurement.md, "view_pop").
+    pub(super) fn view_counterfactual(
+        &self,
+        base: &BlockGpu<'_>,
+        method: &mut dyn crate::methods::Method,
+        (input, history): (&FrameInput<'_>, &StateHistory),
+    ) -> Option<wgpu::SubmissionIndex> {
+        let view = self.kernels.view.as_ref()?;
+        let f = input.frame;
+        let scene = base.scene;
+        let (ctx, gpu) = (base.ctx, &base.gpu);
+        let (before, now) = (scene.camera(f.checked_sub(1)?).eye, scene.camera(f).eye);
+        let still = matches!(scene.motion, crate::scene::Motion::Static);
+        if before == now && still {
+            return None;
+        }
+        gpu.write_impostor_eye(before);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let states = history.all();
+        crate::methods::common::ask_counterfactual(method, |m| {
+            m.encode_before(gpu, input, &states, &mut encoder, &view.target)
+        });
+        view.kernel.encode(&ctx.queue, &mut encoder, f, 0);
+        let index = ctx.queue.submit([encoder.finish()]);
+        gpu.write_impostor_eye(now);
+        Some(index)
+    }
+
     /// With a dump: the counterfactual frames drawn this frame, for read-back.
     pub(super) fn request_counterfactual_reads(
         &self,

@@ -89,14 +89,20 @@ impl QualityStage {
         if drawn.unlagged || drawn.changed.is_some() || self.taa.is_some() {
             index = ctx.queue.submit([encoder.finish()]);
         }
+        if let Some(i) = self.view_counterfactual(base, method, (&input, &walk.history)) {
+            index = i;
+        }
         if let Some(taa) = &mut self.taa {
             taa.advance();
         }
         self.collect_frame(base, f, reads, index, walk, on_frames)
     }
 
-    /// lodpop's, the lag's and the shadow share's accumulators, before the first frame.
+    /// lodpop's, the lag's, view_pop's and the shadow share's accumulators, before the first frame.
     pub(super) fn clear_kernels(&self, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(v) = &self.kernels.view {
+            v.kernel.clear(encoder);
+        }
         self.kernels.lodpop.clear(encoder);
         self.kernels.lag.clear(encoder);
         if let Some(share) = &self.shadow_share {

@@ -51,6 +51,11 @@ impl StateHistory {
     pub(super) fn earlier(&self) -> Vec<&[InstanceState]> {
         self.frames.iter().skip(1).map(Vec::as_slice).collect()
     }
+
+    /// Every frame's states kept, this frame's first.
+    pub(super) fn all(&self) -> Vec<&[InstanceState]> {
+        self.frames.iter().map(Vec::as_slice).collect()
+    }
 }
 
 /// Whether two states of an instance draw the same image of it (`Counterfactual::same_image_state`).

@@ -18,6 +18,8 @@ pub struct QualityPass {
     pub lodpop: Vec<crate::measure::diff_kernel::DiffFigure>,
     /// Methods with a lag (FSI): lag_rmse per frame.
     pub lag: Option<Vec<f64>>,
+    /// `--impostor`: view_pop per frame (None without impostors, under TAA, for a method with a lag).
+    pub view_pop: Option<Vec<f64>>,
     pub shadow: Option<ShadowFigures>,
     /// The method's own stage per frame (FSI's combination pass), when it has one: timed in the quality pass,
     /// so that its timestamps are never inside a timing-pass frame.

@@ -96,6 +96,15 @@ pub struct QualityKernels {
     pub lodpop: DiffKernel,
     /// lag_rmse: (method, now).
     pub lag: DiffKernel,
+    /// `--impostor`: view_pop's counterfactual frame and its kernel (method, view).
+    pub view: Option<ViewPop>,
+}
+
+/// view_pop's frame (the method's frame with the impostors' frames selected from the previous frame's eye) and
+/// its difference from the method's.
+pub struct ViewPop {
+    pub target: RenderTarget,
+    pub kernel: DiffKernel,
 }
 
 impl QualityKernels {
@@ -109,7 +118,22 @@ impl QualityKernels {
         let frames = scene.frames;
         let pairs = [(&t.method, &t.before), (&t.now, &t.before)];
         let background = gpu.background_bytes(ctx)?;
+        let view = match scene.impostor {
+            Some(_) if scene.taa.is_none() => {
+                let target = RenderTarget::new(
+                    &ctx.device,
+                    "view_pop target",
+                    t.method.width,
+                    t.method.height,
+                );
+                let kernel =
+                    DiffKernel::new(ctx, "view_pop", &[(&t.method, &target)], frames, background)?;
+                Some(ViewPop { target, kernel })
+            }
+            _ => None,
+        };
         Ok(QualityKernels {
+            view,
             lodpop: DiffKernel::new(ctx, "lodpop", &pairs, frames, background)?,
             lag: DiffKernel::new(ctx, "lag", &[(&t.method, &t.now)], frames, background)?,
             metric: MetricKernel::new(

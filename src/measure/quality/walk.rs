@@ -157,6 +157,10 @@ impl QualityStage {
             } else {
                 None
             },
+            view_pop: match &k.view {
+                Some(v) if !walk.has_lag => Some(v.kernel.read(ctx, frames)?),
+                _ => None,
+            },
             shadow,
             stage_ms: method.stage_gpu_ms(ctx)?,
             metric_gpu_ms_median,

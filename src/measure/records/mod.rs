@@ -50,6 +50,7 @@ pub(crate) mod tests {
             lag_rmse: None,
             shadow_rmse: None,
             shadow_lodpop: None,
+            view_pop: None,
             splits: None,
             merges: None,
             select_cpu_ms: None,

@@ -73,6 +73,10 @@ pub struct FrameRecord {
     /// queries (its own passes: not the shadow maps, TAA's resolve or compute passes; empty with `--quality
     /// off` or where the adapter has no such queries).
     pub fragments: Option<u64>,
+    /// `--impostor`: RMS of the method's frame minus the same frame with the impostors' frames and blend weights
+    /// selected from the previous frame's eye: the impostors' own popping under motion, LOD switches aside (0
+    /// where the eye holds still; empty without impostors, under TAA and for FSI).
+    pub view_pop: Option<f64>,
 }
 
 /// Per (scene, count, method) block: sizes and the cost of the two passes.
@@ -212,6 +216,7 @@ impl FrameTimes {
             merges: None,
             select_cpu_ms: None,
             fragments: None,
+            view_pop: None,
         })
     }
 }

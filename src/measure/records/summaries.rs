@@ -70,6 +70,8 @@ pub struct SummaryRecord {
     /// `--shadows on`: mean shadow_rmse and largest shadow_lodpop (the shadow's own error and popping).
     pub shadow_rmse_mean: Option<f64>,
     pub shadow_lodpop_max: Option<f64>,
+    /// `--impostor`: the largest view_pop (the impostors' own popping under motion).
+    pub view_pop_max: Option<f64>,
     /// `--baseline`: this method's time over the baseline's, paired round by round ([`PairedRatios`]).
     pub baseline: Option<String>,
     /// The frame time every ratio of the block is of ([`Clock::of_block`]), the same on every row of a block.
@@ -235,6 +237,8 @@ impl SummaryRecord {
         self.lag_rmse_max = lag.map(|v| v.into_iter().fold(0.0, f64::max));
         self.shadow_rmse_mean = shadow_rmse.as_ref().map(|v| mean(v.iter().copied()));
         self.shadow_lodpop_max = shadow_lodpop.map(|v| v.into_iter().fold(0.0, f64::max));
+        let view_pop: Option<Vec<f64>> = rows.iter().map(|r| r.view_pop).collect();
+        self.view_pop_max = view_pop.map(|v| v.into_iter().fold(0.0, f64::max));
     }
 
     /// Fills the ratio columns from this block's rows and the baseline's (same scene, count, frames, rounds),
