@@ -128,6 +128,10 @@ folders=(
 "engine-check|26|GSA|W=\$(mktemp -d) && \$LB export --scene bunny-sweep --out \$W/bunny-sweep.glb && \$LB tune --scene \$W/bunny-sweep.glb --budget-lodpop 0.004 --speed 2 --views 8 --out \$W/tune-bunny && \$LB tune --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --budget-lodpop 0.004 --speed 2 --views 8 --out \$W/tune-damagedhelmet && \$LB tune --scene \$GSA/Models/WaterBottle/glTF/WaterBottle.gltf --budget-lodpop 0.004 --speed 2 --views 8 --out \$W/tune-waterbottle && python3 scripts/engine_check.py \$W/tune-bunny \$W/tune-damagedhelmet \$W/tune-waterbottle --out \$D --frames 240 --binary \$LB && rm -rf \$W"
 "tune-jnd-damagedhelmet|10|GSA|\$LB tune --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --calibration results/cpu/calibration-simulated/calibration.json --budget-jnd 1 --views 8 --out \$D && \$LB run --scene \$D/tuned.glb --method discrete --width 1920 --height 1080 --frames 240 --rounds 2 --calibration results/cpu/calibration-simulated/calibration.json --out \$D/run"
 "tune-1080-damagedhelmet|10|GSA|\$LB tune --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --budget-lodpop 0.004 --width 1920 --height 1080 --views 8 --out \$D"
+"impostors|13||python3 scripts/impostor_sweep.py \$D --lodbench \$LB --orbit"
+"impostor-trees-ci|3||\$LB run --scene trees --profile ci --impostor --method discrete,dither,alpha,alpha-2pass,alpha-zwrite,fsi --out \$D"
+"impostors-tune-trees|1||\$LB tune --scene trees --impostor --budget-lodpop 0.004 --views 8 --out \$D"
+"impostor-damagedhelmet|1|GSA|\$LB run --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --impostor --impostor-distance 18 --method discrete,dither,alpha,alpha-2pass --out \$D"
 "visible-pops-ci|20||\$LB experiment \$E/visible-pops-ci.toml --out \$D && $PLOT \$D"
 )
 

@@ -208,6 +208,7 @@ pub fn execute(args: &TuneArgs) -> Result<()> {
     )?;
     write_rules(&out, &models)?;
     print_results(&out, &models, &engine_models, &viewing);
+    print_impostor(&scene, &models);
     if let Some(j) = &jnd {
         outln!(
             "budget: {} JND, {}",
@@ -385,6 +386,29 @@ fn jod_of(args: &TuneArgs, settings: &TuneSettings, width: u32, height: u32) -> 
 
 /// The scene with each tuned model's chain cut after its last usable LOD and its switches the chosen ones (what
 /// tuned.glb holds).
+/// `--impostor`: the impostor tune assumed as every chain's last level, and where each model switches to it
+/// (tuned.glb leaves it out: `run --scene tuned.glb --impostor --impostor-distance D` draws it).
+fn print_impostor(scene: &crate::scene::Scene, models: &[ModelSwitches]) {
+    let Some(imp) = &scene.impostor else {
+        return;
+    };
+    outln!(
+        "the last level of every chain is an impostor, as assumed (tuned.glb has the mesh levels only): {}",
+        imp.describe()
+    );
+    for m in models {
+        let last = scene.models[m.model as usize].chain.lods.len() as u32 - 1;
+        let at = m.pairs.iter().find(|p| p.lod_to == last);
+        match at.and_then(|p| p.switch_distance) {
+            Some(d) => outln!(
+                "  {}: the impostor from {d:.4} (lodbench run --scene tuned.glb --impostor --impostor-distance {d:.4})",
+                m.name
+            ),
+            None => outln!("  {}: no distance measured keeps the impostor within the budget", m.name),
+        }
+    }
+}
+
 fn tuned_scene(scene: &crate::scene::Scene, models: &[ModelSwitches]) -> crate::scene::Scene {
     let mut out = scene.clone();
     let mut list: Vec<crate::scene::Model> = out.models.to_vec();
@@ -392,6 +416,17 @@ fn tuned_scene(scene: &crate::scene::Scene, models: &[ModelSwitches]) -> crate::
         let m = &mut list[t.model as usize];
         let switches: Vec<f32> = t.pairs.iter().map_while(|p| p.switch_distance).collect();
         m.chain.lods.truncate(switches.len() + 1);
+        // tuned.glb holds meshes: an impostor's card is no mesh a glTF file can carry (tune.json, rules.csv and
+        // engines/ keep its switch).
+        if m.chain
+            .lods
+            .last()
+            .is_some_and(|l| crate::geometry::impostor::is_card(&l.mesh))
+        {
+            m.chain.lods.pop();
+        }
+        let mut switches = switches;
+        switches.truncate(m.chain.lods.len() - 1);
         m.switches = switches;
         m.switch_source = crate::scene::model::SwitchSource::Tune;
     }

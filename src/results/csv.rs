@@ -231,7 +231,7 @@ mod tests {
         assert!(!dir.path().join(FRAMES_CSV).exists());
         let partial = std::fs::read_to_string(dir.path().join("frames.csv.partial")).unwrap();
         assert!(partial.starts_with(
-            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,units_drawn,t_instances,lod_mean,k_mean,rmse,pop,lodpop,lodpop_coverage,lodpop_shading,de2000_mean,uncovered_px,crack_px,flip_mean,combine_gpu_ms,lag_rmse,shadow_rmse,shadow_lodpop,splits,merges,select_cpu_ms,round,fragments\n"
+            "scene,method,count,frame,gpu_ms,cpu_ms,triangles,draw_calls,units_drawn,t_instances,lod_mean,k_mean,rmse,pop,lodpop,lodpop_coverage,lodpop_shading,de2000_mean,uncovered_px,crack_px,flip_mean,combine_gpu_ms,lag_rmse,shadow_rmse,shadow_lodpop,splits,merges,select_cpu_ms,round,fragments,view_pop\n"
         ));
         assert!(
             partial.contains("s,m,1,0,,2.0,100,1,1,0,0.0,,0.5,0.0"),

@@ -96,17 +96,6 @@ fn an_impostor_seen_from_its_own_frame_looks_like_the_mesh() {
     let on = bunny_on_a_frame(0.0);
     let mesh = render_frame(&ctx, &on, "reference", 0);
     let card = render_frame(&ctx, &on, "discrete", 0);
-    if let Some(d) = std::env::var_os("LODBENCH_IMPOSTOR_PNG") {
-        let d = std::path::PathBuf::from(d);
-        image::RgbaImage::from_raw(160, 120, mesh.clone())
-            .unwrap()
-            .save(d.join("mesh.png"))
-            .unwrap();
-        image::RgbaImage::from_raw(160, 120, card.clone())
-            .unwrap()
-            .save(d.join("card.png"))
-            .unwrap();
-    }
     let (outline, shading) = compare(&mesh, &card, bg);
     eprintln!("on the frame: outline {outline:.3}, shading {shading:.2}");
     assert!(
@@ -274,4 +263,52 @@ fn a_model_with_no_extent_is_refused() {
         e.contains("no extent") && e.contains(&models[0].name),
         "{e}"
     );
+}
+
+/// tune places the impostor's switch like any other, within the budget, and prints the impostor it assumed
+/// with the run that draws it; tuned.glb keeps the mesh levels (a glTF file holds no impostor).
+#[test]
+fn tune_places_the_impostor_switch() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tune");
+    let o = out.to_str().unwrap();
+    let args = [
+        "tune",
+        "--scene",
+        "simple",
+        "--impostor",
+        "--budget-lodpop",
+        "0.004",
+        "--views",
+        "4",
+        "--out",
+        o,
+    ];
+    let run = lodbench(&args, &[]);
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(
+        text.contains("octahedral impostor: 16 x 16 frames (full)"),
+        "{text}"
+    );
+    let line = text
+        .lines()
+        .find(|l| l.contains("the impostor from"))
+        .expect("the impostor's switch");
+    assert!(line.contains("--impostor --impostor-distance"), "{line}");
+    let tune: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("tune.json")).unwrap()).unwrap();
+    let pairs = tune["models"][0]["pairs"].as_array().unwrap();
+    let card = pairs
+        .iter()
+        .find(|p| p["lod_to"] == 2)
+        .expect("the switch into LOD2, the impostor");
+    let worst = card["value_at_switch"]
+        .as_f64()
+        .expect("a switch within the budget");
+    assert!(worst <= 0.004, "{worst}");
 }
