@@ -19,6 +19,7 @@ METHOD_COLOURS = {
     "reference": "#000000",
     "reference-flat": "#7f7f7f",
     "discrete": "#d62728",
+    "discrete-mesh": "#5c0a0a",
     "alpha": "#ff7f0e",
     "alpha-2pass": "#ffbb78",
     "alpha-linear": "#8c564b",

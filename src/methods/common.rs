@@ -301,6 +301,9 @@ pub struct OpaqueInstances {
     seams: Option<SeamDraws>,
     /// A pipeline of its own in place of the scene's opaque one (`reference-flat`'s flat surface).
     pipeline: Option<crate::gpu::MeshPipelines>,
+    /// Per model, the finest LOD drawn at most in place of a coarser one (`discrete-mesh`: the last mesh level
+    /// in place of an impostor's card); None: every LOD as asked.
+    cap: Option<Vec<u32>>,
 }
 
 impl OpaqueInstances {
@@ -310,6 +313,29 @@ impl OpaqueInstances {
             buffer: gpu.create_instance_buffer(label, scene.instances.len() as u32),
             seams: None,
             pipeline: None,
+            cap: None,
+        }
+    }
+
+    /// The same, drawing each model's last mesh level where the schedule asks for its impostor's card
+    /// (`--impostor`; without it, every LOD as asked).
+    pub fn without_impostors(gpu: &SceneGpu, scene: &Scene, label: &str) -> Self {
+        let cap = scene
+            .models
+            .iter()
+            .map(|m| {
+                let last = m.chain.lods.len() as u32 - 1;
+                match m.chain.lods.last() {
+                    Some(l) if crate::geometry::impostor::is_card(&l.mesh) => {
+                        last.saturating_sub(1)
+                    }
+                    _ => last,
+                }
+            })
+            .collect();
+        OpaqueInstances {
+            cap: Some(cap),
+            ..Self::new(gpu, scene, label)
         }
     }
 
@@ -341,7 +367,10 @@ impl OpaqueInstances {
     ) -> DrawStats {
         self.list.clear();
         for (i, (inst, state)) in input.scene.instances.iter().zip(input.states).enumerate() {
-            let lod = lod_of(state);
+            let lod = match &self.cap {
+                Some(cap) => lod_of(state).min(cap[inst.model as usize]),
+                None => lod_of(state),
+            };
             self.list.push(
                 0,
                 inst.model,

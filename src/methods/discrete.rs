@@ -19,6 +19,15 @@ impl Discrete {
         }
     }
 
+    /// `discrete-mesh`: discrete with `--impostor`'s cards left out, each model's last mesh level drawn in their
+    /// place: the frame the impostor saves the cost of, paired with discrete round by round in the same run
+    /// (without `--impostor` it is discrete itself, an A/A pair).
+    pub fn without_impostors(gpu: &SceneGpu, scene: &Scene) -> Self {
+        Discrete {
+            draw: OpaqueInstances::without_impostors(gpu, scene, "discrete-mesh instances"),
+        }
+    }
+
     /// `blocks-discrete` (Blow 2003a and 2003b without the blending): each block of a unified scene switches
     /// hard, and the seams between the blocks' LODs close the cracks.
     pub fn with_seams(gpu: &SceneGpu, scene: &Scene) -> Self {

@@ -94,6 +94,7 @@ pub const BUILTIN: &[MethodEntry] = &[
     MethodEntry { name: "reference", about: "LOD0 everywhere: the high-poly reference", create: |b| Ok(Box::new(reference::Reference::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "reference-flat", about: "the reference drawn flat (one colour per model, no texture): paired with reference, the cost of a user scene's materials (not run by default)", create: |b| Ok(Box::new(reference::Reference::flat(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "discrete", about: "discrete LOD switching: a hard switch at k = 0.5", create: |b| Ok(Box::new(discrete::Discrete::new(b.gpu, b.scene))), options: no_options },
+    MethodEntry { name: "discrete-mesh", about: "discrete, drawing the last mesh LOD where --impostor's card would be (its cost)", create: |b| Ok(Box::new(discrete::Discrete::without_impostors(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "alpha", about: "Giegl's unpopping: one LOD opaque, the other blended over it", create: |b| Ok(Box::new(alpha::Alpha::new(b.gpu, b.scene))), options: no_options },
     MethodEntry { name: "alpha-2pass", about: "unpopping, double pass: each translucent LOD shows only its nearest surface", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene, alpha_2pass::Weights::Unpop))), options: no_options },
     MethodEntry { name: "alpha-linear", about: "Sheliemietiev et al. 2023's alpha blending: both LODs translucent, 1 - k and k, double pass each", create: |b| Ok(Box::new(alpha_2pass::AlphaTwoPass::new(b.gpu, b.scene, alpha_2pass::Weights::Linear))), options: no_options },
@@ -217,7 +218,13 @@ pub const UNIFIED_DEFAULT: [&str; 5] = [
 
 /// Built-in methods a run draws only when `--method` names them: variants that test a claim (their image is
 /// another method's, or they ablate one).
-pub const NOT_DEFAULT: [&str; 4] = ["reference-flat", "alpha-sorted", "dither-skip", "fsi-blend"];
+pub const NOT_DEFAULT: [&str; 5] = [
+    "reference-flat",
+    "alpha-sorted",
+    "dither-skip",
+    "fsi-blend",
+    "discrete-mesh",
+];
 
 /// Built-in methods that cannot draw a transition into an impostor (`--impostor`): geomorph moves the finer
 /// LOD's vertices onto the coarser LOD's surface, and a card has no surface to move them onto. A run with
