@@ -14,6 +14,13 @@ pub fn execute(args: &ExportArgs) -> Result<()> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     let mut cfg = SceneConfig::from_args(&args.scene_args)?;
+    if cfg.impostor.is_some() {
+        return Err(Error::Config(
+            "export --impostor: an impostor is baked when a scene is drawn and has no glTF or OBJ form; export \
+             without --impostor (and run the exported file with it)"
+                .into(),
+        ));
+    }
     if obj {
         // An OBJ holds the geometry alone: no image is decoded (a file whose textures are missing or KTX2 still
         // exports).

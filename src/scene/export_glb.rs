@@ -45,6 +45,19 @@ pub fn glb_with(scene: &Scene, camera: bool) -> Result<Vec<u8>> {
             scene.name()
         )));
     }
+    let card = |m: &&crate::scene::Model| {
+        m.chain
+            .lods
+            .iter()
+            .any(|l| crate::geometry::impostor::is_card(&l.mesh))
+    };
+    if let Some(m) = scene.models.iter().find(card) {
+        return Err(Error::Config(format!(
+            "export: model {}'s chain ends in an impostor, which is baked when a scene is drawn and has no glTF \
+             form; export without --impostor",
+            m.name
+        )));
+    }
     let mut w = Writer::default();
     // A user scene's materials, with their images as PNG.
     let drawn = w.materials_of(&scene.materials)?;

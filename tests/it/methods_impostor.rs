@@ -289,6 +289,20 @@ fn bad_impostor_input_is_refused() {
     );
     let out = lodbench(&["describe", "--scene", "terrain", "--impostor"], &[]);
     fails_with(&out, &["--impostor", "terrain"]);
+    let glb = dir.path().join("x.glb");
+    let out = lodbench(
+        &[
+            "export",
+            "--scene",
+            "simple",
+            "--impostor",
+            "--out",
+            glb.to_str().unwrap(),
+        ],
+        &[],
+    );
+    fails_with(&out, &["export --impostor", "without --impostor"]);
+    assert!(!glb.exists());
 }
 
 /// (e) A model with no extent (bounding radius 0) cannot be baked: one error naming the model.
