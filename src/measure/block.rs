@@ -402,8 +402,8 @@ pub struct QualityToRenders {
 
 /// `quality_to_renders_ratio` and its 95 % interval: per round, the quality segment's time per frame over the
 /// renders it made, each at the same round's timing time per frame (`method_ms`, `reference_ms`): the method's
-/// frame, the reference's on the frames it was drawn (not copied), lodpop's counterfactual on the frames it was
-/// drawn; then the geometric mean of the rounds' ratios and its Student-t interval. None where a round lacks a
+/// frame, the reference's on the frames it was drawn (not copied), lodpop's and view_pop's counterfactuals on the
+/// frames they were drawn; then the geometric mean of the rounds' ratios and its Student-t interval. None where a round lacks a
 /// time.
 pub fn quality_to_renders(
     segments: &[SegmentCost],
@@ -416,7 +416,7 @@ pub fn quality_to_renders(
         .map(|(r, s)| {
             let n = (s.frames[1] - s.frames[0]).max(1) as f64;
             let drawn = 1.0 - s.reference_copied as f64 / n;
-            let counterfactual = s.counterfactual_frames as f64 / n;
+            let counterfactual = (s.counterfactual_frames + s.view_frames) as f64 / n;
             let renders = method_ms.get(r)? * (1.0 + counterfactual) + reference_ms.get(r)? * drawn;
             (renders > 0.0).then(|| s.ms / n / renders)
         })
@@ -445,6 +445,7 @@ mod tests {
             ms,
             counterfactual_frames,
             reference_copied,
+            view_frames: 0,
         }
     }
 

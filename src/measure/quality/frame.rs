@@ -90,7 +90,7 @@ impl QualityStage {
             index = ctx.queue.submit([encoder.finish()]);
         }
         if let Some(i) = self.view_counterfactual(base, method, (&input, &walk.history)) {
-            index = i;
+            (index, walk.view_frames) = (i, walk.view_frames + 1);
         }
         if let Some(taa) = &mut self.taa {
             taa.advance();

@@ -61,4 +61,6 @@ pub struct SegmentCost {
     pub counterfactual_frames: u32,
     /// Frames whose reference frame was copied, not drawn.
     pub reference_copied: u32,
+    /// Frames on which view_pop's counterfactual was drawn (`--impostor`).
+    pub view_frames: u32,
 }

@@ -32,6 +32,8 @@ pub struct Walk {
     pub(super) tiles_read: u64,
     /// Pixels lodpop's counterfactual was drawn in, summed, and the frames it was drawn on.
     pub(super) counterfactual_pixels: (u64, u32),
+    /// Frames on which view_pop's counterfactual was drawn (`--impostor`).
+    pub(super) view_frames: u32,
     /// The method is the reference and its frame is made by the frame alone: the reference frame is a copy
     /// of the method's.
     pub(super) reference_is_method_frame: bool,
@@ -71,6 +73,7 @@ impl QualityStage {
             coverage: Coverage::new(base.scene, self.region == MetricRegion::Covered && confined),
             tiles_read: 0,
             counterfactual_pixels: (0, 0),
+            view_frames: 0,
             reference_is_method_frame: is_reference
                 && Self::reference_copyable(&self.taa, &self.shadow_share),
             reference_copied: 0,
@@ -95,7 +98,11 @@ impl QualityStage {
         on_frames: &mut dyn FnMut(u32, FrameImages<'_>) -> Result<()>,
     ) -> Result<()> {
         let start = Instant::now();
-        let before = (walk.counterfactual_pixels.1, walk.reference_copied);
+        let before = (
+            walk.counterfactual_pixels.1,
+            walk.reference_copied,
+            walk.view_frames,
+        );
         let first = frames.start;
         for f in frames.clone() {
             check_interrupt()?;
@@ -110,6 +117,7 @@ impl QualityStage {
             ms: start.elapsed().as_secs_f64() * 1e3,
             counterfactual_frames: walk.counterfactual_pixels.1 - before.0,
             reference_copied: walk.reference_copied - before.1,
+            view_frames: walk.view_frames - before.2,
         });
         Ok(())
     }
