@@ -19,6 +19,9 @@
 // scenes without it keep shaders with no discard.
 override ALPHA_TEST: bool = false;
 
+// Set per scene when its chains end in impostors (--impostor), so scenes without them compile no impostor code.
+override IMPOSTORS: bool = false;
+
 struct Camera {
     view_proj: mat4x4<f32>,
     eye: vec4<f32>,
@@ -73,7 +76,7 @@ const KIND_DEFORMED: f32 = 4.0;
 const KIND_IMPOSTOR: f32 = 5.0;
 
 fn transform(position: vec3<f32>, normal: vec3<f32>, aux: vec4<f32>, inst: InstanceIn) -> VsOut {
-    if (aux.z == KIND_IMPOSTOR) {
+    if (IMPOSTORS && aux.z == KIND_IMPOSTOR) {
         return impostor_card(aux, inst);
     }
     var p = position;
@@ -132,7 +135,7 @@ fn leaf_cluster_mask(uv: vec2<f32>) -> bool {
 // True where an alpha-tested leaf card (aux kinds 1 and 2) has no leaf, or an impostor's card no model (the
 // fragment is discarded by every method).
 fn aux_masked(in: VsOut) -> bool {
-    if (in.kind == KIND_IMPOSTOR) {
+    if (IMPOSTORS && in.kind == KIND_IMPOSTOR) {
         return impostor_masked(in);
     }
     if (in.kind == KIND_LEAF) {

@@ -61,7 +61,7 @@ fn shade(in: VsOut, front: bool) -> vec4<f32> {
     var n = normalize(in.normal);
     var l = camera.light.xyz;
     var albedo = in.color.rgb;
-    if (in.kind == KIND_IMPOSTOR) {
+    if (IMPOSTORS && in.kind == KIND_IMPOSTOR) {
         let t = impostor_texel(in);
         n = t.normal;
         l = in.normal;

@@ -158,7 +158,7 @@ fn masked(in: VsOut) -> bool {
     if (aux_masked(in)) {
         return true;
     }
-    if (in.kind == KIND_IMPOSTOR) {
+    if (IMPOSTORS && in.kind == KIND_IMPOSTOR) {
         return false;
     }
     return material.alpha.x == 1.0 && base_color(in).a < material.alpha.y;
@@ -268,7 +268,7 @@ fn pbr_light(s: PbrSurface, v: vec3<f32>, l: vec3<f32>, world: vec3<f32>) -> vec
 // An impostor's card is lit from its atlas in object space (`normal` holds the light's direction there); its
 // material's alpha mode and unlit flag are the baked model's, not applied again.
 fn shade(in: VsOut, front: bool) -> vec4<f32> {
-    if (in.kind == KIND_IMPOSTOR) {
+    if (IMPOSTORS && in.kind == KIND_IMPOSTOR) {
         let t = impostor_texel(in);
         let s = PbrSurface(t.base.rgb, t.orm.z, t.orm.y, t.normal, t.orm.x, t.emissive);
         return vec4<f32>(pbr_light(s, normalize(-in.imp_ray), in.normal, in.world), 1.0);

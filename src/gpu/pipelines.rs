@@ -153,6 +153,8 @@ pub struct PipelineContext<'a> {
     pub shader: &'a wgpu::ShaderModule,
     pub camera_layout: &'a wgpu::BindGroupLayout,
     pub alpha_test: bool,
+    /// The scene's chains end in impostors: every mesh pipeline is built with `IMPOSTORS` on.
+    pub impostors: bool,
     pub surface: Surface,
     /// The material bind group layout (the PBR surface).
     pub material_layout: Option<&'a wgpu::BindGroupLayout>,
@@ -406,13 +408,14 @@ fn mesh_pipeline_from(
     let device = ctx.device;
     let layout = mesh_pipeline_layout(ctx, d);
     let buffers = mesh_vertex_buffers(ctx, d);
-    let constants: &[(&str, f64)] = if ctx.alpha_test {
-        &[("ALPHA_TEST", 1.0)]
-    } else {
-        &[]
-    };
+    let constants: Vec<(&str, f64)> =
+        [("ALPHA_TEST", ctx.alpha_test), ("IMPOSTORS", ctx.impostors)]
+            .into_iter()
+            .filter(|c| c.1)
+            .map(|(name, _)| (name, 1.0))
+            .collect();
     let compilation_options = wgpu::PipelineCompilationOptions {
-        constants,
+        constants: &constants,
         ..Default::default()
     };
     // Depth-only passes need a fragment stage only to apply the alpha-test mask.
