@@ -418,11 +418,7 @@ fn tuned_scene(scene: &crate::scene::Scene, models: &[ModelSwitches]) -> crate::
         m.chain.lods.truncate(switches.len() + 1);
         // tuned.glb holds meshes: an impostor's card is no mesh a glTF file can carry (tune.json, rules.csv and
         // engines/ keep its switch).
-        if m.chain
-            .lods
-            .last()
-            .is_some_and(|l| crate::geometry::impostor::is_card(&l.mesh))
-        {
+        if crate::geometry::impostor::ends_in_card(&m.chain) {
             m.chain.lods.pop();
         }
         let mut switches = switches;

@@ -346,6 +346,11 @@ pub fn is_card(mesh: &Mesh) -> bool {
     mesh.aux.first().is_some_and(|a| a[2] == AUX_IMPOSTOR)
 }
 
+/// Whether `chain` ends in an impostor's card (`--impostor` appends it as the last level, and only there).
+pub fn ends_in_card(chain: &crate::geometry::lod::LodChain) -> bool {
+    chain.lods.last().is_some_and(|l| is_card(&l.mesh))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,7 +11,8 @@
 
 use crate::error::{Error, Result};
 use crate::geometry::impostor::{
-    frame_basis, frame_direction, is_card, Impostor, Layout, LAYERS_PER_IMPOSTOR, MAX_IMPOSTORS,
+    ends_in_card, frame_basis, frame_direction, Impostor, Layout, LAYERS_PER_IMPOSTOR,
+    MAX_IMPOSTORS,
 };
 use crate::geometry::projection::Sphere;
 use crate::gpu::draw_list::{DrawList, InstanceRaw};
@@ -36,9 +37,10 @@ pub fn slots(scene: &Scene) -> Vec<ImpostorSlot> {
         .models
         .iter()
         .enumerate()
+        .filter(|(_, m)| ends_in_card(&m.chain))
         .filter_map(|(i, m)| {
             let last = m.chain.lods.last()?;
-            is_card(&last.mesh).then(|| ImpostorSlot {
+            Some(ImpostorSlot {
                 model: i as u32,
                 slot: last.mesh.aux[0][3] as u32,
                 sphere: Sphere::new(m.center, m.radius / m.scale),

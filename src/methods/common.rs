@@ -325,11 +325,9 @@ impl OpaqueInstances {
             .iter()
             .map(|m| {
                 let last = m.chain.lods.len() as u32 - 1;
-                match m.chain.lods.last() {
-                    Some(l) if crate::geometry::impostor::is_card(&l.mesh) => {
-                        last.saturating_sub(1)
-                    }
-                    _ => last,
+                match crate::geometry::impostor::ends_in_card(&m.chain) {
+                    true => last.saturating_sub(1),
+                    false => last,
                 }
             })
             .collect();

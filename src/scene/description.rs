@@ -235,12 +235,7 @@ impl SceneDef {
                 let models = self
                     .models
                     .iter()
-                    .filter(|m| {
-                        m.chain
-                            .lods
-                            .last()
-                            .is_some_and(|l| crate::geometry::impostor::is_card(&l.mesh))
-                    })
+                    .filter(|m| crate::geometry::impostor::ends_in_card(&m.chain))
                     .count();
                 ImpostorDescription {
                     settings: imp,

@@ -45,12 +45,7 @@ pub fn glb_with(scene: &Scene, camera: bool) -> Result<Vec<u8>> {
             scene.name()
         )));
     }
-    let card = |m: &&crate::scene::Model| {
-        m.chain
-            .lods
-            .iter()
-            .any(|l| crate::geometry::impostor::is_card(&l.mesh))
-    };
+    let card = |m: &&crate::scene::Model| crate::geometry::impostor::ends_in_card(&m.chain);
     if let Some(m) = scene.models.iter().find(card) {
         return Err(Error::Config(format!(
             "export: model {}'s chain ends in an impostor, which is baked when a scene is drawn and has no glTF \
