@@ -2,7 +2,8 @@
 # Remakes every folder of results/cpu/ from the code at HEAD, in the order below, one folder at a time:
 #   scripts/regenerate-results.sh [--list] [--stale] [--force] [--out ROOT] [NAME ...]
 # Each folder is made in results/cpu/.regen/NAME, then pruned to what the committed folder keeps (a file whose name
-# it has, and figures/ where it has figures: frames.csv and frame dumps go unless it kept them) and moved into place;
+# it has, and figures/ and clips/ where it has them: frames.csv and frame dumps go unless it kept them) and moved
+# into place;
 # a top-level subfolder of the committed folder that the command does not make is kept. Resumable:
 # a folder already made by this build (results/cpu/.regen/done lists NAME and the build's commit) is skipped
 # unless --force; an interrupted folder is made again from its start. Prints each folder's time and the total.
@@ -105,10 +106,10 @@ folders=(
 "sort-error-trees-ci|4||\$LB run --scene trees --profile ci --method discrete,alpha,alpha-sorted --dump-frames --dump-transitions --out \$D && python3 scripts/sort_error.py \$D"
 "frontier-ci|14||\$LB experiment $E/frontier-ci.toml --out \$D && $PLOT \$D"
 "frontier-perceptual-ci|16||\$LB experiment $E/frontier-perceptual-ci.toml --out \$D && for r in \$D/runs/*/; do \$LB perceptual \$r; done && $PLOT \$D"
-"clips-ci|4||\$LB run --scene bunny-sweep,trees --profile ci --method reference,discrete,alpha,alpha-2pass,alpha-zwrite,dither,geomorph,fsi --dump-frames --dump-transitions --out \$D && \$LB clips \$D --max-frames 20 --transitions 0,1,2,3,4 --mp4 off && $PLOT \$D"
-"materials-damagedhelmet|1|GSA|\$LB run --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --method reference,discrete,alpha,dither,geomorph,fsi --frames 600 --dump-frames --dump-transitions --out \$D && \$LB clips \$D --max-frames 16 --mp4 off --methods discrete,alpha,dither,geomorph,fsi && $PLOT \$D"
+"clips-ci|4||\$LB run --scene bunny-sweep,trees --profile ci --method reference,discrete,alpha,alpha-2pass,alpha-zwrite,dither,geomorph,fsi --dump-frames --dump-transitions --out \$D && \$LB clips \$D --max-frames 20 --transitions 0,1,2,3,4 --mp4 only && $PLOT \$D"
+"materials-damagedhelmet|1|GSA|\$LB run --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --method reference,discrete,alpha,dither,geomorph,fsi --frames 600 --dump-frames --dump-transitions --out \$D && \$LB clips \$D --max-frames 16 --mp4 only --methods discrete,alpha,dither,geomorph,fsi && $PLOT \$D"
 "materials-waterbottle|1|GSA|\$LB run --scene \$GSA/Models/WaterBottle/glTF/WaterBottle.gltf --method reference,discrete,alpha,dither,geomorph,fsi --frames 600 --out \$D && $PLOT \$D"
-"materials-scifihelmet|1|GSA|scifi_available && \$LB run --scene \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet-available.gltf --method reference,discrete,alpha,dither,geomorph,fsi --frames 600 --dump-frames --dump-transitions --out \$D && \$LB clips \$D --max-frames 16 --mp4 off --methods discrete,alpha,dither,geomorph,fsi && $PLOT \$D"
+"materials-scifihelmet|1|GSA|scifi_available && \$LB run --scene \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet-available.gltf --method reference,discrete,alpha,dither,geomorph,fsi --frames 600 --dump-frames --dump-transitions --out \$D && \$LB clips \$D --max-frames 16 --mp4 only --methods discrete,alpha,dither,geomorph,fsi && $PLOT \$D"
 "materials-scifihelmet-flat|1|GSA|scifi_available && \$LB run --scene \$GSA/Models/SciFiHelmet/glTF/SciFiHelmet-available.gltf --materials flat --method reference,discrete,alpha,dither,geomorph,fsi --frames 600 --out \$D && $PLOT \$D"
 "materials-damagedhelmet-flat|1|GSA|\$LB run --scene \$GSA/Models/DamagedHelmet/glTF-Binary/DamagedHelmet.glb --materials flat --method reference,discrete,alpha,dither,geomorph,fsi --frames 600 --out \$D && $PLOT \$D"
 "materials-waterbottle-flat|1|GSA|\$LB run --scene \$GSA/Models/WaterBottle/glTF/WaterBottle.gltf --materials flat --method reference,discrete,alpha,dither,geomorph,fsi --frames 600 --out \$D && $PLOT \$D"
@@ -205,15 +206,17 @@ export -f read_check
 prune() {
     local new=$1 old=$2 rel
     local -A kept=()
-    local figures=0
+    local figures=0 clips=0
     while IFS= read -r rel; do
         kept[${rel##*/}]=1
         [[ $rel == figures/* || $rel == */figures/* ]] && figures=1
+        [[ $rel == clips/* ]] && clips=1
     done < <(git ls-files -- "$old" | sed "s|^$old/||")
     while IFS= read -r rel; do
         rel=${rel#./}
         [[ -n ${kept[${rel##*/}]:-} ]] && continue
         [[ $figures == 1 && ($rel == figures/* || $rel == */figures/*) ]] && continue
+        [[ $clips == 1 && $rel == clips/* ]] && continue
         rm -f -- "$new/$rel"
     done < <(cd "$new" && find . -type f)
     find "$new" -mindepth 1 -type d -empty -delete

@@ -10,8 +10,10 @@ index.json and, per clip (one transition of one scene), `<clip>/frame_NNNNN.png`
 method's frame side by side, labelled) and `<clip>/error_NNNNN.png` (each method's error heat-map at the same
 places), plus animations of it (`<clip>.png`, an animated PNG, or `<clip>.gif`, and with ffmpeg `<clip>.mp4`).
 One image holds every method, so the methods are in sync by construction; the player steps, plays or slides through
-the clip's frames and toggles frame and error view at the same frame. An experiment folder's runs get players too
-(`runs/<run>/clips/`).
+the clip's frames and toggles frame and error view at the same frame. A clip made with `lodbench clips --mp4 only`
+has no frame images (index.json's `frame_images` and `error_images` null): its MP4, the frame grid over the error
+grid, is the player's source, each frame shown by seeking to its middle and the view by which half is shown. An
+experiment folder's runs get players too (`runs/<run>/clips/`).
 """
 import html
 import json
@@ -93,8 +95,11 @@ def check_clip(clip, n, where, prefix, clips_dir: Path, run):
     if not isinstance(frames, list) or not frames or not all(isinstance(f, int) and not isinstance(f, bool)
                                                                for f in frames):
         raise ValueError(f"{what}: \"frames\" is not a non-empty list of frame numbers")
+    movie = clip.get("frame_images") is None and clip.get("error_images") is None
     for key in PER_FRAME:
         v = clip.get(key)
+        if movie and key.endswith("_images"):
+            continue
         if not isinstance(v, list) or len(v) != len(frames):
             raise ValueError(f"{what}: \"{key}\" is not a list of {len(frames)} entries, one per frame")
     for f, k in zip(frames, clip["k"]):
@@ -106,28 +111,40 @@ def check_clip(clip, n, where, prefix, clips_dir: Path, run):
         if not all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in size):
             raise ValueError(f"{what}: width and height {size} are not pixel counts")
     out = dict(clip)
-    for key in ("frame_images", "error_images"):
-        paths = []
-        for f, rel in zip(frames, clip[key]):
-            p = image_path(rel, what, f"{key[:-7]} image of frame {f}", prefix, clips_dir)
-            try:
-                with Image.open(clips_dir / rel) as im:
-                    got = im.size
-            except OSError as e:
-                raise ValueError(f"{what}: {prefix}clips/{rel}: not an image ({e})") from None
-            size = size or got
-            if got != size:
-                raise ValueError(f"{what}: {prefix}clips/{rel} is {got[0]}x{got[1]} pixels, the clip's images "
-                                 f"{size[0]}x{size[1]}")
-            paths.append(p)
-        out[key] = paths
+    if movie:
+        if not clip.get("mp4") or size is None:
+            raise ValueError(f"{what}: no frame images, and no MP4 with its width and height to play instead; "
+                             "rerun `lodbench clips`")
+        out["frame_images"] = out["error_images"] = None
+    else:
+        for key in ("frame_images", "error_images"):
+            out[key], size = clip_images(clip, key, size, what, prefix, clips_dir)
     out["width"], out["height"] = size
     for key, _ in MEDIA:
         rel = clip.get(key)
         out[key] = None if rel is None else image_path(rel, what, key, prefix, clips_dir)
+    out["movie"] = out["mp4"] if movie else None
     out["run"] = run
     out["prefix"] = prefix
     return out
+
+
+def clip_images(clip, key, size, what, prefix, clips_dir: Path):
+    """The checked URLs of a clip's frame or error images (`key`), and their common size (`size` when given)."""
+    paths = []
+    for f, rel in zip(clip["frames"], clip[key]):
+        p = image_path(rel, what, f"{key[:-7]} image of frame {f}", prefix, clips_dir)
+        try:
+            with Image.open(clips_dir / rel) as im:
+                got = im.size
+        except OSError as e:
+            raise ValueError(f"{what}: {prefix}clips/{rel}: not an image ({e})") from None
+        size = size or got
+        if got != size:
+            raise ValueError(f"{what}: {prefix}clips/{rel} is {got[0]}x{got[1]} pixels, the clip's images "
+                             f"{size[0]}x{size[1]}")
+        paths.append(p)
+    return paths, size
 
 
 def image_path(rel, what, role, prefix, clips_dir: Path) -> str:
@@ -218,10 +235,20 @@ image){heat}. {' &middot; '.join(links)}</p>
 </span>
 </div>
 <p class="caption" aria-live="polite">{esc(caption(clip, 0))}</p>
-<div class="frame"><img class="clip" src="{esc(clip['frame_images'][0])}" width="{clip['width']}"
- height="{clip['height']}" alt="{esc(clip['name'])}, frame {clip['frames'][0]}"
- title="click: actual pixels / fit"></div>
+<div class="frame">{shown(clip)}</div>
 </section>"""
+
+
+def shown(clip) -> str:
+    """What a player shows: its first frame image, or its MP4 (the frame grid over the error grid) in a box one grid
+    high, at the first frame's middle."""
+    if clip["movie"]:
+        w, h = clip["width"], clip["height"]
+        return (f'<div class="movie" style="--w: {w}px; aspect-ratio: {w} / {h}" title="click: actual pixels / fit">'
+                f'<video class="clip" src="{esc(clip["movie"])}#t={0.5 / clip["fps"]:.4f}" width="{w}" '
+                f'height="{2 * h}" muted playsinline preload="metadata"></video></div>')
+    return (f'<img class="clip" src="{esc(clip["frame_images"][0])}" width="{clip["width"]}" height="{clip["height"]}"'
+            f' alt="{esc(clip["name"])}, frame {clip["frames"][0]}" title="click: actual pixels / fit">')
 
 
 def caption(clip, j: int) -> str:
@@ -440,7 +467,7 @@ def page(title: str, answers, headline, tables, figures, clips, runs, players=Tr
         body += [figure_html(name, cap) for name, cap in figures]
     body += ['<h2 id="manifest">Manifest</h2>', runs if isinstance(runs, str) else manifest_html(runs)]
     data = {"clips": [{k: c[k] for k in ("name", "fps", "frames", "k", "t_instances", "frame_images",
-                                         "error_images")} for c in clips or []]}
+                                         "error_images", "movie")} for c in clips or []]}
     return f"""<!DOCTYPE html>
 <html lang="en">
 <head>
@@ -501,13 +528,18 @@ figcaption { color: #555; }
 .player .frame { overflow-x: auto; }
 .player img.clip { display: block; max-width: 100%; height: auto; background: #000; cursor: zoom-in; }
 .player img.clip.actual { max-width: none; cursor: zoom-out; }
+.player .movie { width: min(100%, var(--w)); overflow: hidden; background: #000; cursor: zoom-in; }
+.player .movie.actual { width: var(--w); cursor: zoom-out; }
+.player .movie video.clip { display: block; width: 100%; height: auto; }
+.player .movie.error video.clip { transform: translateY(-50%); }
 .player.broken .caption { color: #b00020; }
 """
 
 # The players. Each preloads its clip's frame and error images when it comes near the viewport (all of a page's
 # clips at once could be hundreds of megabytes), so stepping and playback never wait for the disk; a missing image
-# is logged with console.error and shown in the caption. scripts/tests/test_report_browser.py waits on a player's
-# data-total/data-settled (its images, and those loaded or failed) and calls its preload().
+# is logged with console.error and shown in the caption. A player of an MP4 (`clips --mp4 only`) preloads the whole
+# MP4 instead and shows frame j by seeking to (j + 0.5) / fps. scripts/tests/test_report_browser.py waits on a
+# player's data-total/data-settled (its images or its MP4, and those loaded or failed) and calls its preload().
 SCRIPT = """
 (function () {
   "use strict";
@@ -516,6 +548,7 @@ SCRIPT = """
   function setup(el) {
     var clip = data.clips[Number(el.dataset.clip)];
     var img = el.querySelector("img.clip"), slider = el.querySelector(".slider");
+    var movie = el.querySelector("video.clip"), box = el.querySelector(".movie");
     var caption = el.querySelector(".caption"), play = el.querySelector(".play");
     var n = clip.frames.length, index = 0, view = "frame", timer = null, cache = null, missing = [];
     function settled() { el.dataset.settled = String(Number(el.dataset.settled || 0) + 1); }
@@ -529,6 +562,13 @@ SCRIPT = """
     el.preload = function () {
       if (cache) return;
       cache = [];
+      if (movie) {
+        el.dataset.total = "1";
+        if (movie.readyState >= 2) settled();
+        else movie.addEventListener("loadeddata", settled, { once: true });
+        movie.preload = "auto";
+        return;
+      }
       el.dataset.total = String(2 * n);
       ["frame_images", "error_images"].forEach(function (key) {
         clip[key].forEach(function (src) {
@@ -542,9 +582,16 @@ SCRIPT = """
     };
     function show(i) {
       index = Math.max(0, Math.min(n - 1, i));
-      var src = clip[view === "frame" ? "frame_images" : "error_images"][index];
-      if (img.getAttribute("src") !== src) img.setAttribute("src", src);
-      img.alt = clip.name + ", frame " + clip.frames[index] + ", " + view + " view";
+      if (movie) {
+        var at = (index + 0.5) / clip.fps;
+        if (Math.abs(movie.currentTime - at) > 1e-4) movie.currentTime = at;
+        box.classList.toggle("error", view === "error");
+        movie.setAttribute("aria-label", clip.name + ", frame " + clip.frames[index] + ", " + view + " view");
+      } else {
+        var src = clip[view === "frame" ? "frame_images" : "error_images"][index];
+        if (img.getAttribute("src") !== src) img.setAttribute("src", src);
+        img.alt = clip.name + ", frame " + clip.frames[index] + ", " + view + " view";
+      }
       slider.value = String(index);
       var k = clip.k[index];
       caption.textContent = "frame " + clip.frames[index] + " (" + (index + 1) + "/" + n + "), k=" +
@@ -568,8 +615,13 @@ SCRIPT = """
     el.querySelectorAll("input[type=radio]").forEach(function (r) {
       r.addEventListener("change", function () { if (r.checked) { view = r.value; el.preload(); show(index); } });
     });
-    img.addEventListener("error", function () { fail(img.getAttribute("src")); });
-    img.addEventListener("click", function () { img.classList.toggle("actual"); });
+    if (movie) {
+      movie.addEventListener("error", function () { settled(); fail(clip.movie); });
+      box.addEventListener("click", function () { box.classList.toggle("actual"); });
+    } else {
+      img.addEventListener("error", function () { fail(img.getAttribute("src")); });
+      img.addEventListener("click", function () { img.classList.toggle("actual"); });
+    }
     show(0);
   }
   players.forEach(setup);

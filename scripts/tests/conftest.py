@@ -121,12 +121,17 @@ def pixel_error_experiment(tmp_path_factory) -> Path:
     return out
 
 
-def write_clips(folder: Path, clips=2, frames=8, tile=(160, 120), methods=("reference", "discrete", "alpha")) -> dict:
+def write_clips(folder: Path, clips=2, frames=8, tile=(160, 120), methods=("reference", "discrete", "alpha"),
+                movie=False) -> dict:
     """A synthetic `clips/` in `folder`, laid out as `lodbench clips` writes it (index.json, per clip a frame and an
     error image per frame, an animated PNG and a GIF, no MP4): each tile a method's colour with a white bar that
-    moves with the frame, so every frame differs from every other. Returns the index."""
+    moves with the frame, so every frame differs from every other. With `movie`, as `lodbench clips --mp4 only`
+    writes it: the frame grids over the error grids in an MP4 alone (ffmpeg; the test is skipped without it).
+    Returns the index."""
     import json
+    import shutil
 
+    import numpy as np
     from PIL import Image, ImageDraw
 
     colours = [(70, 110, 200), (200, 90, 60), (60, 160, 90), (170, 150, 40)]
@@ -138,7 +143,7 @@ def write_clips(folder: Path, clips=2, frames=8, tile=(160, 120), methods=("refe
         (out / name).mkdir(parents=True, exist_ok=True)
         first = 10 + 20 * c
         numbers = list(range(first - 2, first - 2 + frames))
-        gif = []
+        gif, stacked = [], []
         for j, f in enumerate(numbers):
             for kind in ("frame", "error"):
                 im = Image.new("RGB", (width, height), (0, 0, 0))
@@ -154,6 +159,8 @@ def write_clips(folder: Path, clips=2, frames=8, tile=(160, 120), methods=("refe
                 im.save(out / name / f"{kind}_{f:05d}.png")
                 if kind == "frame":
                     gif.append(im)
+                else:
+                    stacked.append(np.concatenate([np.asarray(gif[-1]), np.asarray(im)]))
         gif[0].save(out / f"{name}.gif", save_all=True, append_images=gif[1:], duration=100, loop=0)
         gif[0].save(out / f"{name}.png", save_all=True, append_images=gif[1:], duration=100, loop=0)
         t_instances = [0 if j in (0, frames - 1) else 1 for j in range(frames)]
@@ -166,8 +173,28 @@ def write_clips(folder: Path, clips=2, frames=8, tile=(160, 120), methods=("refe
             "error_images": [f"{name}/error_{f:05d}.png" for f in numbers],
             "apng": f"{name}.png", "gif": f"{name}.gif", "mp4": None, "width": width, "height": height,
         })
+        if movie:
+            write_mp4(out / f"{name}.mp4", stacked, index["fps"])
+            shutil.rmtree(out / name)
+            for ext in ("png", "gif"):
+                (out / f"{name}.{ext}").unlink()
+            index["clips"][-1].update(frame_images=None, error_images=None, apng=None, gif=None, mp4=f"{name}.mp4")
     (out / "index.json").write_text(json.dumps(index, indent=2))
     return index
+
+
+def write_mp4(path: Path, pictures, fps: int):
+    """RGB pictures (arrays, all one size) as an H.264 MP4, as `lodbench clips` encodes it (CRF 18, yuv420p)."""
+    import shutil
+
+    if shutil.which("ffmpeg") is None:
+        pytest.skip("no ffmpeg for an MP4-only clip: apt-get install ffmpeg")
+    h, w = pictures[0].shape[:2]
+    r = subprocess.run(["ffmpeg", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{w}x{h}",
+                        "-r", str(fps), "-i", "-", "-c:v", "libx264", "-crf", "18", "-pix_fmt", "yuv420p",
+                        "-movflags", "+faststart", str(path)], input=b"".join(p.tobytes() for p in pictures),
+                       capture_output=True)
+    assert r.returncode == 0, r.stderr.decode()
 
 
 @pytest.fixture(scope="session")

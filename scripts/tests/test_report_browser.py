@@ -59,14 +59,25 @@ def plot(folder: Path):
 
 
 PLAYER = "document.querySelector('.player')"
+# The first player's picture shown and settled: an image loaded, or an MP4 (`clips --mp4 only`) done seeking with
+# the frame there.
+SHOWN = (f"(e => e.tagName === 'IMG' ? e.complete : !e.seeking && e.readyState >= 2)"
+         f"({PLAYER}.querySelector('.clip'))")
 
 
 def player_state(b: Browser):
-    return b.js(f"""(() => {{ const p = {PLAYER}, img = p.querySelector('img.clip'),
-        box = r => (r => [r.left, r.top, r.width, r.height])(r.getBoundingClientRect());
-        return {{ src: img.getAttribute('src'), ready: img.complete && img.naturalWidth > 0,
+    """The first player: what it shows (`src`: the image, or the MP4 with its time), in which `view` (frame or error,
+    from the image's name or the MP4's box), its caption, slider and their boxes."""
+    return b.js(f"""(() => {{ const p = {PLAYER}, img = p.querySelector('.clip'),
+        movie = img.tagName === 'VIDEO', shown = movie ? p.querySelector('.movie') : img,
+        box = r => (r => [r.left, r.top, r.width, r.height])(r.getBoundingClientRect()),
+        src = img.getAttribute('src');
+        return {{ src: movie ? src.split('#')[0] + '@' + img.currentTime.toFixed(3) : src,
+                  view: movie ? (shown.classList.contains('error') ? 'error' : 'frame')
+                              : (src.includes('/error_') ? 'error' : src.includes('/frame_') ? 'frame' : '?'),
+                  ready: movie ? !img.seeking && img.readyState >= 2 : img.complete && img.naturalWidth > 0,
                   caption: p.querySelector('.caption').textContent, value: p.querySelector('.slider').value,
-                  max: p.querySelector('.slider').max, img: box(img), slider: box(p.querySelector('.slider')),
+                  max: p.querySelector('.slider').max, img: box(shown), slider: box(p.querySelector('.slider')),
                   error: box(p.querySelector('input[value=error]')) }}; }})()""")
 
 
@@ -99,7 +110,7 @@ def exercise(b: Browser, folder: Path, shots: Path, tag: str) -> dict:
     b.js("document.querySelectorAll('.player').forEach(p => p.preload())")
     b.until("[...document.querySelectorAll('.player')].every(p => p.dataset.settled === p.dataset.total)",
             "every player's preload")
-    b.until(f"{PLAYER}.querySelector('img.clip').complete", "the first image")
+    b.until(SHOWN, "the first image")
     b.painted()
     loaded_s = time.monotonic() - t0
     s0 = player_state(b)
@@ -107,21 +118,21 @@ def exercise(b: Browser, folder: Path, shots: Path, tag: str) -> dict:
     # Real input: a click at three quarters of the slider's track moves its thumb there.
     x, y, w, h = s0["slider"]
     b.click(x + 0.75 * w, y + h / 2)
-    b.until(f"{PLAYER}.querySelector('img.clip').complete", "the clicked frame")
+    b.until(SHOWN, "the clicked frame")
     b.painted()
     s1 = player_state(b)
     shot1 = b.screenshot()
     # The focused slider's arrow key: one frame on (or back, at the end).
     step = ("ArrowLeft", 37) if s1["value"] == s1["max"] else ("ArrowRight", 39)
     b.key(*step)
-    b.until(f"{PLAYER}.querySelector('img.clip').complete", "the next frame")
+    b.until(SHOWN, "the next frame")
     b.painted()
     s2 = player_state(b)
     shot2 = b.screenshot()
     # The error view of the same frame.
     x, y, w, h = s2["error"]
     b.click(x + w / 2, y + h / 2)
-    b.until(f"{PLAYER}.querySelector('img.clip').complete", "the error view")
+    b.until(SHOWN, "the error view")
     b.painted()
     s3 = player_state(b)
     shot3 = b.screenshot()
@@ -136,10 +147,10 @@ def check(result):
     s0, s1, s2, s3 = result["states"]
     assert s0["ready"] and s1["ready"] and s3["ready"], result["states"]
     assert s1["value"] != s0["value"] and frame_of(s1["caption"]) != frame_of(s0["caption"]), (s0, s1)
-    assert s1["src"] != s0["src"] and "/frame_" in s1["src"]
+    assert s1["src"] != s0["src"] and s0["view"] == s1["view"] == "frame", (s0, s1)
     assert abs(int(s2["value"]) - int(s1["value"])) == 1, (s1, s2)
     assert s3["value"] == s2["value"] and frame_of(s3["caption"]) == frame_of(s2["caption"]), (s2, s3)
-    assert "/error_" in s3["src"], s3
+    assert s3["view"] == "error", s3
     assert result["clicked"] > 0.001, f"the player's pixels did not change ({result['clicked']:.4%} differ)"
     assert result["toggled"] > 0.001, f"the error view looks like the frame view ({result['toggled']:.4%} differ)"
     assert result["errors"] == [], result["errors"]
@@ -177,6 +188,22 @@ def test_synthetic_clips_in_chromium(synthetic, browser, tmp_path):
     result = exercise(browser, synthetic, screenshots_dir(tmp_path), "synthetic")
     report_timing(browser, result, "synthetic")
     check(result)
+
+
+def test_mp4_only_clips_in_chromium(chromium, software_run, make_clips, browser, tmp_path):
+    """The player of `clips --mp4 only` (what committed example folders keep): stepping seeks the MP4 to the frame,
+    the error view shows its lower half, and the pixels change with each."""
+    folder = tmp_path / "movie"
+    shutil.copytree(software_run, folder)
+    make_clips(folder, clips=3, frames=12, tile=(200, 150), movie=True)
+    plot(folder)
+    result = exercise(browser, folder, screenshots_dir(tmp_path), "mp4-only")
+    report_timing(browser, result, "mp4 only")
+    check(result)
+    s0, s1 = result["states"][:2]
+    fps = 10
+    at = lambda s: float(s["src"].split("@")[1])  # noqa: E731
+    assert abs(at(s1) - (int(s1["value"]) + 0.5) / fps) < 1e-3 and abs(at(s0) - 0.5 / fps) < 1e-3, (s0, s1)
 
 
 def test_missing_clip_image_is_an_error(synthetic, browser, tmp_path):

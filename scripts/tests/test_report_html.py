@@ -180,6 +180,32 @@ def spoil(what: str, folder: Path):
     index_path.write_text(json.dumps(index))
 
 
+def test_an_mp4_only_clip_is_played_from_its_mp4(dump, make_clips, tmp_path):
+    """`lodbench clips --mp4 only`: no frame images, the player's source is the MP4 (seeked, in a box one grid high);
+    the MP4 is linked, and a clip with neither frame images nor an MP4 is refused."""
+    folder = tmp_path / "movie"
+    shutil.copytree(dump, folder)
+    index = make_clips(folder, clips=2, frames=6, movie=True)
+    r = plot(folder)
+    assert r.returncode == 0, r.stderr
+    page = Page((folder / "report.html").read_text())
+    assert len(page.players) == 2
+    videos = [a for tag, a in page.tags if tag == "video"]
+    assert [v["src"] for v in videos] == [f"clips/{c['mp4']}#t=0.0500" for c in index["clips"]]
+    assert all((v["width"], v["height"]) == ("480", "240") for v in videos)  # three 160x120 tiles, over three
+    assert not any(tag == "img" and "clips/" in a.get("src", "") for tag, a in page.tags)
+    for clip, shown in zip(index["clips"], page.clips["clips"]):
+        assert shown["movie"] == f"clips/{clip['mp4']}"
+        assert shown["frame_images"] is None and shown["error_images"] is None
+        assert ("a", f"clips/{clip['mp4']}") in page.refs
+    for v in videos:
+        assert (folder / unquote(v["src"].split("#")[0])).is_file()
+    index["clips"][1]["mp4"] = None
+    (folder / "clips" / "index.json").write_text(json.dumps(index))
+    r = plot(folder)
+    assert r.returncode == 2 and "clip bunny-sweep_c1_t01: no frame images, and no MP4" in r.stderr, r.stderr
+
+
 BAD_CLIPS = [
     ("not json", "clips/index.json: not readable JSON"),
     ("no clips list", "clips/index.json: expected an object with a \"clips\" list"),

@@ -319,7 +319,8 @@ pub struct ClipsArgs {
     /// Also a GIF of each clip (beside its animated PNG).
     #[arg(long)]
     pub gif: bool,
-    /// MP4s with ffmpeg: auto (when ffmpeg is on the PATH), on (an error without it), off.
+    /// MP4s with ffmpeg: auto (when ffmpeg is on the PATH), on (an error without it), off; only: the MP4 alone,
+    /// no frame images and no animated PNG, report.html's player plays it (a tenth of the bytes; needs ffmpeg).
     #[arg(long, value_enum, value_parser = names_only::<Mp4>(), default_value = "auto")]
     pub mp4: Mp4,
 }
@@ -780,6 +781,9 @@ pub enum Mp4 {
     /// Always; an error when `ffmpeg` is missing.
     On,
     Off,
+    /// The MP4 alone: no per-frame images and no animated PNG (report.html's player plays the MP4); an error
+    /// when `ffmpeg` is missing.
+    Only,
 }
 
 #[cfg(test)]

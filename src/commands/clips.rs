@@ -15,6 +15,9 @@
 //!   `<clip>.gif` (the `image` crate);
 //! - `<clip>.mp4`: the same, H.264, when `ffmpeg` is on the PATH (`--mp4 auto`, the default);
 //! - `<clip>/frame_FFFFF.png` and `<clip>/error_FFFFF.png`: each frame's two grids, for report.html's player;
+//! - with `--mp4 only`, the MP4 alone: no animated PNG and no frame images (index.json's `apng`,
+//!   `frame_images` and `error_images` are null), and report.html's player steps through the MP4 (about a
+//!   tenth of the bytes: what a committed example folder keeps);
 //! - `index.json`: the clips, their frames, k per frame and the files ([`ClipIndex`]).
 //!
 //! The folder is built as `clips.partial/` and renamed to `clips/` only when every clip is written, so a
@@ -110,10 +113,12 @@ pub fn execute(args: &ClipsArgs) -> Result<()> {
             c.frames.len(),
             c.frames.first().copied().unwrap_or_default(),
             c.frames.last().copied().unwrap_or_default(),
-            c.apng,
+            c.apng.as_deref().or(c.mp4.as_deref()).unwrap_or_default(),
             [&c.gif, &c.mp4]
                 .iter()
-                .filter_map(|f| f.as_ref().map(|f| format!(", {f}")))
+                .filter_map(|f| f.as_ref())
+                .filter(|f| c.apng.is_some() || Some(*f) != c.mp4.as_ref())
+                .map(|f| format!(", {f}"))
                 .collect::<String>()
         );
     }
@@ -151,11 +156,11 @@ pub struct ClipEntry {
     /// Mean k of the instances in transition per frame (None where none is, or frames.csv lacks k_mean).
     pub k: Vec<Option<f64>>,
     pub t_instances: Vec<Option<u32>>,
-    /// Paths relative to `clips/`.
-    pub frame_images: Vec<String>,
-    pub error_images: Vec<String>,
-    /// The animated PNG (lossless; every current browser plays it).
-    pub apng: String,
+    /// Paths relative to `clips/` (None with `--mp4 only`).
+    pub frame_images: Option<Vec<String>>,
+    pub error_images: Option<Vec<String>>,
+    /// The animated PNG (lossless; every current browser plays it; None with `--mp4 only`).
+    pub apng: Option<String>,
     /// With `--gif` (256 colours a frame, quantised by NeuQuant).
     pub gif: Option<String>,
     pub mp4: Option<String>,
@@ -382,10 +387,11 @@ fn ffmpeg_wanted(mp4: Mp4) -> Result<bool> {
     match mp4 {
         Mp4::Off => Ok(false),
         Mp4::Auto => Ok(ffmpeg_available()),
-        Mp4::On if ffmpeg_available() => Ok(true),
-        Mp4::On => Err(Error::Config(
-            "clips --mp4 on: ffmpeg is not on the PATH (Debian: apt install ffmpeg)".into(),
-        )),
+        Mp4::On | Mp4::Only if ffmpeg_available() => Ok(true),
+        Mp4::On | Mp4::Only => Err(Error::Config(format!(
+            "clips --mp4 {}: ffmpeg is not on the PATH (Debian: apt install ffmpeg)",
+            if mp4 == Mp4::On { "on" } else { "only" }
+        ))),
     }
 }
 
@@ -455,11 +461,13 @@ impl ClipJob<'_> {
         }
         let frames = self.frames(t, &methods)?;
         let files = ClipFiles::new(&t.scene, t.count, t.transition);
-        let clip_dir = self.partial.join(files.folder());
-        std::fs::create_dir_all(&clip_dir).map_err(|e| Error::io(&clip_dir, e))?;
+        if self.settings.mp4 != Mp4::Only {
+            let clip_dir = self.partial.join(files.folder());
+            std::fs::create_dir_all(&clip_dir).map_err(|e| Error::io(&clip_dir, e))?;
+        }
         let mut tiles = vec![DumpKind::Reference.name().to_string()];
         tiles.extend(methods.iter().cloned());
-        let mut entry = new_entry(t, &files, tiles, frames, self.settings.gif);
+        let mut entry = new_entry(t, &files, tiles, frames, self.settings);
         let loaded = entry
             .frames
             .iter()
@@ -592,15 +600,19 @@ impl ClipJob<'_> {
                 &error_tiles,
                 self.settings.columns,
             );
-            let frame_file = files.frame_image(f);
-            let error_file = files.error_image(f);
-            save(&self.partial.join(&frame_file), &frame_grid.image)?;
-            save(&self.partial.join(&error_file), &error_grid.image)?;
+            if let (Some(frame_images), Some(error_images)) =
+                (&mut entry.frame_images, &mut entry.error_images)
+            {
+                let frame_file = files.frame_image(f);
+                let error_file = files.error_image(f);
+                save(&self.partial.join(&frame_file), &frame_grid.image)?;
+                save(&self.partial.join(&error_file), &error_grid.image)?;
+                frame_images.push(frame_file);
+                error_images.push(error_file);
+            }
             entry.width = frame_grid.image.width();
             entry.height = frame_grid.image.height();
             entry.tiles = frame_grid.boxes;
-            entry.frame_images.push(frame_file);
-            entry.error_images.push(error_file);
             entry.k.push(facts.k);
             entry.t_instances.push(facts.t_instances);
             movie.push(stack(&frame_grid.image, &error_grid.image));
@@ -616,7 +628,9 @@ impl ClipJob<'_> {
         movie: &[RgbaImage],
     ) -> Result<()> {
         let fps = self.settings.fps;
-        write_apng(&self.partial.join(&entry.apng), movie, fps)?;
+        if let Some(apng) = &entry.apng {
+            write_apng(&self.partial.join(apng), movie, fps)?;
+        }
         if let Some(gif) = &entry.gif {
             write_gif(&self.partial.join(gif), movie, fps)?;
         }
@@ -635,8 +649,9 @@ fn new_entry(
     files: &ClipFiles,
     tiles: Vec<String>,
     frames: Vec<u32>,
-    gif: bool,
+    settings: &ClipSettings,
 ) -> ClipEntry {
+    let lossless = settings.mp4 != Mp4::Only;
     ClipEntry {
         name: files.name.clone(),
         scene: t.scene.clone(),
@@ -649,10 +664,10 @@ fn new_entry(
         frames,
         k: Vec::new(),
         t_instances: Vec::new(),
-        frame_images: Vec::new(),
-        error_images: Vec::new(),
-        apng: files.animation("png"),
-        gif: gif.then(|| files.animation("gif")),
+        frame_images: lossless.then(Vec::new),
+        error_images: lossless.then(Vec::new),
+        apng: lossless.then(|| files.animation("png")),
+        gif: settings.gif.then(|| files.animation("gif")),
         mp4: None,
         width: 0,
         height: 0,

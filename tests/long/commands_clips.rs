@@ -3,7 +3,7 @@
 
 use crate::common::{fails_with, lodbench, run_into};
 use crate::regress_run;
-use lodbench::commands::clips::{make, ClipSettings, Mp4};
+use lodbench::commands::clips::{make, ClipIndex, ClipSettings, Mp4};
 use lodbench::measure::records::{TransitionRecord, TRANSITION_LEAD, TRANSITION_TAIL};
 use lodbench::results::png::FrameDumper;
 use std::path::Path;
@@ -114,8 +114,8 @@ fn clips_are_the_dumps_side_by_side() {
         // Every tile of the transition's middle frame.
         let i = c.frames.len() / 2;
         let f = c.frames[i];
-        let frame = open(&clips_dir.join(&c.frame_images[i]));
-        let error = open(&clips_dir.join(&c.error_images[i]));
+        let frame = open(&clips_dir.join(&c.frame_images.as_ref().unwrap()[i]));
+        let error = open(&clips_dir.join(&c.error_images.as_ref().unwrap()[i]));
         assert_eq!((frame.width(), frame.height()), (c.width, c.height));
         assert_eq!(frame.dimensions(), error.dimensions());
         let dump = |method: &str, kind: &str| {
@@ -153,10 +153,10 @@ fn clips_are_the_dumps_side_by_side() {
         }
         // The animation: the frame image over the error image, one frame per clip frame.
         let decoder = image::codecs::png::PngDecoder::new(std::io::BufReader::new(
-            std::fs::File::open(clips_dir.join(&c.apng)).unwrap(),
+            std::fs::File::open(clips_dir.join(c.apng.as_ref().unwrap())).unwrap(),
         ))
         .unwrap();
-        assert!(decoder.is_apng().unwrap(), "{}", c.apng);
+        assert!(decoder.is_apng().unwrap(), "{:?}", c.apng);
         use image::AnimationDecoder;
         let frames = decoder
             .apng()
@@ -164,7 +164,7 @@ fn clips_are_the_dumps_side_by_side() {
             .into_frames()
             .collect_frames()
             .unwrap();
-        assert_eq!(frames.len(), c.frames.len(), "{}", c.apng);
+        assert_eq!(frames.len(), c.frames.len(), "{:?}", c.apng);
         let shown = frames[i].buffer();
         assert_eq!(shown.dimensions(), (c.width, c.height * 2));
         let top = image::imageops::crop_imm(shown, 0, 0, c.width, c.height).to_image();
@@ -179,6 +179,76 @@ fn clips_are_the_dumps_side_by_side() {
         index.clips.iter().any(|c| c.scale > 1),
         "the regress viewport is small: some clip is upscaled"
     );
+    if ffmpeg {
+        mp4_only_is_the_same_clip(dir, &settings, &index);
+    }
+}
+
+/// `--mp4 only` (what committed example folders keep): the same clips, the MP4 alone (no animated PNG, no frame
+/// images, index.json's fields for them null), each MP4 with a picture per clip frame, the frame grid over the
+/// error grid, and its middle picture the lossless frame grid within H.264's loss. Run after the lossless clips
+/// of the same folder, which it replaces.
+fn mp4_only_is_the_same_clip(dir: &Path, settings: &ClipSettings, lossless: &ClipIndex) {
+    let clips_dir = dir.join("clips");
+    let middles: Vec<image::RgbaImage> = lossless
+        .clips
+        .iter()
+        .map(|c| open(&clips_dir.join(&c.frame_images.as_ref().unwrap()[c.frames.len() / 2])))
+        .collect();
+    let only = ClipSettings {
+        mp4: Mp4::Only,
+        ..settings.clone()
+    };
+    let index = make(dir, &only).unwrap();
+    assert_eq!(index.clips.len(), lossless.clips.len());
+    let mut files: Vec<String> = std::fs::read_dir(&clips_dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    let mut want: Vec<String> = index.clips.iter().map(|c| c.mp4.clone().unwrap()).collect();
+    want.push("index.json".into());
+    want.sort();
+    assert_eq!(
+        files, want,
+        "--mp4 only writes the MP4s and index.json alone"
+    );
+    for (c, middle) in index.clips.iter().zip(&middles) {
+        assert!(c.apng.is_none() && c.frame_images.is_none() && c.error_images.is_none());
+        let mp4 = clips_dir.join(c.mp4.as_ref().unwrap());
+        let out = std::process::Command::new("ffmpeg")
+            .args(["-loglevel", "error", "-i"])
+            .arg(&mp4)
+            .args(["-f", "rawvideo", "-pix_fmt", "rgba", "-"])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let picture = (c.width * c.height * 2 * 4) as usize;
+        assert_eq!(
+            out.stdout.len(),
+            picture * c.frames.len(),
+            "{}: a {}x{} picture per clip frame",
+            c.name,
+            c.width,
+            c.height * 2
+        );
+        // The frame grid is the top half of the middle picture. Mean absolute difference over its RGB: H.264 at
+        // CRF 18 in 4:2:0 loses a level or two where the picture is flat and more at the labels' edges; a
+        // wrong frame, a shifted grid or the error grid in its place differs by tens of levels.
+        let i = c.frames.len() / 2;
+        let top = &out.stdout[i * picture..i * picture + picture / 2];
+        let diff: u64 = top
+            .chunks(4)
+            .zip(middle.as_raw().chunks(4))
+            .map(|(a, b)| (0..3).map(|k| a[k].abs_diff(b[k]) as u64).sum::<u64>())
+            .sum();
+        let mean = diff as f64 / (3 * c.width * c.height) as f64;
+        assert!(mean < 3.0, "{}: mean difference {mean:.2} levels", c.name);
+    }
 }
 
 /// A folder without dumps, an unknown method, `--mp4 on` without ffmpeg: one error line each, and no clips
@@ -227,6 +297,13 @@ fn bad_clip_input_is_one_error() {
             &[("PATH", "")],
         ),
         &["ffmpeg"],
+    );
+    fails_with(
+        &lodbench(
+            &["clips", &run, "--methods", "discrete", "--mp4", "only"],
+            &[("PATH", "")],
+        ),
+        &["--mp4 only", "ffmpeg"],
     );
     assert!(!empty.join("clips").exists() && !empty.join("clips.partial").exists());
 }
