@@ -320,7 +320,8 @@ pub struct ClipsArgs {
     #[arg(long)]
     pub gif: bool,
     /// MP4s with ffmpeg: auto (when ffmpeg is on the PATH), on (an error without it), off; only: the MP4 alone,
-    /// no frame images and no animated PNG, report.html's player plays it (a tenth of the bytes; needs ffmpeg).
+    /// no frame images and no animated PNG, report.html's player plays it (a third of the bytes or less; needs
+    /// ffmpeg).
     #[arg(long, value_enum, value_parser = names_only::<Mp4>(), default_value = "auto")]
     pub mp4: Mp4,
 }

@@ -16,8 +16,8 @@
 //! - `<clip>.mp4`: the same, H.264, when `ffmpeg` is on the PATH (`--mp4 auto`, the default);
 //! - `<clip>/frame_FFFFF.png` and `<clip>/error_FFFFF.png`: each frame's two grids, for report.html's player;
 //! - with `--mp4 only`, the MP4 alone: no animated PNG and no frame images (index.json's `apng`,
-//!   `frame_images` and `error_images` are null), and report.html's player steps through the MP4 (about a
-//!   tenth of the bytes: what a committed example folder keeps);
+//!   `frame_images` and `error_images` are null), and report.html's player steps through the MP4 (a third of
+//!   the bytes or less: what a committed example folder keeps);
 //! - `index.json`: the clips, their frames, k per frame and the files ([`ClipIndex`]).
 //!
 //! The folder is built as `clips.partial/` and renamed to `clips/` only when every clip is written, so a
