@@ -63,6 +63,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from lodbench_results import save_figure  # noqa: E402  (beside this file)
+
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATE = ROOT / "src" / "commands" / "calibrate" / "page.html"
 PLACEHOLDER = "__LODBENCH_STIMULI__"
@@ -456,7 +459,7 @@ def figure(cal: dict, metric: str, path: Path):
     ax.set_title(title, fontsize=10, color="darkred" if cal["simulated"] else "black")
     ax.legend(fontsize=8, loc="lower right")
     fig.tight_layout()
-    write_atomic(path, lambda f: fig.savefig(f, format="png"))
+    write_atomic(path, lambda f: save_figure(fig, f))
     plt.close(fig)
 
 
@@ -638,7 +641,7 @@ def trials_figure(summary, metric: str, plant: str, bootstrap: int, path: Path):
     fig.suptitle(f"SIMULATED observers, not human data: {plant}; {summary[0]['seeds']} seeds per point, "
                  f"{bootstrap} resamples (x: trials per track (total))", fontsize=9, color="darkred")
     fig.tight_layout()
-    write_atomic(path, lambda f: fig.savefig(f, format="png"))
+    write_atomic(path, lambda f: save_figure(fig, f))
     plt.close(fig)
 
 

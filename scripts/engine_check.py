@@ -57,7 +57,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from lodbench_results import read_csv  # noqa: E402
+from lodbench_results import read_csv, save_figure  # noqa: E402
 from tune_rules import DIAGONAL, RULES, camera_eye, markdown, write_path  # noqa: E402
 
 PATHS = (("axis", (0.0, 0.0, 1.0)), ("diagonal", DIAGONAL))
@@ -332,7 +332,7 @@ def lodpop_figure(asset: Asset, series: dict, out: Path):
     ax.legend(fontsize=7, loc="upper left")
     ax.set_ylim(bottom=0)
     fig.tight_layout()
-    fig.savefig(out)
+    save_figure(fig, out)
     plt.close(fig)
 
 
@@ -392,7 +392,7 @@ def switch_figure(asset: Asset, row: dict, lb: Path, three: Path, out: Path):
     fig.suptitle(f"{asset.name}: rule tune, axis path, first switch {row['pair']}, {asset.width}x{asset.height} "
                  f"cropped to x {x0}-{x1 - 1}, y {y0}-{y1 - 1} (budget {asset.budget:g})", fontsize=8)
     fig.tight_layout()
-    fig.savefig(out)
+    save_figure(fig, out)
     plt.close(fig)
 
 

@@ -28,7 +28,7 @@ import sys
 from collections import OrderedDict
 from pathlib import Path
 
-from lodbench_results import FRAMES_CSV, SUMMARY_CSV, num, read_csv, run_folder_of
+from lodbench_results import FRAMES_CSV, SUMMARY_CSV, num, read_csv, run_folder_of, save_figure
 
 COLUMNS = (
     ("triangles", "triangles_mean"),
@@ -164,7 +164,7 @@ def figure(scene_curves, path):
         row[0].set_yscale("log")
         row[0].legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 

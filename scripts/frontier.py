@@ -21,7 +21,7 @@ import matplotlib.pyplot as plt
 from matplotlib.lines import Line2D
 
 import method_colours
-from lodbench_results import PERCEPTUAL_CSV, num, read_csv, run_folder_of
+from lodbench_results import PERCEPTUAL_CSV, num, read_csv, run_folder_of, save_figure
 
 LEVELS = (1.0, 0.5, 0.25, 0.125)
 
@@ -99,7 +99,7 @@ def figure(scene, pts, curve, path):
     fig.legend(handles=handles, loc="center right", fontsize=7, frameon=False)
     fig.suptitle(f"{scene}: cost against popping across {curve or 'the run'} (points labelled with {curve})")
     fig.tight_layout(rect=(0, 0, 0.84, 1))
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 

@@ -149,3 +149,64 @@ def part_text(part) -> str:
 def sentence_text(parts) -> str:
     """A sentence of answer.json as it reads: its parts joined."""
     return "".join(part_text(p) for p in parts)
+
+
+def save_figure(fig, path, dpi=None):
+    """A matplotlib figure written as PNG to `path` (a path or a binary file), in 256 colours (`palette_png`)."""
+    import io
+
+    from PIL import Image
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    buf.seek(0)
+    with Image.open(buf) as im:
+        palette_png(im, path)
+
+
+# palette_png's run: a colour filling this many pixels in a row is drawn, not an antialiased blend.
+RUN = 8
+
+
+def palette_png(im, path):
+    """A plot's pixels as a PNG of at most 256 colours, at about a third of matplotlib's RGBA bytes. Kept exactly:
+    first every colour that fills a horizontal run of RUN pixels somewhere (the background, the axes, and each
+    series' colour, which its legend sample draws as such a run even when its line is mostly hidden), then the most
+    frequent others up to 256; every other pixel (an antialiased edge) becomes the nearest kept colour.
+    Deterministic; the `Software` text matplotlib writes is kept, and an image already in a palette is written as
+    it is. For plots only: a frame or a contact sheet of frames keeps its own pixels."""
+    import numpy as np
+    from PIL import Image
+    from PIL.PngImagePlugin import PngInfo
+
+    info = PngInfo()
+    if "Software" in im.info:
+        info.add_text("Software", im.info["Software"])
+    if im.mode == "P":
+        im.save(path, format="PNG", optimize=True, pnginfo=info)
+        return
+    rgba = np.asarray(im.convert("RGBA"))
+    packed = rgba.reshape(-1, 4).view(np.uint32).ravel()
+    colours, inverse, counts = np.unique(packed, return_inverse=True, return_counts=True)
+    grid = inverse.reshape(rgba.shape[:2])
+    same = np.concatenate([np.zeros((grid.shape[0], 1), int), (grid[:, 1:] == grid[:, :-1]).astype(int)], axis=1)
+    ends = np.cumsum(same, axis=1)
+    in_run = np.zeros(grid.shape, bool)
+    in_run[:, RUN - 1:] = ends[:, RUN - 1:] - ends[:, :1 - RUN or None] == RUN - 1
+    runs = np.unique(grid[in_run])
+    rank = np.argsort(-(counts + np.isin(np.arange(len(colours)), runs) * counts.sum()), kind="stable")
+    keep = np.sort(rank[:256])
+    palette = colours[keep].view(np.uint8).reshape(-1, 4).astype(np.int32)
+    # Each distinct colour's nearest kept colour (itself where kept), then each pixel's.
+    every = colours.view(np.uint8).reshape(-1, 4).astype(np.int32)
+    nearest = np.empty(len(colours), dtype=np.uint8)
+    for i in range(0, len(every), 4096):
+        d = ((every[i:i + 4096, None, :] - palette[None, :, :]) ** 2).sum(axis=2)
+        nearest[i:i + 4096] = d.argmin(axis=1)
+    index = nearest[inverse].reshape(rgba.shape[:2])
+    out = Image.fromarray(index, mode="P")
+    if (palette[:, 3] == 255).all():
+        out.putpalette(palette[:, :3].astype(np.uint8).ravel().tolist())
+    else:
+        out.putpalette(palette.astype(np.uint8).ravel().tolist(), rawmode="RGBA")
+    out.save(path, format="PNG", optimize=True, pnginfo=info)

@@ -93,6 +93,7 @@ from lodbench_results import (  # noqa: E402  (scripts/lodbench_results.py, besi
     part_text,
     ratio_text,
     read_csv,
+    save_figure,
     sentence_text,
     sig3,
     thousands,
@@ -124,7 +125,7 @@ def switch_frames(rows):
 
 def save(fig, path):
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -328,7 +329,7 @@ def unified(scene, summary, path):
     axes[0].legend(fontsize=8)
     fig.suptitle(f"{scene}: unified LOD against pixel error")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -357,7 +358,7 @@ def cost(scene, summary, path):
     fig.legend(handles=handles, loc="center right", fontsize=7, frameon=False)
     fig.suptitle(f"{scene}: error against cost")
     fig.tight_layout(rect=(0, 0, 0.84, 1))
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -515,7 +516,7 @@ def contact(scene, frames_dir, by_method, path, which="worst"):
     fig.suptitle(f"{scene}: transition {episode} of the path, frames {picks[0]}-{picks[-1]}{crop_note(box)}\n"
                  "(error heat-map: black = equal, white >= 0.25)", fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path, dpi=100)
     plt.close(fig)
     for im in opened.values():
         im.close()

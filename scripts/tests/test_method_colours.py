@@ -114,7 +114,7 @@ def drawn(monkeypatch, tmp_path):
     kept = []
     close = plt.close
     monkeypatch.setattr(plot.plt, "close", lambda fig=None: kept.append(fig))
-    monkeypatch.setattr(plot.plt.Figure, "savefig", lambda self, *a, **k: None)
+    monkeypatch.setattr(plot, "save_figure", lambda *a, **k: None)
     out = []
 
     def draw(name, f, *args):

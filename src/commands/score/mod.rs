@@ -295,7 +295,8 @@ fn write_manifest(
         },
     });
     let path = out.join(RUN_JSON);
-    std::fs::write(&path, serde_json::to_string_pretty(&json)?).map_err(|e| Error::io(&path, e))
+    // Compact, as every run.json is (results::manifest::Manifest::write).
+    std::fs::write(&path, serde_json::to_string(&json)? + "\n").map_err(|e| Error::io(&path, e))
 }
 
 fn print_transitions(found: &[crate::measure::records::TransitionRecord], budget: Option<f64>) {

@@ -21,7 +21,7 @@ use crate::results::csv::{read_rows, rows_of, CsvRow};
 use crate::results::files::{
     run_folder_of, ANSWER_JSON, PAIRS_CSV, PERCEPTUAL_CSV, RUN_JSON, SUMMARY_CSV, TRANSITIONS_CSV,
 };
-use crate::results::manifest::{read_json, write_json_file, BuildVersion};
+use crate::results::manifest::{read_json, write_compact_json_file, BuildVersion};
 use parts::{text_of, Part};
 use rule::{Budget, Sentence};
 use serde::Serialize;
@@ -255,7 +255,7 @@ fn budget_lodpop(path: &Path) -> Option<rule::Given> {
 /// Writes `dir/answer.json` from the folder's files, and returns it.
 pub fn write(dir: &Path) -> Result<AnswerFile> {
     let answer = from_folder(dir)?;
-    write_json_file(dir, ANSWER_JSON, &answer)?;
+    write_compact_json_file(dir, ANSWER_JSON, &answer)?;
     Ok(answer)
 }
 
