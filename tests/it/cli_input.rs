@@ -299,6 +299,26 @@ fn a_scene_that_is_not_one_names_its_remedy() {
         "{}",
         String::from_utf8_lossy(&flat.stderr)
     );
+    // The shape of assimp's test/models/glTF2/wrongTypes/badArray.gltf: a mesh's `primitives` an object holding one
+    // primitive, not an array. It was read as a mesh without triangles ("its meshes hold only points or lines").
+    let mut bad: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&tetra).unwrap()).unwrap();
+    let first = bad["meshes"][0]["primitives"][0].clone();
+    bad["meshes"][0]["primitives"] =
+        serde_json::json!({ "not an array": first["attributes"], "mode": 4 });
+    let path = write(dir.path(), "bad-array.gltf", &bad.to_string());
+    let out = lodbench(&["describe", "--scene", &path], &[]);
+    fails_with(
+        &out,
+        &[
+            "bad-array.gltf",
+            "meshes[0].primitives is an object, not an array: the file does not follow the glTF 2.0 schema",
+        ],
+    );
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("points or lines"),
+        "the real defect, not its symptom"
+    );
 }
 
 #[test]

@@ -33,7 +33,7 @@ pub fn container(bytes: &[u8]) -> Result<(Value, Option<&[u8]>), String> {
     let json_of = |b: &[u8]| -> Result<Value, String> {
         let v: Value = serde_json::from_slice(b).map_err(|e| format!("invalid JSON: {e}"))?;
         match v.pointer("/asset/version").and_then(Value::as_str) {
-            Some(ver) if ver.starts_with("2.") => Ok(v),
+            Some(ver) if ver.starts_with("2.") => super::json::check_shapes(&v).map(|()| v),
             Some(ver) => Err(format!("glTF version {ver}; lodbench reads glTF 2.0")),
             None => Err("no asset.version: not a glTF 2.0 document".into()),
         }

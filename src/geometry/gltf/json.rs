@@ -150,3 +150,161 @@ mod tests {
         assert!(float_list(&json!({}), "w").is_err());
     }
 }
+
+/// The top-level collections of a glTF 2.0 document: arrays of objects where present.
+const COLLECTIONS: [&str; 14] = [
+    "accessors",
+    "animations",
+    "buffers",
+    "bufferViews",
+    "cameras",
+    "images",
+    "materials",
+    "meshes",
+    "nodes",
+    "samplers",
+    "scenes",
+    "skins",
+    "textures",
+    "extensionsRequired",
+];
+
+/// The glTF 2.0 schema's shapes of what lodbench reads: each top-level collection an array (of objects, but for
+/// `extensionsRequired`), each mesh's `primitives` an array of objects, each primitive's `attributes` an object,
+/// each node's `children`, `matrix`, `translation`, `rotation`, `scale` and `weights` arrays. A part of the wrong
+/// JSON type is named here, rather than read as if absent (which made a mesh whose `primitives` is an object look
+/// like a mesh of points and lines).
+pub fn check_shapes(json: &Value) -> Result<(), String> {
+    let kind = |v: &Value| match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    };
+    let wrong = |path: String, v: &Value, want: &str| {
+        format!(
+            "{path} is {}, not {want}: the file does not follow the glTF 2.0 schema (the Khronos glTF Validator \
+             lists every such defect); export it again from its source, or fix that property",
+            kind(v)
+        )
+    };
+    let arrays_of_objects = |path: &str, v: &Value, objects: bool| -> Result<(), String> {
+        let items = v
+            .as_array()
+            .ok_or_else(|| wrong(path.to_string(), v, "an array"))?;
+        match items.iter().position(|i| objects && !i.is_object()) {
+            Some(i) => Err(wrong(format!("{path}[{i}]"), &items[i], "an object")),
+            None => Ok(()),
+        }
+    };
+    for key in COLLECTIONS {
+        if let Some(v) = json.get(key) {
+            arrays_of_objects(key, v, key != "extensionsRequired")?;
+        }
+    }
+    for (m, mesh) in array(json, "meshes").iter().enumerate() {
+        match mesh.get("primitives") {
+            Some(p) => arrays_of_objects(&format!("meshes[{m}].primitives"), p, true)?,
+            None => {
+                return Err(format!(
+                    "meshes[{m}] has no primitives, which glTF 2.0 requires"
+                ))
+            }
+        }
+        for (p, prim) in array(mesh, "primitives").iter().enumerate() {
+            match prim.get("attributes") {
+                Some(a) if !a.is_object() => {
+                    return Err(wrong(
+                        format!("meshes[{m}].primitives[{p}].attributes"),
+                        a,
+                        "an object",
+                    ))
+                }
+                _ => {}
+            }
+        }
+    }
+    for (n, node) in array(json, "nodes").iter().enumerate() {
+        for key in [
+            "children",
+            "matrix",
+            "translation",
+            "rotation",
+            "scale",
+            "weights",
+        ] {
+            if let Some(v) = node.get(key).filter(|v| !v.is_array()) {
+                return Err(wrong(format!("nodes[{n}].{key}"), v, "an array"));
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod shape_tests {
+    use super::check_shapes;
+    use serde_json::json;
+
+    fn doc(extra: serde_json::Value) -> serde_json::Value {
+        let mut d = json!({"asset": {"version": "2.0"},
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "nodes": [{"mesh": 0, "translation": [0, 0, 0]}]});
+        for (k, v) in extra.as_object().unwrap() {
+            d[k] = v.clone();
+        }
+        d
+    }
+
+    #[test]
+    fn a_well_formed_document_passes() {
+        assert_eq!(check_shapes(&doc(json!({}))), Ok(()));
+    }
+
+    /// assimp's test/models/glTF2/wrongTypes/badArray.gltf: `primitives` an object holding one primitive.
+    #[test]
+    fn primitives_as_an_object_is_named() {
+        let d =
+            doc(json!({"meshes": [{"primitives": {"not an array": {"POSITION": 2}, "mode": 4}}]}));
+        let e = check_shapes(&d).unwrap_err();
+        assert!(
+            e.starts_with("meshes[0].primitives is an object, not an array: the file does not follow the glTF 2.0"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn each_wrong_shape_is_named_by_its_path() {
+        for (extra, path) in [
+            (
+                json!({"nodes": {"a": 1}}),
+                "nodes is an object, not an array",
+            ),
+            (
+                json!({"accessors": [3]}),
+                "accessors[0] is a number, not an object",
+            ),
+            (
+                json!({"meshes": [{"primitives": [{"attributes": [0]}]}]}),
+                "meshes[0].primitives[0].attributes is an array, not an object",
+            ),
+            (
+                json!({"meshes": [{"name": "m"}]}),
+                "meshes[0] has no primitives",
+            ),
+            (
+                json!({"nodes": [{"children": 1}]}),
+                "nodes[0].children is a number, not an array",
+            ),
+            (
+                json!({"extensionsRequired": "KHR_x"}),
+                "extensionsRequired is a string, not an array",
+            ),
+        ] {
+            let e = check_shapes(&doc(extra)).unwrap_err();
+            assert!(e.starts_with(path), "{e}");
+        }
+    }
+}
