@@ -392,7 +392,7 @@ def switch_figure(asset: Asset, row: dict, lb: Path, three: Path, out: Path):
     fig.suptitle(f"{asset.name}: rule tune, axis path, first switch {row['pair']}, {asset.width}x{asset.height} "
                  f"cropped to x {x0}-{x1 - 1}, y {y0}-{y1 - 1} (budget {asset.budget:g})", fontsize=8)
     fig.tight_layout()
-    save_figure(fig, out)
+    save_figure(fig, out, palette=False)  # rendered frames: every shade kept
     plt.close(fig)
 
 

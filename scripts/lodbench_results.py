@@ -151,12 +151,17 @@ def sentence_text(parts) -> str:
     return "".join(part_text(p) for p in parts)
 
 
-def save_figure(fig, path, dpi=None):
-    """A matplotlib figure written as PNG to `path` (a path or a binary file), in 256 colours (`palette_png`)."""
+def save_figure(fig, path, dpi=None, palette=True):
+    """A matplotlib figure written as PNG to `path` (a path or a binary file): a plot in 256 colours (`palette_png`);
+    with `palette=False` (a figure of rendered frames: a contact sheet, FSI's buffers, a switch strip) in matplotlib's
+    own RGBA, so no shade of a frame or of an error heat-map is moved to another."""
     import io
 
     from PIL import Image
 
+    if not palette:
+        fig.savefig(path, format="png", dpi=dpi)
+        return
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
     buf.seek(0)

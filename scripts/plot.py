@@ -123,9 +123,9 @@ def switch_frames(rows):
     return [i for i in range(1, len(lod)) if lod[i] != lod[i - 1]]
 
 
-def save(fig, path):
+def save(fig, path, palette=True):
     fig.tight_layout()
-    save_figure(fig, path, dpi=110)
+    save_figure(fig, path, dpi=110, palette=palette)
     plt.close(fig)
 
 
@@ -516,7 +516,7 @@ def contact(scene, frames_dir, by_method, path, which="worst"):
     fig.suptitle(f"{scene}: transition {episode} of the path, frames {picks[0]}-{picks[-1]}{crop_note(box)}\n"
                  "(error heat-map: black = equal, white >= 0.25)", fontsize=9)
     fig.tight_layout()
-    save_figure(fig, path, dpi=100)
+    save_figure(fig, path, dpi=100, palette=False)  # rendered frames: every shade kept
     plt.close(fig)
     for im in opened.values():
         im.close()
@@ -551,7 +551,7 @@ def fsi_buffers(scene, frames_dir, by_method, path):
         fig.suptitle(f"{scene}, {method}, frame {f} ({best['t_instances']} instances in transition"
                      f"{crop_note(box)}): the two "
                      "LOD buffers hold this frame and the previous one; the combination pass merges them", fontsize=9)
-        save(fig, path)
+        save(fig, path, palette=False)  # rendered frames: every shade kept
         return f
     return None
 

@@ -35,6 +35,9 @@ def test_sweep_folder(dump, tmp_path):
         assert f"(figures/{name})" in report
         with Image.open(folder / "figures" / name) as im:
             assert im.width > 300 and im.height > 200
+            # Plots in 256 colours; the figures of rendered frames keep every shade (lodbench_results.save_figure).
+            frames = name.startswith(("contact_", "fsi_buffers_"))
+            assert im.mode == ("RGBA" if frames else "P"), (name, im.mode)
     assert "| bunny-sweep | dither |" in report
     assert "| bunny-sweep | fsi |" in report
     assert "## bunny-sweep: max lodpop (pose held) of each transition (its frames and the 2 after)" in report
