@@ -280,3 +280,57 @@ pub fn render_frame(
         .unwrap();
     out.expect("the frame was rendered")
 }
+
+/// `out` of a command that must succeed (its stderr shown otherwise).
+pub fn ok(out: Output) -> Output {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// A small bunny-sweep experiment of four runs (a `band` sweep at 64x48, discrete and dither), written into `dir`: what
+/// the shard, merge, resume and cluster-recipe tests run.
+pub fn experiment_file(dir: &Path, frames: u32) -> PathBuf {
+    let p = dir.join("shards.toml");
+    std::fs::write(
+        &p,
+        format!(
+            "name = \"shards\"\n[run]\nscene = [\"bunny-sweep\"]\nmethod = [\"discrete\", \"dither\"]\n\
+             width = 64\nheight = 48\nframes = {frames}\nwarmup = 0\nrounds = 2\n\
+             [sweep]\nvariable = \"band\"\nvalues = [0.02, 0.05, 0.1, 0.15]\n"
+        ),
+    )
+    .unwrap();
+    p
+}
+
+/// The columns that are the same on every run of the same flags on the same adapter (not the timings).
+pub const SAME: [&str; 10] = [
+    "band",
+    "scene",
+    "method",
+    "frame",
+    "triangles",
+    "t_instances",
+    "lod_mean",
+    "rmse",
+    "pop",
+    "lodpop",
+];
+
+pub fn deterministic(rows: &Rows) -> Vec<Vec<String>> {
+    rows.iter()
+        .map(|r| SAME.iter().map(|c| r[*c].clone()).collect())
+        .collect()
+}
+
+/// The index of column `name` of a CSV header.
+pub fn column(header: &csv::StringRecord, name: &str) -> usize {
+    header
+        .iter()
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("no column {name}"))
+}

@@ -6,7 +6,10 @@
 //!   a minute and a half on lavapipe);
 //! - `commands_clips`: `lodbench clips` on the regression set's dumps;
 //! - `scene_fidelity`: a dense scan-like mesh (58,784 triangles) swept through every LOD by discrete and FSI at the
-//!   quick profile's 600 frames (about 37 s).
+//!   quick profile's 600 frames (about 37 s);
+//! - `commands_cluster`: the GNU parallel and Slurm recipes, each a sharded experiment merged (Slurm's on a local
+//!   one-node cluster, about 12 s);
+//! - `commands_probe_bands`: `lodbench probe`'s timing bands, ratios of paired rounds measured up to three times.
 
 #![allow(
     clippy::unwrap_used,
@@ -19,6 +22,8 @@
 mod common;
 
 mod commands_clips;
+mod commands_cluster;
+mod commands_probe_bands;
 mod regress;
 mod scene_fidelity;
 
