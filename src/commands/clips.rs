@@ -108,18 +108,17 @@ pub fn execute(args: &ClipsArgs) -> Result<()> {
     let index = make(&args.dir, &ClipSettings::from_args(args))?;
     for c in &index.clips {
         outln!(
-            "{}: {} frames ({}-{}), {}{}",
+            "{}: {} frames ({}-{}), {}",
             c.name,
             c.frames.len(),
             c.frames.first().copied().unwrap_or_default(),
             c.frames.last().copied().unwrap_or_default(),
-            c.apng.as_deref().or(c.mp4.as_deref()).unwrap_or_default(),
-            [&c.gif, &c.mp4]
-                .iter()
-                .filter_map(|f| f.as_ref())
-                .filter(|f| c.apng.is_some() || Some(*f) != c.mp4.as_ref())
-                .map(|f| format!(", {f}"))
-                .collect::<String>()
+            [&c.apng, &c.gif, &c.mp4]
+                .into_iter()
+                .flatten()
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     outln!(
