@@ -159,12 +159,11 @@ def listed_methods(lodbench, file: Path):
     return runs
 
 
-def experiment_blocks(lodbench, scenes: Scenes, name: str, sets=()):
+def experiment_blocks(lodbench, scenes: Scenes, name: str):
     """The blocks of experiment `name` for `cost` (each run's scenes and counts, with their methods)."""
     file = ROOT / "scenes" / "experiments" / f"{name}.toml"
     spec = read_toml(file)
-    run = dict(spec.get("run", {}))
-    run.update(sets)
+    run = spec.get("run", {})
     sweep = spec.get("sweep", {})
     variables = sweep.get("variables") or ([sweep["variable"]] if "variable" in sweep else [])
     values = sweep.get("values") or [None]
@@ -217,13 +216,10 @@ class Suite:
 
     def run(self, cmd, tee=None) -> str:
         """Runs `cmd` (a list) to its end, or, with a budget, to the deadline: then SIGTERM, and GRACE_S later
-        SIGKILL. Returns "ran", "cut" or "failed"."""
+        SIGKILL. With `tee`, its output goes to that file and is printed once it ends. Returns "ran", "cut" or
+        "failed"."""
         out = open(tee, "w") if tee else None
-        self.child = subprocess.Popen(cmd, stdout=subprocess.PIPE if out else None, text=True)
-        if out:
-            for line in self.child.stdout:
-                sys.stdout.write(line)
-                out.write(line)
+        self.child = subprocess.Popen(cmd, stdout=out, text=True)
         cut = False
         while self.child.poll() is None:
             if self.stopped or (self.budget and self.budget.left() <= 0):
@@ -240,6 +236,7 @@ class Suite:
         self.child = None
         if out:
             out.close()
+            sys.stdout.write(Path(tee).read_text())
         return "cut" if cut else ("ran" if code == 0 else "failed")
 
     def step(self, name, commands, blocks=None, most=None):
