@@ -367,25 +367,22 @@ impl ExperimentRecord<PlannedRunRecord> {
 
 /// Writes `value` as pretty JSON to `dir/name` (probe.json, overhead.json), the path named when it cannot be.
 pub fn write_json_file<T: Serialize + ?Sized>(dir: &Path, name: &str, value: &T) -> Result<()> {
-    let path = dir.join(name);
-    let json = serde_json::to_string_pretty(value)?;
-    std::fs::write(&path, json).map_err(|e| Error::Output {
-        path: path.clone(),
-        problem: format!("cannot be written ({e})"),
-    })
+    write_output(&dir.join(name), serde_json::to_string_pretty(value)?)
 }
 
 /// Writes `value` as compact JSON on one line to `dir/name` (answer.json, whose value objects are half whitespace
-/// when indented), the path named when it cannot be.
+/// when indented; score's run.json), the path named when it cannot be.
 pub fn write_compact_json_file<T: Serialize + ?Sized>(
     dir: &Path,
     name: &str,
     value: &T,
 ) -> Result<()> {
-    let path = dir.join(name);
-    let json = serde_json::to_string(value)? + "\n";
-    std::fs::write(&path, json).map_err(|e| Error::Output {
-        path: path.clone(),
+    write_output(&dir.join(name), serde_json::to_string(value)? + "\n")
+}
+
+fn write_output(path: &Path, text: String) -> Result<()> {
+    std::fs::write(path, text).map_err(|e| Error::Output {
+        path: path.to_path_buf(),
         problem: format!("cannot be written ({e})"),
     })
 }

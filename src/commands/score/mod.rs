@@ -294,9 +294,8 @@ fn write_manifest(
             "path_fps": folder.manifest.fps,
         },
     });
-    let path = out.join(RUN_JSON);
-    // Compact, as every run.json is (results::manifest::Manifest::write).
-    std::fs::write(&path, serde_json::to_string(&json)? + "\n").map_err(|e| Error::io(&path, e))
+    // Compact, as every run.json is (results::manifest::RunManifest::write).
+    crate::results::manifest::write_compact_json_file(out, RUN_JSON, &json)
 }
 
 fn print_transitions(found: &[crate::measure::records::TransitionRecord], budget: Option<f64>) {
