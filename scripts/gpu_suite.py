@@ -35,6 +35,9 @@ import sys
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from lodbench_results import PROBE_CSV, read_csv  # noqa: E402  (beside this file)
+
 ROOT = Path(__file__).resolve().parents[1]
 EXPERIMENTS = ["aa-gpu", "fsi-fig8", "sheliemietiev-fig5", "sheliemietiev-fig6", "trees-sorting", "unified-lod",
                "terrain-equal-error", "frontier"]
@@ -196,10 +199,7 @@ def overhead_blocks(scenes: Scenes):
 def probe_rates(folder: Path):
     """(triangles a second, blended fragments a second) from the probe's probe.csv: the slower of the plain and the
     instanced triangle rates."""
-    import csv
-
-    with open(folder / "probe.csv") as f:
-        rows = {r["probe"]: float(r["rate_median"]) for r in csv.DictReader(f)}
+    rows = {r["probe"]: float(r["rate_median"]) for r in read_csv(folder / PROBE_CSV)}
     return min(rows["triangles"], rows["triangles-instanced"]), rows["fill-blended"]
 
 

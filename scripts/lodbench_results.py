@@ -75,6 +75,7 @@ READS = {
     PERCEPTUAL_CSV: ("scene", "method", "count", "jod_popping"),
     TUNE_CSV: ("model", "lod_from", "lod_to", "view", "distance", "lodpop", "jod", "refined"),
     RULES_CSV: ("model", "lod_from", "lod_to", "rule", "distance", "screen_size", "value", "within_budget"),
+    PROBE_CSV: ("probe", "rate_median"),
 }
 
 # The columns an experiment's or a merged folder's CSVs lead with, before the record's own: one per swept variable

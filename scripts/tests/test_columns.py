@@ -52,6 +52,13 @@ NOT_COLUMNS = {
     },
     "equal_error.py": {"triangles", "cost"},  # its points' values, named by COLUMNS
     "frontier.py": {"axes.prop_cycle", "color"},  # matplotlib's rcParams
+    "gpu_suite.py": {
+        "triangles", "triangles-instanced", "fill-blended",  # probe.csv's rows, keyed by its `probe` column
+        "models", "instance_counts", "width", "height",  # `lodbench describe --json` (a model's lods' triangles)
+        "run", "sweep", "profile", "quality", "variable", "variables", "values",  # an experiment file's TOML
+        "status", "ran", "cut", "left",  # its own budget.json entries
+        "FRAMES", "LODBENCH",  # the environment
+    },
     "plot.py": TUNE_JSON_KEYS | {
         "fov_y_deg", "band", "bands", "switch_distance", "triangles_from", "triangles_to", "value_at_switch",
         "checked_worst", "error_px_at_switch",  # tune.json
