@@ -22,6 +22,7 @@ from pathlib import Path
 FRAMES_CSV = "frames.csv"
 SUMMARY_CSV = "summary.csv"
 TRANSITIONS_CSV = "transitions.csv"
+EVENTS_CSV = "events.csv"
 ROUNDS_CSV = "rounds.csv"
 PAIRS_CSV = "pairs.csv"
 PERCEPTUAL_CSV = "perceptual.csv"

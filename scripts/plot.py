@@ -837,8 +837,9 @@ def visible_pops(summary, header, lead, runs):
     fps = report_html.path_fps(runs)
     at = (f"at {fps[0]:g} frames a second (run.json's path_fps)" if len(fps) == 1 else
           "at each run's frame rate (its run.json's path_fps)" if fps else "at its frame rate")
-    note = ("visible_pops_per_min: a method's pop events (its transitions, those that start within 3 frames of the "
-            "last one's end joined into one event, scored by the root of the sum of their lodpop_max squared) "
+    note = ("visible_pops_per_min: a method's pop events (events.csv: its instances' switches, those that begin "
+            "within 0.1 s of a wave's first joined into one event, scored by the root of the sum of their lodpop "
+            "squared) "
             "whose score exceeds visible_pop_threshold (1 JND of the calibration; without one the run's "
             "`--budget-lodpop`, else half the hard switch's largest lodpop), per minute of the path "
             f"{at}; pop_events counts them all. Empty: not measured (no threshold, or no lodpop). Full precision in "

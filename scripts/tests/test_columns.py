@@ -22,6 +22,7 @@ RECORDS = {
     results.FRAMES_CSV: ("src/measure/records/rows.rs", "FrameRecord"),
     results.SUMMARY_CSV: ("src/measure/records/summaries.rs", "SummaryRecord"),
     results.TRANSITIONS_CSV: ("src/measure/records/transitions.rs", "TransitionRecord"),
+    results.EVENTS_CSV: ("src/measure/records/events.rs", "EventRecord"),
     results.ROUNDS_CSV: ("src/measure/records/summaries.rs", "RoundRecord"),
     results.PAIRS_CSV: ("src/measure/records/summaries.rs", "PairRecord"),
     results.PERCEPTUAL_CSV: ("src/commands/perceptual.rs", "PerceptualRecord"),
@@ -197,8 +198,8 @@ def test_every_record_parses():
 
 def test_the_parsed_records_are_the_headers_lodbench_writes(dump):
     """The parse against a run's own CSVs: the same columns in the same order."""
-    for csv_name in (results.FRAMES_CSV, results.SUMMARY_CSV, results.TRANSITIONS_CSV, results.ROUNDS_CSV,
-                     results.PAIRS_CSV):
+    for csv_name in (results.FRAMES_CSV, results.SUMMARY_CSV, results.TRANSITIONS_CSV, results.EVENTS_CSV,
+                     results.ROUNDS_CSV, results.PAIRS_CSV):
         written = (dump / csv_name).read_text().splitlines()[0].split(",")
         assert header(csv_name) == written, csv_name
 

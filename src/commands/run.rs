@@ -7,13 +7,13 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::measure::records::{
     pair_records, round_records, set_visible_pops, BlockInfo, Clock, FrameRecord, PairRecord,
-    RoundRecord, SummaryRecord, TransitionRecord, Visibility,
+    RoundRecord, SummaryRecord, SwitchRecord, TransitionRecord, Visibility,
 };
 use crate::measure::{BlockOutput, BlockRunner, FrameImages, MethodSetup, QualityOptions};
 use crate::methods::{is_reference, Registry};
 use crate::results::answer::AnswerFile;
 use crate::results::csv::{
-    write_pairs, write_rounds, write_summary, write_transitions, FramesWriter,
+    write_events, write_pairs, write_rounds, write_summary, write_transitions, FramesWriter,
 };
 use crate::results::files::{stale_run_files, WRITE_PROBE};
 use crate::results::manifest::{now_rfc3339, peak_resident_bytes, RunManifest, RunStatus};
@@ -188,6 +188,7 @@ struct RunOutput {
     frames_csv: FramesWriter,
     summaries: Vec<SummaryRecord>,
     transitions: Vec<TransitionRecord>,
+    switches: Vec<SwitchRecord>,
     rounds: Vec<RoundRecord>,
     pairs: Vec<PairRecord>,
 }
@@ -228,6 +229,7 @@ fn run_blocks(
         frames_csv: FramesWriter::create(out_dir)?,
         summaries: Vec::new(),
         transitions: Vec::new(),
+        switches: Vec::new(),
         rounds: Vec::new(),
         pairs: Vec::new(),
     };
@@ -267,7 +269,31 @@ fn run_blocks(
     for s in &mut output.summaries {
         s.set_ceiling(ceiling, manifest.fragment_ceiling);
     }
-    // Over 1 JND with a calibration (whatever the budget), else over the budget.
+    let RunOutput {
+        mut summaries,
+        mut transitions,
+        switches,
+        rounds,
+        pairs,
+        ..
+    } = output;
+    write_run_csvs(cfg, out_dir, (&mut summaries, &mut transitions, &switches))?;
+    write_rounds(out_dir, &rounds)?;
+    write_pairs(out_dir, &pairs)?;
+    Ok((summaries, pairs))
+}
+
+/// The visible pops (over 1 JND with a calibration, whatever the budget, else over the budget), then
+/// summary.csv, transitions.csv and events.csv, each whole.
+fn write_run_csvs(
+    cfg: &RunConfig,
+    out_dir: &Path,
+    (summaries, transitions, switches): (
+        &mut [SummaryRecord],
+        &mut [TransitionRecord],
+        &[SwitchRecord],
+    ),
+) -> Result<()> {
     let visibility = Visibility {
         threshold: match &cfg.calibration {
             Some(j) => Some(j.value_of(1.0)),
@@ -276,12 +302,11 @@ fn run_blocks(
         fps: cfg.path_fps,
         jnd: cfg.calibration.as_ref().map(|j| j.threshold),
     };
-    set_visible_pops(&mut output.summaries, &mut output.transitions, visibility);
-    write_summary(out_dir, &output.summaries)?;
-    write_transitions(out_dir, &output.transitions)?;
-    write_rounds(out_dir, &output.rounds)?;
-    write_pairs(out_dir, &output.pairs)?;
-    Ok((output.summaries, output.pairs))
+    let events = set_visible_pops(summaries, transitions, switches, visibility);
+    write_summary(out_dir, summaries)?;
+    write_transitions(out_dir, transitions)?;
+    write_events(out_dir, &events)?;
+    Ok(())
 }
 
 /// The adapter the run draws on, recorded in the manifest with its ceilings (`--ceilings on`: measured now, and
@@ -393,6 +418,7 @@ fn record_outputs(
     for out in outputs {
         output.frames_csv.write_block(&out.rows)?;
         output.transitions.extend(out.transitions);
+        output.switches.extend(out.switches);
         measured.push(MeasuredMethod {
             extra_target_bytes: out.info.extra_target_bytes,
             rows: out.rows,

@@ -20,8 +20,8 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::measure::metrics::Metric;
 use crate::measure::records::{
-    near_transitions, transitions, BlockInfo, BlockRounds, FrameRecord, TransitionPair,
-    TransitionRecord,
+    near_transitions, switches, transitions, BlockInfo, BlockRounds, FrameRecord, SwitchRecord,
+    TransitionPair, TransitionRecord,
 };
 use crate::methods::{is_reference, Method};
 use crate::rng::SplitMix64;
@@ -32,6 +32,8 @@ use indicatif::ProgressBar;
 pub struct BlockOutput {
     pub rows: Vec<FrameRecord>,
     pub transitions: Vec<TransitionRecord>,
+    /// Each instance's switches (`records::events`; none without a quality pass).
+    pub switches: Vec<SwitchRecord>,
     pub info: BlockInfo,
 }
 
@@ -187,8 +189,10 @@ impl<'a> BlockRunner<'a> {
             base.ctx.check_errors()?;
             let rows = self.frame_records(m, quality.as_ref());
             let pairs: Vec<TransitionPair> = m.facts.iter().map(|f| f.pair).collect();
+            let changes = quality.as_ref().map_or(&[][..], |q| &q.changes);
             outputs.push(BlockOutput {
                 transitions: transitions(&rows, &pairs),
+                switches: switches(&rows, changes),
                 rows,
                 info: self.block_info(m, quality.as_ref(), reference_ms.as_deref()),
             });

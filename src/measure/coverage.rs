@@ -166,7 +166,7 @@ pub struct Coverage {
     height: u32,
     tiles_x: u32,
     tiles_y: u32,
-    /// Each model's reach box.
+    /// Each model's reach box (used for the bound only when `bounded`).
     boxes: Vec<(Vec3, Vec3)>,
     /// The tiles the previous frame covered (None before the first frame).
     previous: Option<Vec<bool>>,
@@ -184,15 +184,11 @@ impl Coverage {
             height: scene.height,
             tiles_x: scene.width.div_ceil(TILE),
             tiles_y: scene.height.div_ceil(TILE),
-            boxes: if bounded {
-                scene
-                    .models
-                    .iter()
-                    .map(|m| m.deformed_reach.unwrap_or_else(|| reach_box(&m.chain)))
-                    .collect()
-            } else {
-                Vec::new()
-            },
+            boxes: scene
+                .models
+                .iter()
+                .map(|m| m.deformed_reach.unwrap_or_else(|| reach_box(&m.chain)))
+                .collect(),
             previous: None,
         }
     }
@@ -224,6 +220,19 @@ impl Coverage {
             self.width,
             self.height,
         )
+    }
+
+    /// The pixels of instance `i`'s rectangle on this frame, bounded or not: its weight among the instances
+    /// that switch on one frame (`records::events`).
+    pub fn instance_pixels(&self, scene: &Scene, i: usize, matrix: Mat4, view_proj: Mat4) -> u64 {
+        let model = scene.instances[i].model as usize;
+        project_box(
+            self.boxes[model],
+            view_proj * matrix,
+            self.width,
+            self.height,
+        )
+        .pixels()
     }
 
     /// The union of the rectangles of the instances `which` picks (empty when it picks none).

@@ -4,14 +4,14 @@
 
 use crate::error::{Error, Result};
 use crate::measure::records::{
-    FrameRecord, FrameTimes, PairRecord, RoundRecord, SummaryRecord, TransitionRecord,
+    EventRecord, FrameRecord, FrameTimes, PairRecord, RoundRecord, SummaryRecord, TransitionRecord,
 };
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use super::files::partial;
 pub use super::files::{
-    FRAMES_CSV, PAIRS_CSV, PARTIAL_SUFFIX, ROUNDS_CSV, SUMMARY_CSV, TRANSITIONS_CSV,
+    EVENTS_CSV, FRAMES_CSV, PAIRS_CSV, PARTIAL_SUFFIX, ROUNDS_CSV, SUMMARY_CSV, TRANSITIONS_CSV,
 };
 
 /// Appends frame rows to `frames.csv.partial`; `finish` renames it to `frames.csv`.
@@ -69,6 +69,11 @@ pub fn write_whole<T: serde::Serialize>(dir: &Path, name: &str, rows: &[T]) -> R
 /// Writes summary.csv (whole or not at all).
 pub fn write_summary(dir: &Path, rows: &[SummaryRecord]) -> Result<PathBuf> {
     write_whole(dir, SUMMARY_CSV, rows)
+}
+
+/// Writes events.csv (whole or not at all).
+pub fn write_events(dir: &Path, rows: &[EventRecord]) -> Result<PathBuf> {
+    write_whole(dir, EVENTS_CSV, rows)
 }
 
 /// Writes transitions.csv (whole or not at all).

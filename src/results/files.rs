@@ -4,7 +4,7 @@
 //! A run folder (`lodbench run --out DIR`):
 //! - [`RUN_JSON`]: what was run and whether it finished (`results::manifest::RunManifest`);
 //! - [`FRAMES_CSV`] (written as `frames.csv.partial` until the run completes), [`SUMMARY_CSV`],
-//!   [`TRANSITIONS_CSV`], [`ROUNDS_CSV`], [`PAIRS_CSV`] (`results::csv`);
+//!   [`TRANSITIONS_CSV`], [`EVENTS_CSV`], [`ROUNDS_CSV`], [`PAIRS_CSV`] (`results::csv`);
 //! - [`FRAMES_DIR`]`/`: with `--dump-frames`, `<stem>_<kind>.png` per dumped frame ([`DumpKind`]);
 //! - [`CLIPS_DIR`]`/`: `lodbench clips`, with [`INDEX_JSON`] (built as `clips.partial/`);
 //! - [`PERCEPTUAL_CSV`]: `lodbench perceptual`;
@@ -24,6 +24,8 @@ use std::path::{Path, PathBuf};
 pub const FRAMES_CSV: &str = "frames.csv";
 pub const SUMMARY_CSV: &str = "summary.csv";
 pub const TRANSITIONS_CSV: &str = "transitions.csv";
+/// The pop events, waves of switches (`measure::records::events`).
+pub const EVENTS_CSV: &str = "events.csv";
 pub const ROUNDS_CSV: &str = "rounds.csv";
 pub const PAIRS_CSV: &str = "pairs.csv";
 pub const PERCEPTUAL_CSV: &str = "perceptual.csv";
@@ -99,10 +101,11 @@ pub const PARTIAL_SUFFIX: &str = ".partial";
 pub const WRITE_PROBE: &str = ".lodbench-write-test";
 
 /// The CSV files of a run folder that an experiment, and `lodbench merge`, join across runs.
-pub const RUN_CSVS: [&str; 5] = [
+pub const RUN_CSVS: [&str; 6] = [
     FRAMES_CSV,
     SUMMARY_CSV,
     TRANSITIONS_CSV,
+    EVENTS_CSV,
     ROUNDS_CSV,
     PAIRS_CSV,
 ];
@@ -114,11 +117,12 @@ pub fn partial(name: &str) -> String {
 
 /// The result files of an earlier run that a new run in the same folder removes first, so nothing stale looks
 /// complete.
-pub fn stale_run_files() -> [String; 6] {
+pub fn stale_run_files() -> [String; 7] {
     [
         FRAMES_CSV.to_string(),
         SUMMARY_CSV.to_string(),
         TRANSITIONS_CSV.to_string(),
+        EVENTS_CSV.to_string(),
         ROUNDS_CSV.to_string(),
         PAIRS_CSV.to_string(),
         partial(FRAMES_CSV),

@@ -276,3 +276,49 @@ fn a_switch_of_colour_is_shading_and_a_switch_of_outline_is_coverage() {
         assert_eq!(transitions[0][part], transitions[0]["lodpop_max"], "{file}");
     }
 }
+
+/// (f) A planted wave: bunny-grid's two bunnies (x = 13.28 and 61.35) seen from a camera that backs away along
+/// their perpendicular bisector, so both are at one distance on every frame and switch together at each of the
+/// three switch distances. events.csv has a wave per switch distance, each of both bunnies' switches, scored by
+/// the combined change of its frame (discrete: both switch on one frame, so the event's lodpop is that frame's;
+/// dither: the fade's largest frame at least); every squared lodpop of discrete's frames is some event's.
+#[rustfmt::skip]
+#[test]
+fn a_wave_of_instances_switching_together_is_one_event() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("path.csv");
+    let mid = 0.5 * (13.278 + 61.35);
+    std::fs::write(&path, format!("frame,x,y,z,target_x,target_y,target_z\n0,{mid},0,32,{mid},0,0\n1,{mid},0,100,{mid},0,0\n")).unwrap();
+    let out = run_into(&dir.path().join("run"), &[
+        "--scene", "bunny-grid", "--count", "2", "--camera-path", path.to_str().unwrap(), "--frames", "60",
+        "--width", "128", "--height", "96", "--switch-distances", "45,60,80", "--rounds", "1", "--warmup", "0",
+        "--method", "discrete,dither",
+    ]);
+    let frames = read_csv(&out.join("frames.csv"));
+    let events = read_csv(&out.join("events.csv"));
+    let num = |r: &std::collections::HashMap<String, String>, c: &str| r[c].parse::<f64>().unwrap();
+    for method in ["discrete", "dither"] {
+        let mine: Vec<_> = events.iter().filter(|e| e["method"] == method).collect();
+        assert_eq!(mine.len(), 3, "{method}: a wave per switch distance: {mine:?}");
+        assert!(mine.iter().all(|e| e["switches"] == "2"), "{method}: both bunnies in each wave: {mine:?}");
+        let lodpop = col(&frames, method, "lodpop");
+        for e in &mine {
+            let (a, b) = (num(e, "first_frame") as usize, num(e, "last_frame") as usize);
+            let largest = lodpop[a..=b + 2].iter().cloned().fold(0.0, f64::max);
+            assert!(largest > 0.0, "{method}: the wave changes its frames");
+            assert!(num(e, "lodpop") >= largest * (1.0 - 1e-9), "{method}: {e:?} against its frame's {largest}");
+        }
+    }
+    let discrete: Vec<_> = events.iter().filter(|e| e["method"] == "discrete").collect();
+    for e in &discrete {
+        assert_eq!(e["first_frame"], e["last_frame"], "a discrete switch is one frame, both on the same");
+        let f = num(e, "first_frame") as usize;
+        let on_frame = col(&frames, "discrete", "lodpop")[f];
+        assert!((num(e, "lodpop") - on_frame).abs() <= 1e-12, "{e:?}: the frame's {on_frame}");
+    }
+    let frames_sq: f64 = col(&frames, "discrete", "lodpop").iter().map(|l| l * l).sum();
+    let events_sq: f64 = discrete.iter().map(|e| num(e, "lodpop").powi(2)).sum();
+    assert!((frames_sq - events_sq).abs() <= 1e-12 * frames_sq.max(1e-12), "{frames_sq} against {events_sq}");
+    let summary = read_csv(&out.join("summary.csv"));
+    assert!(summary.iter().all(|s| s["pop_events"] == "3"), "{summary:?}");
+}

@@ -16,10 +16,11 @@ use crate::error::{Error, Result};
 use crate::measure::frame_figures::{FramePictures, ImageFigures, SequenceFigures};
 use crate::measure::metrics::Metric;
 use crate::measure::records::{
-    set_visible_pops, transitions, Clock, FrameRecord, SummaryRecord, TransitionPair, Visibility,
+    set_visible_pops, switches, transitions, Clock, FrameChanges, FrameRecord, SummaryRecord,
+    TransitionPair, Visibility,
 };
 use crate::results::csv::{
-    write_pairs, write_rounds, write_summary, write_transitions, FramesWriter,
+    write_events, write_pairs, write_rounds, write_summary, write_transitions, FramesWriter,
 };
 use crate::results::files::{DumpKind, RUN_JSON};
 use crate::results::png::{FrameDumper, FrameId};
@@ -50,13 +51,20 @@ pub fn execute(args: &ScoreArgs) -> Result<()> {
         fps: folder.manifest.fps,
         jnd: None,
     };
-    set_visible_pops(&mut summaries, &mut found, visibility);
+    let changed = changed_objects(&folder.selections);
+    let events = set_visible_pops(
+        &mut summaries,
+        &mut found,
+        &switches(&rows, &changed),
+        visibility,
+    );
     link_pictures(&folder, &out, (&scene, &method))?;
     let mut frames_csv = FramesWriter::create(&out)?;
     frames_csv.write_block(&rows)?;
     frames_csv.finish()?;
     write_summary(&out, &summaries)?;
     write_transitions(&out, &found)?;
+    write_events(&out, &events)?;
     write_rounds(&out, &[])?;
     write_pairs(&out, &[])?;
     write_manifest(&folder, args, &out, (&scene, &method))?;
@@ -138,6 +146,23 @@ fn load(path: &Path) -> Result<image::RgbaImage> {
 
 /// A frame's objects in transition: (from, to, k) of each ([`in_transition`]).
 type Moving = Vec<(u32, u32, f64)>;
+
+/// Per frame, the objects whose selection differs from the frame before's (a blend's every frame), each of
+/// weight 1: a renderer's folder holds no object's size on screen, so a frame's change is shared equally.
+fn changed_objects(selections: &[Vec<Selection>]) -> Vec<FrameChanges> {
+    (0..selections.len())
+        .map(|f| match f.checked_sub(1) {
+            Some(p) => selections[f]
+                .iter()
+                .zip(&selections[p])
+                .enumerate()
+                .filter(|(_, (now, before))| now != before)
+                .map(|(i, _)| (i as u32, 1.0))
+                .collect(),
+            None => Vec::new(),
+        })
+        .collect()
+}
 
 /// Per frame, the pair of levels its objects in transition (`moving`, [`in_transition`]) go between.
 fn frame_pairs(moving: &[Moving]) -> Vec<TransitionPair> {

@@ -9,6 +9,7 @@ use crate::measure::metrics::MetricRegion;
 use crate::measure::quality::collect::FrameReads;
 use crate::measure::quality::history::{SameImage, StateHistory};
 use crate::measure::quality::setup::QualityStage;
+use crate::measure::records::FrameChanges;
 use crate::methods::common::{Counterfactual, DumpKind};
 use crate::methods::FrameInput;
 use crate::scene::schedule::InstanceState;
@@ -26,7 +27,53 @@ pub(super) struct Counterfactuals {
     pub(super) compared: bool,
 }
 
+/// Whether two states of an instance draw the same image of it, by the method's own test
+/// (`Counterfactual::same_image_state`) where `by_method`, else only when they are equal. A transition's moving
+/// pattern (dither --noise-temporal) changes an instance in transition every frame.
+fn same_image(
+    method: &dyn Counterfactual,
+    by_method: bool,
+) -> impl Fn(&InstanceState, &InstanceState) -> bool + '_ {
+    let moving = method.transition_pattern_moves();
+    move |a: &InstanceState, b: &InstanceState| {
+        !(moving && (a.in_transition() || b.in_transition()))
+            && match by_method {
+                true => method.same_image_state(a, b),
+                false => a == b,
+            }
+    }
+}
+
 impl QualityStage {
+    /// The units whose image changed on this frame (after `history`'s push), for the pop events
+    /// (`records::events`): each instance whose state draws differently from an earlier frame's in the history
+    /// by the method's own test (or is in transition, with a history deeper than one frame), weighted by its
+    /// screen rectangle's pixels (one off screen changes no pixel and is left out); and, where the method's own selection changed (`selection_changed`), the whole
+    /// frame as one unit past the instances.
+    pub(super) fn switched_units(
+        base: &BlockGpu<'_>,
+        method: &dyn Counterfactual,
+        (input, history): (&FrameInput<'_>, &StateHistory),
+        coverage: &Coverage,
+    ) -> FrameChanges {
+        let same = same_image(method, true);
+        let view_proj = base.scene.camera(input.frame).view_proj();
+        let mut out: FrameChanges = history
+            .changed_instances(same)
+            .into_iter()
+            .map(|i| {
+                let px = coverage.instance_pixels(base.scene, i, input.matrices[i], view_proj);
+                (i as u32, px as f64)
+            })
+            .filter(|&(_, px)| px > 0.0)
+            .collect();
+        if method.selection_changed() {
+            let whole = base.scene.width as f64 * base.scene.height as f64;
+            out.push((input.states.len() as u32, whole));
+        }
+        out
+    }
+
     pub(super) fn copy_of(
         &self,
         base: &BlockGpu<'_>,
@@ -59,22 +106,15 @@ impl QualityStage {
         let f = input.frame;
         let taa = self.taa.as_ref();
         let full = PixelRect::full(base.scene.width, base.scene.height);
-        let covered = self.region == MetricRegion::Covered;
-        // A transition's moving pattern (dither --noise-temporal) changes an instance in transition every frame.
-        let moving = method.transition_pattern_moves();
-        let same = |a: &InstanceState, b: &InstanceState| {
-            !(moving && (a.in_transition() || b.in_transition()))
-                && match covered {
-                    true => method.same_image_state(a, b),
-                    false => a == b,
-                }
+        let (changed, rect) = {
+            let same = same_image(&*method, self.region == MetricRegion::Covered);
+            let changed = history.changed(&same, || method.selection_changed());
+            let rect = match (changed, dump) {
+                (true, false) => Self::changed_rect(base, input, history, (coverage, &same)),
+                _ => full,
+            };
+            (changed && !rect.is_empty(), rect)
         };
-        let mut changed = history.changed(same, || method.selection_changed());
-        let rect = match (changed, dump) {
-            (true, false) => Self::changed_rect(base, input, history, (coverage, &same)),
-            _ => full,
-        };
-        changed &= !rect.is_empty();
         let unlagged = self.encode_unlagged(base, method, (input, changed), encoder);
         if changed {
             let earlier = history.earlier();

@@ -68,7 +68,7 @@ impl QualityStage {
             .queue
             .submit(shadows.into_iter().chain([encoder.finish()]));
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        walk.history.push(&driver.states);
+        walk.push_states(base, method, &input);
         let drawn = ask_counterfactual(method, |method| {
             self.counterfactuals(
                 base,

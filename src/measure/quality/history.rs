@@ -47,6 +47,29 @@ impl StateHistory {
                 || selection_changed())
     }
 
+    /// The instances whose state this frame (after `push`) is not `same` as in an earlier frame of the history,
+    /// or, with a history deeper than one frame, is in transition in any (the per-instance [`Self::changed`]).
+    pub(super) fn changed_instances(
+        &self,
+        same: impl Fn(&InstanceState, &InstanceState) -> bool,
+    ) -> Vec<usize> {
+        let h = &self.frames;
+        let Some(now) = h.front().filter(|_| h.len() > 1) else {
+            return Vec::new();
+        };
+        let deep = self.depth > 1;
+        (0..now.len())
+            .filter(|&i| {
+                h.iter()
+                    .skip(1)
+                    .any(|e| e.get(i).is_none_or(|b| !same(b, &now[i])))
+                    || (deep
+                        && h.iter()
+                            .any(|e| e.get(i).is_some_and(|s| s.in_transition())))
+            })
+            .collect()
+    }
+
     /// The earlier frames' states, newest first.
     pub(super) fn earlier(&self) -> Vec<&[InstanceState]> {
         self.frames.iter().skip(1).map(Vec::as_slice).collect()

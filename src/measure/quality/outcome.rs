@@ -41,6 +41,8 @@ pub struct QualityPass {
     pub reference_frames_copied: u32,
     /// The pass's segments (one per timing round), each timed on its own.
     pub segments: Vec<SegmentCost>,
+    /// Per frame, the units whose image changed on it, with their weights (`records::events`).
+    pub changes: Vec<crate::measure::records::FrameChanges>,
 }
 
 /// The images of one dumped quality-pass frame, RGBA8.

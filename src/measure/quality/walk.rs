@@ -11,6 +11,7 @@ use crate::measure::metrics::MetricRegion;
 use crate::measure::quality::history::StateHistory;
 use crate::measure::quality::outcome::{FrameImages, QualityPass, SegmentCost, ShadowFigures};
 use crate::measure::quality::setup::QualityStage;
+use crate::measure::records::FrameChanges;
 use crate::measure::reference_cache::ReferenceCache;
 use crate::methods::common::ask_counterfactual;
 use crate::methods::Method;
@@ -46,6 +47,25 @@ pub struct Walk {
     pub(super) fragments: FragmentRows,
     /// The pass's segments so far.
     pub(super) segments: Vec<SegmentCost>,
+    /// Per frame, the units whose image changed on it (`QualityStage::switched_units`).
+    pub(super) changes: Vec<FrameChanges>,
+}
+
+impl Walk {
+    /// Pushes this frame's states onto lodpop's history and records which instances changed on it (the pop
+    /// events' switches, `QualityStage::switched_units`).
+    pub(super) fn push_states(
+        &mut self,
+        base: &BlockGpu<'_>,
+        method: &mut dyn Method,
+        input: &crate::methods::FrameInput<'_>,
+    ) {
+        self.history.push(input.states);
+        let (history, coverage) = (&self.history, &self.coverage);
+        self.changes[input.frame as usize] = ask_counterfactual(method, |m| {
+            QualityStage::switched_units(base, m, (input, history), coverage)
+        });
+    }
 }
 
 impl QualityStage {
@@ -80,6 +100,7 @@ impl QualityStage {
             metric_timed: Vec::new(),
             fragments: FragmentRows::new(base.scene.frames),
             segments: Vec::new(),
+            changes: vec![Vec::new(); base.scene.frames as usize],
         };
         walk.coverage.reset();
         walk
@@ -178,6 +199,7 @@ impl QualityStage {
             reference_frames_copied: walk.reference_copied,
             ms_per_frame: walk.segments.iter().map(|s| s.ms).sum::<f64>() / frames.max(1) as f64,
             segments: walk.segments,
+            changes: walk.changes,
         })
     }
 }

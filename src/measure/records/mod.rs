@@ -5,7 +5,8 @@
 //! - `rows.rs`: the frame rows and the block's sizes and rounds;
 //! - `summaries.rs`: the statistics (summary.csv, the clock, the paired ratios, rounds.csv, pairs.csv);
 //! - `transitions.rs`: transition detection (transitions.csv, the frames `--dump-transitions` dumps);
-//! - `events.rs`: transitions grouped into the pop events a person sees (summary.csv's visible pops).
+//! - `events.rs`: each instance's switches grouped into the waves a person sees (events.csv, summary.csv's
+//!   visible pops).
 //!
 //! Every figure of the quality pass is an `Option`: empty (never 0) in a run without it (`--quality off`).
 
