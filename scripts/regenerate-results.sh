@@ -202,7 +202,8 @@ read_check() {
 export -f read_check
 
 # Keeps in $1 (the new folder) what the committed folder $2 keeps: a file whose name the committed folder has
-# (anywhere in it: a new run of an experiment keeps what the other runs keep), and figures/ where it has figures.
+# (anywhere in it: a new run of an experiment keeps what the other runs keep), events.csv where it has
+# transitions.csv, and figures/ where it has figures.
 prune() {
     local new=$1 old=$2 rel
     local -A kept=()
@@ -212,6 +213,8 @@ prune() {
         [[ $rel == figures/* || $rel == */figures/* ]] && figures=1
         [[ $rel == clips/* ]] && clips=1
     done < <(git ls-files -- "$old" | sed "s|^$old/||")
+    # events.csv is newer than most committed folders: kept wherever the run's transitions.csv is.
+    [[ -n ${kept[transitions.csv]:-} ]] && kept[events.csv]=1
     while IFS= read -r rel; do
         rel=${rel#./}
         [[ -n ${kept[${rel##*/}]:-} ]] && continue
