@@ -1,7 +1,8 @@
 //! `lodbench score DIR` (docs/measurement.md, "Scoring another renderer's frames"): (a) a score folder written
 //! from a run's own dumps (its frames, counterfactuals and reference, and the levels its schedule drew) gives
-//! back that run's frames.csv image columns exactly, for a switching and two blending methods; (b) a folder
-//! that breaks the protocol is refused with one error naming what is wrong, and nothing is written.
+//! back that run's frames.csv image columns exactly, and its events.csv, for a switching and two blending
+//! methods; (b) a folder that breaks the protocol is refused with one error naming what is wrong, and nothing
+//! is written.
 
 use crate::common::{fails_with, lodbench, read_csv, run_into, sweep_scene};
 use lodbench::measure::FrameDriver;
@@ -145,6 +146,25 @@ fn a_runs_own_dumps_score_to_its_frames_csv_exactly() {
             "{method}: {} transitions",
             transitions.len()
         );
+        // The pop events: the run's instance switches (its schedule) and score's object switches (lods.csv) are
+        // the same frames, and one object takes each frame's whole change, so the events are the run's.
+        let events = |path: &Path| -> Vec<Vec<String>> {
+            read_csv(path)
+                .iter()
+                .filter(|r| r["method"] == method)
+                .map(|r| {
+                    ["event", "first_frame", "last_frame", "switches", "lodpop"]
+                        .map(|c| r[c].clone())
+                        .to_vec()
+                })
+                .collect()
+        };
+        let (ours, scored_events) = (
+            events(&run.join("events.csv")),
+            events(&folder.join("events.csv")),
+        );
+        assert!(ours.len() >= 3, "{method}: {ours:?}");
+        assert_eq!(ours, scored_events, "{method}: events.csv, run vs score");
         // clips and perceptual read the pictures under a run's dump names.
         let linked =
             folder.join("frames/bunny-sweep_".to_string() + method + "_c1_f00000_method.png");

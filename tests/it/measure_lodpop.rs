@@ -3,7 +3,7 @@
 //! smooth method below discrete at every transition of a bunny sweep; (d) the GPU kernel against the CPU
 //! oracle on dumped frames, for lodpop, its coverage and shading parts and FSI's lag_rmse; and fsi-sameframe,
 //! which has no lag, at lag 0; (e) a switch that changes colours only is all shading, one that changes the
-//! outline only all coverage.
+//! outline only all coverage; (f) instances switching together are one pop event (events.csv).
 
 use crate::common::{col, read_csv, run_into, Rows};
 
