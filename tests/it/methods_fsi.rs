@@ -1,6 +1,7 @@
 //! Frame Sequential Interpolation on the software adapter (image tests a-f). The combination pass is
 //! checked pixel by pixel against a CPU implementation of Scherzer & Wimmer 2008 sections 3.4-3.5 and eq. 2 that reads the
-//! same two LOD buffers (colour, depth, id) back from the GPU.
+//! same two LOD buffers (colour, depth, id) back from the GPU. That its combination pass holds no memory per
+//! frame is a long-suite test (tests/long/methods_fsi_memory.rs).
 
 use glam::{Mat4, Vec4};
 use indicatif::ProgressBar;
@@ -11,9 +12,7 @@ use lodbench::methods::fsi::{reprojection, Fsi, FsiCheck, LodBufferImage, Varian
 use lodbench::methods::{Method, MethodOptions};
 use lodbench::scene::{Scene, SceneDef, SceneKind};
 
-use crate::common::{
-    lodbench, near_distance, scene_config as scene_cfg, srgb_to_linear, static_scene, H, W,
-};
+use crate::common::{near_distance, scene_config as scene_cfg, srgb_to_linear, static_scene, H, W};
 
 struct Frame {
     out: Vec<u8>,
@@ -605,54 +604,4 @@ fn h_frame_sequential_blending_mixes_by_k() {
         );
         assert!([64u8, 191].contains(&weights[0]), "{}", weights[0]);
     }
-}
-
-/// run.json's `peak_resident_bytes` of `lodbench run --scene bunny-sweep --method METHODS --profile ci --frames
-/// FRAMES`, in MiB, in rounds of 10 frames (the reference cache holds a round's frames, so its size is the same
-/// for any FRAMES); a process of its own, so that no other test's memory is in it.
-fn peak_resident_mib(methods: &str, frames: u32, dir: &std::path::Path) -> f64 {
-    let out = dir.join(format!("frames-{frames}"));
-    let (rounds, frames) = ((frames / 10).to_string(), frames.to_string());
-    let run = lodbench(
-        &[
-            "run",
-            "--scene",
-            "bunny-sweep",
-            "--method",
-            methods,
-            "--profile",
-            "ci",
-            "--frames",
-            &frames,
-            "--rounds",
-            &rounds,
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &[],
-    );
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert!(run.status.success(), "lodbench run failed: {stderr}");
-    let run: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
-    run["peak_resident_bytes"]
-        .as_u64()
-        .expect("peak_resident_bytes in run.json") as f64
-        / (1 << 20) as f64
-}
-
-/// FSI's combination pass holds no memory per frame. With the variant read from the uniform instead of fixed
-/// in the pipeline, lavapipe (Mesa 22.3) grew by about 330 KB a dispatch at the ci profile's 320x240, in every
-/// variant; fsi and fsi-blend with their quality passes dispatch it 4 to 6 times a frame, so 240 more frames
-/// would add over 300 MB. Without that growth the two peaks differ by about 3 MB (141.1 and 143.9 MiB when
-/// written); the bound of 32 MB sits far from both.
-#[test]
-fn the_combination_pass_holds_no_memory_per_frame() {
-    let dir = tempfile::tempdir().unwrap();
-    let short = peak_resident_mib("fsi,fsi-blend", 40, dir.path());
-    let long = peak_resident_mib("fsi,fsi-blend", 280, dir.path());
-    assert!(
-        long - short < 32.0,
-        "peak resident memory {short:.1} MiB after 40 frames, {long:.1} MiB after 280"
-    );
 }

@@ -9,7 +9,8 @@
 //!   quick profile's 600 frames (about 37 s);
 //! - `commands_cluster`: the GNU parallel and Slurm recipes, each a sharded experiment merged (Slurm's on a local
 //!   one-node cluster, about 12 s);
-//! - `commands_probe_bands`: `lodbench probe`'s timing bands, ratios of paired rounds measured up to three times.
+//! - `commands_probe_bands`: `lodbench probe`'s timing bands, ratios of paired rounds measured up to three times;
+//! - `methods_fsi_memory`: FSI's combination pass holds no memory per frame, 40 frames against 280 (about 15 s).
 
 #![allow(
     clippy::unwrap_used,
@@ -24,6 +25,7 @@ mod common;
 mod commands_clips;
 mod commands_cluster;
 mod commands_probe_bands;
+mod methods_fsi_memory;
 mod regress;
 mod scene_fidelity;
 
