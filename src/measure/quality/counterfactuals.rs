@@ -48,8 +48,8 @@ impl QualityStage {
     /// The units whose image changed on this frame (after `history`'s push), for the pop events
     /// (`records::events`): each instance whose state draws differently from an earlier frame's in the history
     /// by the method's own test (or is in transition, with a history deeper than one frame), weighted by its
-    /// screen rectangle's pixels (one off screen changes no pixel and is left out); and, where the method's own selection changed (`selection_changed`), the whole
-    /// frame as one unit past the instances.
+    /// screen rectangle's pixels (one off screen changes no pixel and is left out); and, where the method's own
+    /// selection changed (`selection_changed`), the whole frame as one unit past the instances.
     pub(super) fn switched_units(
         base: &BlockGpu<'_>,
         method: &dyn Counterfactual,

@@ -125,6 +125,33 @@ mod tests {
     }
 
     #[test]
+    fn the_changed_instances_are_those_whose_state_is_not_the_same() {
+        let before = states(&[(1, 1, 0.0), (2, 3, 0.4), (3, 3, 0.0)]);
+        let now = states(&[(1, 1, 0.0), (2, 3, 0.6), (4, 4, 0.0)]);
+        let mut h = StateHistory::new(1);
+        h.push(&before);
+        assert!(
+            h.changed_instances(|a, b| a == b).is_empty(),
+            "no earlier frame"
+        );
+        h.push(&now);
+        assert_eq!(h.changed_instances(|a, b| a == b), vec![1, 2]);
+        // A method that draws one LOD whatever k is (discrete): the blend's k moved, its image did not.
+        let lod = |s: &InstanceState| if s.k < 0.5 { s.lod_from } else { s.lod_to };
+        assert_eq!(h.changed_instances(|a, b| lod(a) == lod(b)), vec![1, 2]);
+        let mut still = StateHistory::new(1);
+        still.push(&before);
+        still.push(&states(&[(1, 1, 0.0), (2, 3, 0.45), (3, 3, 0.0)]));
+        assert!(still.changed_instances(|a, b| lod(a) == lod(b)).is_empty());
+        // Two frames back, an instance in transition in any of them counts (FSI's older buffer).
+        let mut deep = StateHistory::new(2);
+        for s in [&before, &before, &before] {
+            deep.push(s);
+        }
+        assert_eq!(deep.changed_instances(|a, b| a == b), vec![1]);
+    }
+
+    #[test]
     fn a_deeper_history_counts_a_transition_under_way() {
         let blending = states(&[(1, 2, 0.5)]);
         let mut shallow = StateHistory::new(1);
