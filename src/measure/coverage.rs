@@ -202,7 +202,7 @@ impl Coverage {
         self.tiles_x * self.tiles_y
     }
 
-    /// Instance `i`'s pixel rectangle on this frame.
+    /// Instance `i`'s pixel rectangle on this frame (the whole frame where the bound is not usable).
     pub fn instance_rect(
         &self,
         scene: &Scene,
@@ -213,18 +213,17 @@ impl Coverage {
         if !self.bounded {
             return PixelRect::full(self.width, self.height);
         }
-        let model = scene.instances[i].model as usize;
-        project_box(
-            self.boxes[model],
-            view_proj * matrix,
-            self.width,
-            self.height,
-        )
+        self.projected(scene, i, matrix, view_proj)
     }
 
     /// The pixels of instance `i`'s rectangle on this frame, bounded or not: its weight among the instances
     /// that switch on one frame (`records::events`).
     pub fn instance_pixels(&self, scene: &Scene, i: usize, matrix: Mat4, view_proj: Mat4) -> u64 {
+        self.projected(scene, i, matrix, view_proj).pixels()
+    }
+
+    /// The projection of instance `i`'s reach box on this frame.
+    fn projected(&self, scene: &Scene, i: usize, matrix: Mat4, view_proj: Mat4) -> PixelRect {
         let model = scene.instances[i].model as usize;
         project_box(
             self.boxes[model],
@@ -232,7 +231,6 @@ impl Coverage {
             self.width,
             self.height,
         )
-        .pixels()
     }
 
     /// The union of the rectangles of the instances `which` picks (empty when it picks none).
