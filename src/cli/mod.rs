@@ -251,6 +251,10 @@ pub struct TuneArgs {
     /// Distances per view, log-spaced from where the model fits the view to where it is two pixels across.
     #[arg(long, default_value_t = 24, help_heading = TUNING)]
     pub distances: u32,
+    /// Measure every view at every grid distance (tune.csv then holds whole curves); by default each view's
+    /// curve stops at the nearest distance that breaks the budget, which gives the same switches with fewer draws.
+    #[arg(long, help_heading = TUNING)]
+    pub full_grid: bool,
     /// The camera's speed (world units a second): with it, the narrowest --band blending methods need.
     #[arg(long, help_heading = TUNING)]
     pub speed: Option<f32>,

@@ -117,6 +117,7 @@ fn settings_of(args: &TuneArgs, band: f32, calibrated: Option<f64>) -> Result<Tu
         seed: args.seed,
         speed,
         band,
+        full_grid: args.full_grid,
     })
 }
 

@@ -48,11 +48,13 @@ fn tune_finds_a_switch_known_in_closed_form() {
     );
     assert!(pair["value_at_switch"].as_f64().unwrap() <= budget);
     assert_eq!(t["views"].as_array().unwrap().len(), 1);
+    // The view's curve from the farthest grid distance in to the first that breaks the budget (nearer than d*),
+    // then the bisection's 5 steps.
     let csv = std::fs::read_to_string(out.join("tune.csv")).unwrap();
-    assert!(
-        csv.lines().count() > 24,
-        "every grid distance and refinement"
-    );
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    let grid = rows.iter().filter(|l| l.ends_with(",false")).count();
+    assert_eq!(rows.len() - grid, 5, "{csv}");
+    assert!((2..24).contains(&grid), "{csv}");
 
     // The tuned file reads back with the switch it was given, exactly.
     let d = lodbench(
@@ -153,5 +155,56 @@ fn a_budget_is_required_and_checked() {
             &[],
         ),
         &["unified scene"],
+    );
+}
+
+/// The default search measures each view from the farthest grid distance in to the first that breaks the budget;
+/// `--full-grid` measures every grid distance. Both give the same switches, rules, engine files and tuned glTF
+/// (the bunny's chain of 4 pairs, 3 views; tune.json differs only in its `full_grid` setting), and every sample
+/// of the default is one of the full grid's, with the same figures: the distances it leaves out are not read.
+#[test]
+fn stopping_each_curve_at_its_first_break_changes_no_switch() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        #[rustfmt::skip]
+        let mut args = vec![
+            "tune", "--scene", "bunny-sweep", "--budget-lodpop", "0.004", "--views", "3", "--distances", "12",
+            "--width", "160", "--height", "120", "--out", out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let r = lodbench(&args, &[]);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        out
+    };
+    let (lazy, full) = (run("lazy", &[]), run("full", &["--full-grid"]));
+    let mut tunes = [json(&lazy.join("tune.json")), json(&full.join("tune.json"))];
+    assert_eq!(tunes[1]["settings"]["full_grid"], true);
+    for t in &mut tunes {
+        t["settings"].as_object_mut().unwrap().remove("full_grid");
+    }
+    assert!(tunes[0]["models"][0]["pairs"].as_array().unwrap().len() >= 3);
+    assert_eq!(tunes[0], tunes[1]);
+    let bytes = |p: std::path::PathBuf| std::fs::read(p).unwrap();
+    for f in [
+        "rules.csv",
+        "tuned.glb",
+        "engines/unreal-screen-sizes.json",
+        "engines/threejs-lod.js",
+    ] {
+        assert!(bytes(lazy.join(f)) == bytes(full.join(f)), "{f} differs");
+    }
+    let csv = |p: &Path| std::fs::read_to_string(p.join("tune.csv")).unwrap();
+    let (few, all) = (csv(&lazy), csv(&full));
+    let all_rows: std::collections::HashSet<&str> = all.lines().collect();
+    assert!(
+        few.lines().all(|l| all_rows.contains(l)),
+        "a sample the full grid lacks"
+    );
+    assert!(
+        few.lines().count() < all.lines().count(),
+        "{} rows against {}",
+        few.lines().count(),
+        all.lines().count()
     );
 }

@@ -15,6 +15,8 @@ use crate::measure::switch_tuning::outcome::Budget;
 use crate::measure::switch_tuning::outcome::{
     ModelSwitches, PairSwitch, RuleAt, Sample, TuneSettings,
 };
+#[cfg(doc)]
+use crate::measure::switch_tuning::search::NEAR_BUDGET;
 use crate::measure::switch_tuning::search::{
     close_excess, dense_points, first_switch, limiting_view, log_grid, nearest_within, Crossing,
     DENSE_PER_STEP,
@@ -54,7 +56,9 @@ pub fn tune_model(
         measured: HashMap::new(),
         kept: FrameCache::new(FRAME_CACHE_BYTES),
     };
-    tuning.measure_grid(&range.grid)?;
+    if settings.full_grid() {
+        tuning.measure_grid(&range.grid)?;
+    }
     // Per blending method, where its previous band ends.
     let mut band_end = [0.0f32; 3];
     for lod in 0..m.chain.lods.len().saturating_sub(1) as u32 {
@@ -284,16 +288,33 @@ impl ModelTuning<'_, '_> {
 
     /// Every view's curve over the grid for the pair (`lod`, `lod + 1`), each sample recorded: each view's
     /// crossing (refined between grid distances), and the worst excess over the views at each grid distance.
+    /// Unless [`TuneSettings::full_grid`], each view's curve runs from the farthest grid distance in to the
+    /// nearest that breaks the budget and stops there: the crossing, the dense check and the switch read nothing
+    /// nearer (a view's break is within [`NEAR_BUDGET`] of the budget, so the grid's farthest close distance is
+    /// the same), and the nearer distances are the costliest to draw (the model covers most of the frame).
+    /// The worst excess stays 0 where no view was measured.
     pub(super) fn measure_views(&mut self, lod: u32, range: &DistanceRange) -> Result<Curves> {
         let (grid, near, budget) = (&range.grid, range.near, self.settings.budget);
+        let full = self.settings.full_grid();
         let mut per_view = Vec::with_capacity(self.views.len());
         let mut worst: Vec<(f32, f64)> = grid.iter().map(|&d| (d, 0.0)).collect();
         for v in 0..self.views.len() {
-            let mut curve = Vec::with_capacity(grid.len());
-            for &d in grid {
-                curve.push((d, self.sample(lod, v, d, range, false)?));
+            let mut measured = Vec::with_capacity(grid.len());
+            for &d in grid.iter().rev() {
+                let m = self.measure(lod, v, d)?;
+                measured.push((d, m));
+                if !full && budget.broken_by(m.value()) {
+                    break;
+                }
             }
-            for (w, c) in worst.iter_mut().zip(&curve) {
+            measured.reverse();
+            let mut curve = Vec::with_capacity(measured.len());
+            for (d, m) in measured {
+                self.record(lod, v, d, range, m, false);
+                curve.push((d, m.value()));
+            }
+            let skipped = grid.len() - curve.len();
+            for (w, c) in worst[skipped..].iter_mut().zip(&curve) {
                 w.1 = match budget {
                     Budget::Lodpop(_) => w.1.max(c.1),
                     Budget::Jod(_) => w.1.max(10.0 - c.1),
@@ -321,6 +342,20 @@ impl ModelTuning<'_, '_> {
         refined: bool,
     ) -> Result<f64> {
         let m = self.measure(lod, v, d)?;
+        self.record(lod, v, d, range, m, refined);
+        Ok(m.value())
+    }
+
+    /// Appends the pair (`lod`, `lod + 1`)'s figures `m` at view `v` and distance `d` to the samples.
+    fn record(
+        &mut self,
+        lod: u32,
+        v: usize,
+        d: f32,
+        range: &DistanceRange,
+        m: Measured,
+        refined: bool,
+    ) {
         let name = self.camera.scene.models[self.model as usize].name.clone();
         self.samples.push(Sample {
             model: name,
@@ -335,7 +370,6 @@ impl ModelTuning<'_, '_> {
             jod: m.jod,
             refined,
         });
-        Ok(m.value())
     }
 
     /// Every view at the switch: the views whose crossing lies nearer are within the budget at every grid

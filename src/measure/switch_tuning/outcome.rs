@@ -38,6 +38,17 @@ pub struct TuneSettings {
     /// The schedule's `--band` (its half-width as a fraction of a switch distance): consecutive switches are kept
     /// far enough apart that their bands do not overlap, as `lodbench run` requires.
     pub band: f32,
+    /// `--full-grid`: every view measured at every grid distance, as tune.csv then shows (else each view from the
+    /// farthest grid distance in to the nearest that breaks the budget: the same switches, fewer draws).
+    pub full_grid: bool,
+}
+
+impl TuneSettings {
+    /// Whether every view is measured at every grid distance: with `--full-grid`, and with `--speed` (the
+    /// blending methods' bands read the grid's worst view nearer than the hard switch).
+    pub fn full_grid(&self) -> bool {
+        self.full_grid || self.speed.is_some()
+    }
 }
 
 /// A blending method's transition at a pair: the nearest switch whose band (a relative half-width, the
