@@ -24,6 +24,7 @@ pub mod gpu;
 pub mod measure;
 pub mod methods;
 pub mod numbers;
+pub mod raster;
 pub mod results;
 pub mod rng;
 pub mod scene;

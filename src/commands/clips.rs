@@ -27,6 +27,7 @@ use crate::cli::ClipsArgs;
 use crate::error::{Error, Result};
 use crate::measure::records::TransitionRecord;
 use crate::methods::is_reference;
+use crate::raster::RgbaImage;
 use crate::results::clips::compose::{
     auto_scale, crop_box, grid, heatmap_of, legend, stack, upscale, Crop,
 };
@@ -38,7 +39,6 @@ use crate::results::files::{
     partial, ClipFiles, ClipWindow, DumpKind, EXPERIMENT_JSON, FRAMES_CSV, TRANSITIONS_CSV,
 };
 use crate::results::png::{FrameDumper, FrameId, HEATMAP_FULL_SCALE};
-use image::RgbaImage;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -424,10 +424,7 @@ struct View {
 impl View {
     fn of(&self, img: &RgbaImage) -> RgbaImage {
         let c = self.crop;
-        upscale(
-            &image::imageops::crop_imm(img, c.x, c.y, c.w, c.h).to_image(),
-            self.scale,
-        )
+        upscale(&img.crop(c.x, c.y, c.w, c.h), self.scale)
     }
 }
 

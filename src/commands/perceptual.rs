@@ -58,13 +58,12 @@ pub struct PerceptualSettings {
 
 /// A dumped PNG as ColorVideoVDP's input: interleaved RGB, the stored sRGB-encoded values in [0, 1].
 fn load(path: &Path) -> Result<Image> {
-    let img = image::open(path)
-        .map_err(|e| Error::image(path, e))?
-        .to_rgb8();
+    let img = crate::raster::read(path)?;
     let (w, h) = img.dimensions();
     let data = img
-        .into_raw()
-        .into_iter()
+        .as_raw()
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
         .map(|b| b as f32 / 255.0)
         .collect();
     Image::new(w as usize, h as usize, 3, data).map_err(|e| Error::Perceptual(e.to_string()))

@@ -82,8 +82,7 @@ impl FrameDumper {
 }
 
 fn save(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
-    image::save_buffer(path, rgba, width, height, image::ExtendedColorType::Rgba8)
-        .map_err(|e| Error::image(path, e))
+    crate::raster::write_png(path, width, height, rgba, crate::raster::Packing::Balanced)
 }
 
 /// Black (no difference) through red and yellow to white (HEATMAP_FULL_SCALE or more).

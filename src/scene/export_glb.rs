@@ -208,14 +208,16 @@ impl Writer {
     fn materials_of(&mut self, materials: &Materials) -> Result<Vec<usize>> {
         let mut images = Vec::with_capacity(materials.images.len());
         for img in &materials.images {
-            let rgba = image::RgbaImage::from_raw(img.width, img.height, img.rgba.clone())
-                .ok_or_else(|| Error::Config(format!("export: {} is not whole RGBA", img.name)))?;
-            let mut png = std::io::Cursor::new(Vec::new());
-            rgba.write_to(&mut png, image::ImageFormat::Png)
-                .map_err(|e| {
-                    Error::Config(format!("export: {} cannot be encoded: {e}", img.name))
-                })?;
-            let view = self.view(png.get_ref(), None);
+            if img.rgba.len() != img.width as usize * img.height as usize * 4 {
+                return Err(Error::Config(format!(
+                    "export: {} is not whole RGBA",
+                    img.name
+                )));
+            }
+            let png = crate::raster::png_bytes(img.width, img.height, &img.rgba).map_err(|e| {
+                Error::Config(format!("export: {} cannot be encoded: {e}", img.name))
+            })?;
+            let view = self.view(&png, None);
             self.images
                 .push(json!({"bufferView": view, "mimeType": "image/png", "name": img.name}));
             images.push(self.images.len() - 1);

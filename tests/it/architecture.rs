@@ -27,6 +27,7 @@ pub const LAYERS: &[(&str, &[&str])] = &[
             "defaults.rs",
             "formats.rs",
             "numbers.rs",
+            "raster.rs",
             "rng.rs",
         ],
     ),

@@ -54,9 +54,10 @@ fn folder_from_dumps(run: &Path, method: &str, out: &Path) {
     let lods = lods_csv(method);
     let frames = lods.lines().count() - 1;
     std::fs::write(out.join("lods.csv"), lods).unwrap();
-    let corner = image::open(run.join(format!("frames/bunny-sweep_{method}_c1_f00000_method.png")))
-        .unwrap()
-        .to_rgba8();
+    let corner = lodbench::raster::read(
+        run.join(format!("frames/bunny-sweep_{method}_c1_f00000_method.png")),
+    )
+    .unwrap();
     let bg = corner.get_pixel(0, 0).0;
     std::fs::write(
         out.join("score.json"),
@@ -183,7 +184,9 @@ fn small_folder(dir: &Path) {
     )
     .unwrap();
     std::fs::write(dir.join("lods.csv"), "frame,object,lod\n0,a,0\n1,a,1\n").unwrap();
-    let picture = |v: u8| image::RgbaImage::from_pixel(4, 4, image::Rgba([v, v, v, 255]));
+    let picture = |v: u8| {
+        lodbench::raster::RgbaImage::from_pixel(4, 4, lodbench::raster::Rgba([v, v, v, 255]))
+    };
     picture(10).save(dir.join("frame/00000.png")).unwrap();
     picture(20).save(dir.join("frame/00001.png")).unwrap();
     picture(10)
@@ -218,7 +221,7 @@ fn bad_score_folders_are_refused_each_with_its_reason() {
         (
             "sizes differ",
             |d| {
-                image::RgbaImage::new(5, 4)
+                lodbench::raster::RgbaImage::new(5, 4)
                     .save(d.join("frame/00001.png"))
                     .unwrap();
             },

@@ -205,15 +205,14 @@ pub fn near_distance() -> f32 {
 /// pixel's largest channel difference (times 8, in red) go to `target/snapshots/<name>-actual.png` and
 /// `-difference.png`. The one comparison of every snapshot test; re-bless with
 /// `LODBENCH_BLESS=1 cargo test --release --test it snapshot`.
-pub fn snapshot_problem(actual: &image::RgbaImage, snap: &Path) -> Option<String> {
+pub fn snapshot_problem(actual: &lodbench::raster::RgbaImage, snap: &Path) -> Option<String> {
     if std::env::var_os("LODBENCH_BLESS").is_some() {
         std::fs::create_dir_all(snap.parent().expect("a folder")).expect("snapshot folder");
         actual.save(snap).expect("snapshot written");
         return None;
     }
-    let expected = image::open(snap)
-        .unwrap_or_else(|e| panic!("{}: {e} (bless with LODBENCH_BLESS=1)", snap.display()))
-        .to_rgba8();
+    let expected = lodbench::raster::read(snap)
+        .unwrap_or_else(|e| panic!("{}: {e} (bless with LODBENCH_BLESS=1)", snap.display()));
     if expected.dimensions() != actual.dimensions() {
         return Some(format!(
             "{}: {:?}, the frame {:?}",
@@ -232,11 +231,12 @@ pub fn snapshot_problem(actual: &image::RgbaImage, snap: &Path) -> Option<String
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("snapshot");
-    let difference = image::RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
-        let (a, b) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
-        let worst = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
-        image::Rgba([worst.saturating_mul(8), 0, 0, 255])
-    });
+    let difference =
+        lodbench::raster::RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
+            let (a, b) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
+            let worst = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
+            lodbench::raster::Rgba([worst.saturating_mul(8), 0, 0, 255])
+        });
     let saved = std::fs::create_dir_all(&dir).is_ok()
         && actual.save(dir.join(format!("{name}-actual.png"))).is_ok()
         && difference

@@ -38,9 +38,8 @@ fn frame(dir: &Path, f: u32) -> Vec<u8> {
     let p = dir
         .join("frames")
         .join(format!("bunny-grid_discrete_c1_f{f:05}_reference.png"));
-    image::open(&p)
+    lodbench::raster::read(&p)
         .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
-        .to_rgba8()
         .into_raw()
 }
 

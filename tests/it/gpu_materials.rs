@@ -17,9 +17,7 @@ fn frame(run: &Path, scene: &str, method: &str, f: u32, kind: &str) -> (u32, Vec
     let p = run
         .join("frames")
         .join(format!("{scene}_{method}_c1_f{f:05}_{kind}.png"));
-    let img = image::open(&p)
-        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
-        .to_rgba8();
+    let img = lodbench::raster::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
     (img.width(), img.into_raw())
 }
 

@@ -134,7 +134,7 @@ fn gpu_lodpop_and_lag_match_the_cpu_oracle() {
     let load = |stem: &str, name: &str| -> Option<Vec<u8>> {
         let p = frames.join(format!("{stem}_{name}.png"));
         p.exists()
-            .then(|| image::open(&p).unwrap().to_rgba8().into_raw())
+            .then(|| lodbench::raster::read(&p).unwrap().into_raw())
     };
     let (mut lodpop_checked, mut lag_checked) = (0, 0);
     for r in &rows {

@@ -309,11 +309,15 @@ fn alpha_sorted_is_alpha_where_order_does_not_matter() {
             .parse::<u32>()
             .unwrap()
             .to_string();
-        let a = image::open(&path).unwrap().to_rgb8().into_raw();
-        let b = image::open(path.with_file_name(name.replace("_alpha_c1_", "_alpha-sorted_c1_")))
-            .unwrap()
-            .to_rgb8()
-            .into_raw();
+        let rgb = |p: &std::path::Path| -> Vec<u8> {
+            let img = lodbench::raster::read(p).unwrap();
+            img.as_raw()
+                .chunks(4)
+                .flat_map(|px| [px[0], px[1], px[2]])
+                .collect()
+        };
+        let a = rgb(&path);
+        let b = rgb(&path.with_file_name(name.replace("_alpha_c1_", "_alpha-sorted_c1_")));
         let off: Vec<u8> = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).collect();
         let beyond = off.iter().filter(|&&d| d > 1).count();
         if !moving.contains(&frame) {

@@ -128,9 +128,8 @@ fn the_references_own_pass_dumps_and_flips_its_own_frame() {
     );
     let png = |method: &str, f: u32, kind: &str| {
         let name = format!("bunny-sweep_{method}_c1_f{f:05}_{kind}.png");
-        image::open(out.join("frames").join(&name))
+        lodbench::raster::read(out.join("frames").join(&name))
             .unwrap_or_else(|e| panic!("{name}: {e}"))
-            .to_rgba8()
     };
     for f in [0, 4, 8] {
         let frame = png("reference", f, "method");
@@ -297,7 +296,7 @@ fn snapshot_reference_frame() {
             Ok(())
         })
         .unwrap();
-    let actual = image::RgbaImage::from_raw(scene.width, scene.height, frame0.unwrap())
+    let actual = lodbench::raster::RgbaImage::from_raw(scene.width, scene.height, frame0.unwrap())
         .expect("a frame of the viewport's size");
     let snap =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots/bunny-sweep_reference_f0.png");
@@ -420,9 +419,8 @@ fn snapshot_scenes_every_method() {
         for method in methods {
             let stem = format!("{scene}_{method}_c{count}_f00002_method.png");
             let frame = out.join("frames").join(&stem);
-            let actual = image::open(&frame)
-                .unwrap_or_else(|e| panic!("{}: {e}", frame.display()))
-                .to_rgba8();
+            let actual = lodbench::raster::read(&frame)
+                .unwrap_or_else(|e| panic!("{}: {e}", frame.display()));
             let snap = snaps.join(format!("{scene}_{method}.png"));
             if let Some(p) = snapshot_problem(&actual, &snap) {
                 problems.push(format!("{scene} {method}: {p}"));

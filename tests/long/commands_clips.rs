@@ -16,18 +16,16 @@ fn transitions(dir: &Path) -> Vec<TransitionRecord> {
         .unwrap()
 }
 
-fn open(path: &Path) -> image::RgbaImage {
-    image::open(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_rgba8()
+fn open(path: &Path) -> lodbench::raster::RgbaImage {
+    lodbench::raster::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 /// `image`'s picture `[x, y, w, h]` equals `source` cropped to `crop` and upscaled by `scale` (exactly: the
 /// clip copies the dumps' pixels, nearest neighbour).
 fn assert_tile(
-    image: &image::RgbaImage,
+    image: &lodbench::raster::RgbaImage,
     tile: [u32; 4],
-    source: &image::RgbaImage,
+    source: &lodbench::raster::RgbaImage,
     crop: [u32; 4],
     scale: u32,
     what: &str,
@@ -152,22 +150,23 @@ fn clips_are_the_dumps_side_by_side() {
             checked_fsi |= m == "fsi";
         }
         // The animation: the frame image over the error image, one frame per clip frame.
-        let decoder = image::codecs::png::PngDecoder::new(std::io::BufReader::new(
-            std::fs::File::open(clips_dir.join(c.apng.as_ref().unwrap())).unwrap(),
-        ))
-        .unwrap();
-        assert!(decoder.is_apng().unwrap(), "{:?}", c.apng);
-        use image::AnimationDecoder;
-        let frames = decoder
-            .apng()
-            .unwrap()
-            .into_frames()
-            .collect_frames()
+        let file = std::fs::File::open(clips_dir.join(c.apng.as_ref().unwrap())).unwrap();
+        let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+            .read_info()
             .unwrap();
-        assert_eq!(frames.len(), c.frames.len(), "{:?}", c.apng);
-        let shown = frames[i].buffer();
+        let animation = reader.info().animation_control().copied();
+        assert!(animation.is_some(), "{:?} is not an APNG", c.apng);
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let frames: Vec<lodbench::raster::RgbaImage> = (0..animation.unwrap().num_frames)
+            .map(|_| {
+                let info = reader.next_frame(&mut buf).unwrap();
+                let px = buf[..info.buffer_size()].to_vec();
+                lodbench::raster::RgbaImage::from_raw(info.width, info.height, px).unwrap()
+            })
+            .collect();
+        let shown = &frames[i];
         assert_eq!(shown.dimensions(), (c.width, c.height * 2));
-        let top = image::imageops::crop_imm(shown, 0, 0, c.width, c.height).to_image();
+        let top = shown.crop(0, 0, c.width, c.height);
         assert!(
             top == frame,
             "{}: the animation's frame {i} is not its frame image",
@@ -190,7 +189,7 @@ fn clips_are_the_dumps_side_by_side() {
 /// of the same folder, which it replaces.
 fn mp4_only_is_the_same_clip(dir: &Path, settings: &ClipSettings, lossless: &ClipIndex) {
     let clips_dir = dir.join("clips");
-    let middles: Vec<image::RgbaImage> = lossless
+    let middles: Vec<lodbench::raster::RgbaImage> = lossless
         .clips
         .iter()
         .map(|c| open(&clips_dir.join(&c.frame_images.as_ref().unwrap()[c.frames.len() / 2])))

@@ -326,9 +326,7 @@ fn mid_transition_frames_match_snapshots() {
         let load = |method: &str| {
             let stem = format!("{scene}_{method}_c{count}_f{frame:05}_method.png");
             let path = regress_run().join("frames").join(&stem);
-            image::open(&path)
-                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-                .to_rgba8()
+            lodbench::raster::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
         };
         let discrete = load("discrete");
         for method in lodbench::methods::defaults_for(false) {

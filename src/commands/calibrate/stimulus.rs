@@ -257,9 +257,7 @@ fn switch_of<'a>(
 
 /// Reads a dumped frame as RGBA8.
 fn rgba(path: &Path) -> Result<(Vec<u8>, u32, u32)> {
-    let img = image::open(path)
-        .map_err(|e| Error::image(path, e))?
-        .to_rgba8();
+    let img = crate::raster::read(path)?;
     let (w, h) = img.dimensions();
     Ok((img.into_raw(), w, h))
 }

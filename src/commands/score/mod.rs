@@ -19,6 +19,7 @@ use crate::measure::records::{
     set_visible_pops, switches, transitions, Clock, FrameChanges, FrameRecord, SummaryRecord,
     TransitionPair, Visibility,
 };
+use crate::raster::RgbaImage;
 use crate::results::csv::{
     write_events, write_pairs, write_rounds, write_summary, write_transitions, FramesWriter,
 };
@@ -101,7 +102,7 @@ fn figures_of(folder: &ScoreFolder, (flip, de2000): (bool, bool)) -> Result<Vec<
     let mut seq = SequenceFigures::new(size.0, size.1, folder.manifest.background, (flip, de2000));
     let mut out = Vec::with_capacity(folder.frames() as usize);
     for f in 0..folder.frames() {
-        let picture = |sub: &str| -> Result<image::RgbaImage> {
+        let picture = |sub: &str| -> Result<RgbaImage> {
             let path = folder.picture(sub, f);
             let img = load(&path)?;
             match img.dimensions() == size {
@@ -128,20 +129,20 @@ fn figures_of(folder: &ScoreFolder, (flip, de2000): (bool, bool)) -> Result<Vec<
             .transpose()?;
         out.push(seq.next(&FramePictures {
             frame: frame.as_raw(),
-            counterfactual: counterfactual.as_ref().map(|c| c.as_raw().as_slice()),
-            reference: reference.as_ref().map(|r| r.as_raw().as_slice()),
+            counterfactual: counterfactual.as_ref().map(RgbaImage::as_raw),
+            reference: reference.as_ref().map(RgbaImage::as_raw),
         }));
     }
     Ok(out)
 }
 
-fn load(path: &Path) -> Result<image::RgbaImage> {
+fn load(path: &Path) -> Result<RgbaImage> {
     if !path.is_file() {
         return Err(Error::score(path, "is missing"));
     }
-    let img = image::open(path)
-        .map_err(|e| Error::score(path, format!("is not a readable PNG ({e})")))?;
-    Ok(img.to_rgba8())
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    crate::raster::decode(&bytes)
+        .map_err(|e| Error::score(path, format!("is not a readable PNG ({e})")))
 }
 
 /// A frame's objects in transition: (from, to, k) of each ([`in_transition`]).

@@ -11,6 +11,7 @@ use super::json::{array, floats, index, number_or, opt_index, uint_or};
 use crate::geometry::material::{
     AlphaMode, Filter, Image, Material, Materials, Sampler, TextureRef, Wrap, IDENTITY_TRANSFORM,
 };
+use crate::raster::{format_of, Format, RgbaImage};
 use serde_json::Value;
 use std::collections::HashMap;
 
@@ -342,24 +343,21 @@ impl Doc<'_> {
 
 /// PNG, JPEG or WebP bytes as RGBA8 (16-bit and grey images converted); the format from the bytes themselves
 /// (a file's mimeType may be wrong), KTX2 and AVIF refused with the command that converts them.
-fn decode_image(bytes: &[u8], mime: Option<&str>) -> Result<image::RgbaImage, String> {
-    const KTX2: &[u8] = b"\xABKTX 20\xBB";
-    if bytes.starts_with(KTX2) || mime == Some("image/ktx2") {
+fn decode_image(bytes: &[u8], mime: Option<&str>) -> Result<RgbaImage, String> {
+    let format = format_of(bytes);
+    if format == Some(Format::Other("KTX2")) || mime == Some("image/ktx2") {
         return Err(format!("it is KTX2 (Basis Universal); {KTX2_REMEDY}"));
     }
-    let format = image::guess_format(bytes).map_err(|e| format!("{e} (mimeType {mime:?})"))?;
     match format {
-        image::ImageFormat::Png | image::ImageFormat::Jpeg | image::ImageFormat::WebP => {}
-        image::ImageFormat::Avif => return Err(format!("it is AVIF; {AVIF_REMEDY}")),
-        other => {
-            return Err(format!(
-                "it is {other:?}, not PNG, JPEG or WebP as glTF allows; {AVIF_REMEDY}"
-            ))
-        }
+        Some(Format::Png | Format::Jpeg | Format::WebP) => crate::raster::decode(bytes),
+        Some(Format::Other("AVIF")) => Err(format!("it is AVIF; {AVIF_REMEDY}")),
+        Some(Format::Other(name)) => Err(format!(
+            "it is {name}, not PNG, JPEG or WebP as glTF allows; {AVIF_REMEDY}"
+        )),
+        None => Err(format!(
+            "its format is none lodbench knows, not PNG, JPEG or WebP (mimeType {mime:?})"
+        )),
     }
-    image::load_from_memory_with_format(bytes, format)
-        .map(|i| i.into_rgba8())
-        .map_err(|e| e.to_string())
 }
 
 #[cfg(test)]
@@ -367,10 +365,7 @@ mod tests {
     use super::*;
 
     fn png(w: u32, h: u32, px: [u8; 4]) -> Vec<u8> {
-        let img = image::RgbaImage::from_pixel(w, h, image::Rgba(px));
-        let mut out = std::io::Cursor::new(Vec::new());
-        img.write_to(&mut out, image::ImageFormat::Png).unwrap();
-        out.into_inner()
+        crate::raster::png_bytes(w, h, &px.repeat((w * h) as usize)).unwrap()
     }
 
     fn doc_with(json: serde_json::Value) -> (serde_json::Value, std::path::PathBuf) {

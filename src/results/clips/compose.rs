@@ -1,8 +1,8 @@
 //! The pictures of `lodbench clips` (`commands/clips.rs`): the crop around what is drawn, integer upscaling,
 //! the 8x8 font's text, the heat-map's legend, labelled grids of tiles and grids stacked one over another.
 
+use crate::raster::{Rgba, RgbaImage};
 use crate::results::png::{heatmap, HEATMAP_FULL_SCALE};
-use image::{Rgba, RgbaImage};
 
 /// Pictures lower than this are upscaled (by default) until they are at least this high.
 pub const MIN_TILE_HEIGHT: u32 = 200;
@@ -30,9 +30,9 @@ pub fn crop_box<'a>(pictures: impl Iterator<Item = &'a RgbaImage>, w: u32, h: u3
     let mut background = None;
     let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0u32, 0u32);
     for p in pictures {
-        let bg = *background.get_or_insert(*p.get_pixel(0, 0));
+        let bg = *background.get_or_insert(p.get_pixel(0, 0));
         for (x, y, px) in p.enumerate_pixels() {
-            if *px != bg {
+            if px != bg {
                 x0 = x0.min(x);
                 y0 = y0.min(y);
                 x1 = x1.max(x);
@@ -79,7 +79,7 @@ pub fn upscale(img: &RgbaImage, scale: u32) -> RgbaImage {
         return img.clone();
     }
     RgbaImage::from_fn(img.width() * scale, img.height() * scale, |x, y| {
-        *img.get_pixel(x / scale, y / scale)
+        img.get_pixel(x / scale, y / scale)
     })
 }
 
@@ -111,13 +111,13 @@ pub fn legend(w: u32, h: u32) -> RgbaImage {
     img
 }
 
-pub const BACKGROUND: Rgba<u8> = Rgba([24, 24, 24, 255]);
-pub const TEXT: Rgba<u8> = Rgba([235, 235, 235, 255]);
+pub const BACKGROUND: Rgba = Rgba([24, 24, 24, 255]);
+pub const TEXT: Rgba = Rgba([235, 235, 235, 255]);
 pub const GAP: u32 = 2;
 
 /// Text of the 8x8 public-domain font of `font8x8`, each pixel `size` x `size`; characters outside ASCII
 /// show as '?'.
-pub fn text(img: &mut RgbaImage, x: u32, y: u32, s: &str, size: u32, colour: Rgba<u8>) {
+pub fn text(img: &mut RgbaImage, x: u32, y: u32, s: &str, size: u32, colour: Rgba) {
     for (i, ch) in s.chars().enumerate() {
         let code = if ch.is_ascii() {
             ch as usize
@@ -179,7 +179,7 @@ pub fn grid(header: &str, labels: &[String], pictures: &[RgbaImage], columns: u3
         let x = GAP + c * (pw + GAP);
         let y = header_h + r * (label_h + ph + GAP);
         text(&mut img, x + 2, y + 3, label, label_size, TEXT);
-        image::imageops::replace(&mut img, picture, x as i64, (y + label_h) as i64);
+        img.replace(picture, x as i64, (y + label_h) as i64);
         boxes.push([x, y + label_h, pw, ph]);
     }
     Grid { image: img, boxes }
@@ -191,8 +191,8 @@ pub fn stack(top: &RgbaImage, bottom: &RgbaImage) -> RgbaImage {
         top.height() + bottom.height(),
         BACKGROUND,
     );
-    image::imageops::replace(&mut img, top, 0, 0);
-    image::imageops::replace(&mut img, bottom, 0, top.height() as i64);
+    img.replace(top, 0, 0);
+    img.replace(bottom, 0, top.height() as i64);
     img
 }
 
@@ -247,16 +247,16 @@ mod tests {
         img.put_pixel(1, 0, Rgba([9, 8, 7, 255]));
         let up = upscale(&img, 3);
         assert_eq!(up.dimensions(), (6, 3));
-        assert_eq!(*up.get_pixel(2, 2), Rgba([0, 0, 0, 0]));
-        assert_eq!(*up.get_pixel(3, 0), Rgba([9, 8, 7, 255]));
-        assert_eq!(*up.get_pixel(5, 2), Rgba([9, 8, 7, 255]));
+        assert_eq!(up.get_pixel(2, 2), Rgba([0, 0, 0, 0]));
+        assert_eq!(up.get_pixel(3, 0), Rgba([9, 8, 7, 255]));
+        assert_eq!(up.get_pixel(5, 2), Rgba([9, 8, 7, 255]));
     }
 
     #[test]
     fn text_draws_glyph_bits() {
         let mut img = RgbaImage::from_pixel(16, 8, BACKGROUND);
         text(&mut img, 0, 0, "1", 1, TEXT);
-        let lit = img.pixels().filter(|p| **p == TEXT).count();
+        let lit = img.pixels().filter(|p| *p == TEXT).count();
         let bits: u32 = font8x8::legacy::BASIC_LEGACY['1' as usize]
             .iter()
             .map(|b| b.count_ones())
@@ -280,9 +280,9 @@ mod tests {
         let label_h = 8 + 6;
         let header_h = 8 + 8;
         let y2 = header_h + (label_h + 6 + GAP) + label_h;
-        assert_eq!(*g.get_pixel(GAP, y2), Rgba([150, 150, 150, 255]));
+        assert_eq!(g.get_pixel(GAP, y2), Rgba([150, 150, 150, 255]));
         assert_eq!(
-            *g.get_pixel(GAP + 10 + GAP, header_h + label_h),
+            g.get_pixel(GAP + 10 + GAP, header_h + label_h),
             Rgba([100, 100, 100, 255])
         );
         assert_eq!(boxes[2], [GAP, y2, 10, 6]);

@@ -1,37 +1,21 @@
 //! The files of `lodbench clips` (`commands/clips.rs`): PNG frames read and written, and the animations: APNG
-//! (the `png` crate), GIF (the `image` crate) and MP4 (H.264 through `ffmpeg`, when it is on the PATH).
+//! (the `png` crate), GIF (the `gif` crate, crate::raster) and MP4 (H.264 through `ffmpeg`, when it is on the PATH).
 
 use crate::error::{Error, Result};
-use image::codecs::gif::{GifEncoder, Repeat};
-use image::{Delay, Frame, RgbaImage};
+use crate::raster::{Packing, RgbaImage};
 use std::io::Write;
 use std::path::Path;
 use std::process::{Command, Stdio};
 
 pub fn load(path: &Path) -> Result<RgbaImage> {
-    Ok(image::open(path)
-        .map_err(|e| Error::image(path, e))?
-        .to_rgba8())
+    crate::raster::read(path)
 }
 
 /// PNG at the best compression: the grids are mostly flat colour and upscaled blocks, which it packs about 3x
 /// smaller than the default level.
 pub fn save(path: &Path, img: &RgbaImage) -> Result<()> {
-    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-    use image::ImageEncoder;
-    let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-    PngEncoder::new_with_quality(
-        std::io::BufWriter::new(file),
-        CompressionType::Best,
-        FilterType::Adaptive,
-    )
-    .write_image(
-        img.as_raw(),
-        img.width(),
-        img.height(),
-        image::ExtendedColorType::Rgba8,
-    )
-    .map_err(|e| Error::image(path, e))
+    let (w, h) = img.dimensions();
+    crate::raster::write_png(path, w, h, img.as_raw(), Packing::Best)
 }
 
 /// An animated PNG (APNG) of `frames` (all one size), looping, with the `png` crate.
@@ -60,19 +44,7 @@ pub fn write_apng(path: &Path, frames: &[RgbaImage], fps: u32) -> Result<()> {
 }
 
 pub fn write_gif(path: &Path, frames: &[RgbaImage], fps: u32) -> Result<()> {
-    let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-    let mut encoder = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
-    encoder
-        .set_repeat(Repeat::Infinite)
-        .map_err(|e| Error::image(path, e))?;
-    let delay = Delay::from_numer_denom_ms(1000, fps);
-    encoder
-        .encode_frames(
-            frames
-                .iter()
-                .map(|f| Frame::from_parts(f.clone(), 0, 0, delay)),
-        )
-        .map_err(|e| Error::image(path, e))
+    crate::raster::write_gif(path, frames, fps)
 }
 
 pub fn ffmpeg_available() -> bool {
