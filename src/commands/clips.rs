@@ -12,7 +12,7 @@
 //! instances in transition, from frames.csv). Written into `RUN_DIR/clips/`:
 //! - `<clip>.png`: an animated PNG of the frame grid over the error grid, looping (lossless, and about half
 //!   the size of a GIF of the same frames; the `png` crate, no system dependency); with `--gif` also
-//!   `<clip>.gif` (the `image` crate);
+//!   `<clip>.gif` (the `gif` crate, crate::raster);
 //! - `<clip>.mp4`: the same, H.264, when `ffmpeg` is on the PATH (`--mp4 auto`, the default);
 //! - `<clip>/frame_FFFFF.png` and `<clip>/error_FFFFF.png`: each frame's two grids, for report.html's player;
 //! - with `--mp4 only`, the MP4 alone: no animated PNG and no frame images (index.json's `apng`,
