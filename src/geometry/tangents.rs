@@ -38,8 +38,15 @@ impl bevy_mikktspace::Geometry for Faces<'_> {
         [u, 1.0 - v]
     }
 
-    fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
-        self.corners[face * 3 + vert] = tangent;
+    /// A corner MikkTSpace found no tangent for gets its default (+x, the bitangent's sign -1), as the reference
+    /// implementation and bevy_mikktspace 0.16 wrote it.
+    fn set_tangent(
+        &mut self,
+        tangent: Option<bevy_mikktspace::TangentSpace>,
+        face: usize,
+        vert: usize,
+    ) {
+        self.corners[face * 3 + vert] = tangent.unwrap_or_default().tangent_encoded();
     }
 }
 
@@ -59,7 +66,9 @@ pub fn mikktspace_corners(
         indices,
         corners: vec![[1.0, 0.0, 0.0, 1.0]; indices.len()],
     };
-    bevy_mikktspace::generate_tangents(&mut faces).then_some(faces.corners)
+    bevy_mikktspace::generate_tangents(&mut faces)
+        .is_ok()
+        .then_some(faces.corners)
 }
 
 /// Whether two corner tangents are the same vertex's (direction within about 0.06 degrees, same sign).
