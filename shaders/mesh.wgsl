@@ -93,8 +93,7 @@ fn transform(position: vec3<f32>, normal: vec3<f32>, aux: vec4<f32>, inst: Insta
     let world = model * vec4<f32>(p, 1.0);
     var out: VsOut;
     out.clip = camera.view_proj * world;
-    // Instances are scaled uniformly, so the model matrix transforms normals too.
-    out.normal = (model * vec4<f32>(n, 0.0)).xyz;
+    out.normal = normal_to_world(model, n);
     out.color = inst.color;
     out.params = inst.params;
     out.uv = aux.xy;
@@ -102,6 +101,22 @@ fn transform(position: vec3<f32>, normal: vec3<f32>, aux: vec4<f32>, inst: Insta
     out.object = select(position, aux.xyw, aux.z == KIND_DEFORMED);
     out.world = world.xyz;
     return out;
+}
+
+// A normal to world space, up to a positive factor (the fragment normalises it). Under a rotation and a uniform
+// scale, the model matrix itself. Under a scale that stretches (a user scene's instance scaled unlike its model,
+// src/scene/user/models.rs), the inverse transpose, as the cofactor matrix det(M) M^-T (columns c1 x c2, c2 x c0,
+// c0 x c1) times the sign of det(M).
+fn normal_to_world(model: mat4x4<f32>, n: vec3<f32>) -> vec3<f32> {
+    let c = mat3x3<f32>(model[0].xyz, model[1].xyz, model[2].xyz);
+    let len2 = vec3<f32>(dot(c[0], c[0]), dot(c[1], c[1]), dot(c[2], c[2]));
+    let tol = 1e-4 * max(len2.x, max(len2.y, len2.z));
+    let skew = max(abs(dot(c[0], c[1])), max(abs(dot(c[1], c[2])), abs(dot(c[2], c[0]))));
+    if (abs(len2.x - len2.y) <= tol && abs(len2.y - len2.z) <= tol && skew <= tol) {
+        return (model * vec4<f32>(n, 0.0)).xyz;
+    }
+    let cof = mat3x3<f32>(cross(c[1], c[2]), cross(c[2], c[0]), cross(c[0], c[1]));
+    return cof * n * sign(dot(c[0], cof[0]));
 }
 
 @vertex
@@ -181,7 +196,8 @@ fn lit(world: vec3<f32>) -> f32 {
 // Octahedral impostors (src/geometry/impostor.rs holds the same maps and selection on the CPU, with their
 // tests: keep the two in step). A card's vertex has aux = (corner x, corner y, KIND_IMPOSTOR, slot); the card is
 // spread across the view on the plane through the model's centre, as large as its bounding sphere's silhouette.
-// Lighting happens in object space (instances are scaled uniformly, so angles are kept): `normal` carries the
+// Lighting happens in object space (models with impostors have instances scaled uniformly, so angles are kept:
+// src/scene/user/models.rs keys their placements by shape): `normal` carries the
 // light's direction there, `imp_ray` the ray from the eye to the card point, `imp_eye` the selecting eye.
 
 fn impostor_sign(v: vec2<f32>) -> vec2<f32> {

@@ -195,11 +195,19 @@ fn print_hierarchy(d: &SceneDescription) {
 fn print_models(d: &SceneDescription) {
     for m in &d.models {
         outln!(
-            "model {} (radius {:.3}, switch distances from {}):",
+            "model {} (radius {:.3}, {} instance{}, switch distances from {}):",
             m.name,
             m.radius,
+            m.instances,
+            if m.instances == 1 { "" } else { "s" },
             m.switch_source
         );
+        if let Some([a, b]) = m.sizes {
+            outln!(
+                "  its instances are {a:.3} to {b:.3} times its size: each switches at that multiple of the \
+                 distances below"
+            );
+        }
         let deviation = m.lods.iter().any(|l| l.deviation_max.is_some());
         outln!(
             "  {:>4} {:>10} {:>9} {:>14} {:>16}{}",

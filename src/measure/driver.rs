@@ -103,7 +103,8 @@ impl<'s> FrameDriver<'s> {
         for (i, inst) in self.scene.instances.iter().enumerate() {
             let d = self.scene.instance_position(i, frame).distance(eye);
             let switches = &self.scene.models[inst.model as usize].switches;
-            let s = self.schedule.update(i, d, switches);
+            // An instance `size` times its model's selects as its model would at d / size.
+            let s = self.schedule.update(i, d / inst.size(), switches);
             if self.scene.ground != Some(i) {
                 lod_sum += s.lod_value() as f64;
             }

@@ -67,12 +67,7 @@ pub fn frame_lights(scene: &Scene) -> Vec<FrameLight> {
                 .iter()
                 .enumerate()
                 .filter(|(i, _)| scene.ground != Some(*i))
-                .map(|(i, inst)| {
-                    Sphere::new(
-                        scene.instance_position(i, f),
-                        scene.models[inst.model as usize].radius,
-                    )
-                })
+                .map(|(i, _)| Sphere::new(scene.instance_position(i, f), scene.instance_radius(i)))
                 .collect();
             let r = spheres.iter().map(|s| s.radius).fold(0.0f32, f32::max);
             let (matrix, depth) = crate::effects::shadow::light_matrix(

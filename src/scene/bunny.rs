@@ -190,6 +190,7 @@ pub fn def(
             position,
             yaw: 0.0,
             rotation: glam::Quat::IDENTITY,
+            scale: Vec3::ONE,
         }
     });
     let set = ModelSet {
@@ -327,6 +328,7 @@ pub fn layout(kind: SceneKind, m: &Model, path: &BunnyPath, count: u32) -> Layou
                     position: Vec3::new(camera_x + near_d + i as f32 * dx, 0.0, 0.0),
                     yaw,
                     rotation: glam::Quat::IDENTITY,
+                    scale: Vec3::ONE,
                 })
                 .collect();
             (inst, Motion::Static, near_d + w + 2.0 * m.radius)
@@ -337,6 +339,7 @@ pub fn layout(kind: SceneKind, m: &Model, path: &BunnyPath, count: u32) -> Layou
                 position: Vec3::new(near_d, 0.0, 0.0),
                 yaw,
                 rotation: glam::Quat::IDENTITY,
+                scale: Vec3::ONE,
             }],
             Motion::SweepX {
                 near: near_d,

@@ -169,7 +169,7 @@ impl SceneDef {
             }
             let r = &mut range[inst.model as usize];
             for f in 0..scene.frames {
-                let d = scene.instance_distance(i, f);
+                let d = scene.lod_distance(i, f);
                 *r = (r.0.min(d), r.1.max(d));
             }
         }
@@ -210,7 +210,7 @@ impl SceneDef {
                 .instances
                 .iter()
                 .map(|i| {
-                    let r = self.models[i.model as usize].radius;
+                    let r = self.models[i.model as usize].radius * i.size();
                     path.eyes()
                         .map(|e| e.distance(i.position) + r)
                         .fold(0.0f32, f32::max)

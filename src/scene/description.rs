@@ -8,7 +8,7 @@ use crate::scene::bunny::BunnyPath;
 use crate::scene::config::SceneConfig;
 use crate::scene::def::SceneDef;
 use crate::scene::kind::CameraMode;
-use crate::scene::model::{Model, Motion, Preprocessing, Scene, Unified};
+use crate::scene::model::{Motion, Preprocessing, Scene, Unified};
 use crate::scene::schedule::ScheduleParams;
 use serde::Serialize;
 
@@ -116,6 +116,12 @@ pub struct HierarchyLevel {
 pub struct ModelDescription {
     pub name: String,
     pub radius: f32,
+    /// Its instances at the first instance count.
+    pub instances: usize,
+    /// The smallest and largest of its instances' sizes (`Instance::size`) where any differs from 1: an instance
+    /// `s` times its model's size switches at `s` times the model's switch distances.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sizes: Option<[f32; 2]>,
     pub switch_source: crate::scene::model::SwitchSource,
     pub lods: Vec<LodDescription>,
 }
@@ -220,7 +226,9 @@ impl SceneDef {
             mesh: self.mesh_source.clone(),
             pixel_error: cfg.pixel_error(self.kind, self.height),
             schedule: self.schedule,
-            models: self.models.iter().map(|m| self.describe_model(m)).collect(),
+            models: (0..self.models.len())
+                .map(|m| self.describe_model(m, &first))
+                .collect(),
             motion: first.motion.clone(),
             camera: self.camera_mode,
             lod_generation_ms: self.lod_generation_ms,
@@ -283,11 +291,22 @@ impl SceneDef {
         d
     }
 
-    fn describe_model(&self, m: &Model) -> ModelDescription {
-        let path = self.path();
+    fn describe_model(&self, index: usize, first: &Scene) -> ModelDescription {
+        let (path, m) = (self.path(), &self.models[index]);
+        let sizes: Vec<f32> = (first.instances.iter())
+            .filter(|i| i.model as usize == index)
+            .map(|i| i.size())
+            .collect();
+        let range = sizes
+            .iter()
+            .fold([f32::INFINITY, f32::NEG_INFINITY], |[a, b], &s| {
+                [a.min(s), b.max(s)]
+            });
         ModelDescription {
             name: m.name.clone(),
             radius: m.radius,
+            instances: sizes.len(),
+            sizes: sizes.iter().any(|&s| s != 1.0).then_some(range),
             switch_source: m.switch_source,
             lods: m
                 .chain

@@ -378,7 +378,8 @@ impl Writer {
             node["extensions"] = json!({"MSFT_lod": {"ids": coarser}});
             node["extras"] = json!({
                 "MSFT_screencoverage": coverage,
-                "lodbench_switch_distances": m.switches,
+                // The instance's own: its model's times its size, where lodbench selects its LODs.
+                "lodbench_switch_distances": m.switches.iter().map(|d| d * inst.size()).collect::<Vec<_>>(),
             });
         }
         if m.spin_per_frame != 0.0 {

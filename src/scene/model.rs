@@ -132,6 +132,17 @@ pub struct Instance {
     pub yaw: f32,
     /// A rotation applied before the yaw (a user scene's node rotation; identity elsewhere).
     pub rotation: glam::Quat,
+    /// A scale applied before the rotation, over the model's own (a user scene's placement whose scale differs
+    /// from the one its model bakes in; one elsewhere). Its largest magnitude is the instance's `size`.
+    pub scale: Vec3,
+}
+
+impl Instance {
+    /// How much larger than its model the instance is drawn: the largest magnitude of its scale, the factor by
+    /// which its model's errors, radius and switch distances grow (a bound along the most stretched axis).
+    pub fn size(&self) -> f32 {
+        self.scale.abs().max_element()
+    }
 }
 
 /// How instances move over the frames.
@@ -316,14 +327,27 @@ impl Scene {
         Mat4::from_translation(self.instance_position(i, frame))
             * Mat4::from_rotation_y(inst.yaw)
             * Mat4::from_quat(inst.rotation)
-            * Mat4::from_scale(Vec3::splat(m.scale))
+            * Mat4::from_scale(inst.scale * m.scale)
             * Mat4::from_translation(-m.center)
     }
 
-    /// Distance from the camera to instance `i`'s centre on `frame` (what LOD selection uses).
+    /// Distance from the camera to instance `i`'s centre on `frame`.
     pub fn instance_distance(&self, i: usize, frame: u32) -> f32 {
         self.instance_position(i, frame)
             .distance(self.camera(frame).eye)
+    }
+
+    /// The distance LOD selection compares with instance `i`'s model's switch distances on `frame`: its camera
+    /// distance over its size (an instance twice its model's size shows its model's errors as the model does
+    /// at half the distance).
+    pub fn lod_distance(&self, i: usize, frame: u32) -> f32 {
+        self.instance_distance(i, frame) / self.instances[i].size()
+    }
+
+    /// Instance `i`'s bounding radius (world units): its model's, times its size.
+    pub fn instance_radius(&self, i: usize) -> f32 {
+        let inst = &self.instances[i];
+        self.models[inst.model as usize].radius * inst.size()
     }
 
     pub fn camera(&self, frame: u32) -> Camera {

@@ -110,6 +110,7 @@ pub fn layout(m: &Model, count: u32) -> Layout {
                 ),
                 yaw: rng.next_f32() * std::f32::consts::TAU,
                 rotation: glam::Quat::IDENTITY,
+                scale: Vec3::ONE,
             }
         })
         .collect();

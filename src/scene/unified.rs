@@ -517,6 +517,7 @@ fn finish(
             position: m.center,
             yaw: 0.0,
             rotation: glam::Quat::IDENTITY,
+            scale: Vec3::ONE,
         })
         .collect();
     let data = Unified {

@@ -2,9 +2,10 @@
 //! draws it.
 //!
 //! - Every node with a mesh is an instance (EXT_mesh_gpu_instancing: one instance per entry). Placements of the
-//!   same glTF mesh at the same scale and morph weights share one model, drawn instanced; the node's rotation and
-//!   translation place the instance, its scale is baked into the model (LOD errors and switch distances are per
-//!   model), a mirroring scale with the winding reversed. A transform that shears is refused.
+//!   same glTF mesh and morph weights share one model, drawn instanced, whatever their scale: the model bakes in
+//!   its first placement's scale (a mirroring one with the winding reversed; mirrors share a model of their
+//!   own), every instance carries its rotation, translation and scale over the model's (`models.rs`). A
+//!   transform that shears is refused.
 //! - Skinned meshes are placed by their joints (the node's own transform ignored, as glTF specifies), morph
 //!   targets take their node's weights, else the mesh's. Points and lines are not drawn (a note names the mesh).
 //! - An authored LOD chain (MSFT_lod, or `NAME_LODn` siblings) is one model whose levels are the chain's node
@@ -55,8 +56,7 @@ pub fn def(
     let fov_y = camera.as_ref().and_then(|c| c.0.yfov).unwrap_or(fov_y);
 
     // The models at rest, and how the clip moves their instances.
-    let mut collected =
-        models::Collector::new(file, &mut content, &rig, cfg.materials).collect()?;
+    let mut collected = models::Collector::new(file, &mut content, &rig, cfg).collect()?;
     let materials = Arc::new(std::mem::take(&mut collected.materials));
     let placed = Placed::new(&content, &rig, clip.as_ref(), pv.frames, &collected);
     let deform_specs: Vec<Option<models::DeformSpec>> =
@@ -178,9 +178,10 @@ fn place_instances(pending: &[models::PendingInstance], models: &[Model]) -> Vec
         .iter()
         .map(|i| Instance {
             model: i.model as u32,
-            position: i.translation + i.rotation * models[i.model].center,
+            position: i.translation + i.rotation * (i.scale * models[i.model].center),
             yaw: 0.0,
             rotation: i.rotation,
+            scale: i.scale,
         })
         .collect()
 }
@@ -234,7 +235,7 @@ impl Placed {
             rest: collected
                 .instances
                 .iter()
-                .map(|i| Mat4::from_rotation_translation(i.rotation, i.translation))
+                .map(|i| Mat4::from_scale_rotation_translation(i.scale, i.rotation, i.translation))
                 .collect(),
         }
     }
@@ -307,7 +308,8 @@ fn build_models(
                 .iter()
                 .zip(instances)
                 .filter(|(_, i)| i.model == m)
-                .map(|(s, _)| s.centre.distance(eye))
+                // An instance `size` times its model's shows the model's errors as the model would nearer.
+                .map(|(s, i)| s.centre.distance(eye) / i.scale.abs().max_element())
                 .fold(f32::INFINITY, f32::min),
             None => fit,
         };
@@ -334,7 +336,7 @@ fn last_places(
             let m = &models[i.model as usize];
             (
                 placed.at(k, last).transform_point3(m.center),
-                m.switches.last().copied(),
+                m.switches.last().map(|s| s * i.size()),
             )
         })
         .collect()
@@ -354,10 +356,9 @@ fn clip_eyes(
     }
 }
 
-/// The clip planes: the file camera's when it gives them; else near at 0.02 of the smallest model's radius and far
-/// at 1.5 times the farthest any instance gets from the camera's `eyes` (its keys, `--camera-path`'s, or the
-/// flight's ends), over the
-/// frames (every 64th and the last).
+/// The clip planes: the file camera's when it gives them; else near at 0.02 of the smallest instance's radius and
+/// far at 1.5 times the farthest any instance gets from the camera's `eyes` (its keys, `--camera-path`'s, or the
+/// flight's ends), over the frames (every 64th and the last).
 fn clip_planes(
     models: &[Model],
     instances: &[Instance],
@@ -374,12 +375,12 @@ fn clip_planes(
         .map(|(k, i, f)| {
             let m = &models[i.model as usize];
             let p = placed.at(k, f).transform_point3(m.center);
-            eyes.iter().map(|e| p.distance(*e)).fold(0.0f32, f32::max) + m.radius
+            eyes.iter().map(|e| p.distance(*e)).fold(0.0f32, f32::max) + m.radius * i.size()
         })
         .fold(0.0f32, f32::max);
-    let smallest = models
+    let smallest = instances
         .iter()
-        .map(|m| m.radius)
+        .map(|i| models[i.model as usize].radius * i.size())
         .fold(f32::INFINITY, f32::min);
     let file = camera.as_ref().map(|c| (c.0.znear, c.0.zfar));
     (

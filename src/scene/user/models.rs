@@ -1,6 +1,13 @@
 //! A user scene's models and instances at rest: every placement of the scene drawn as glTF places it, placements
-//! of the same mesh at the same scale and weights sharing one model (drawn instanced), an authored LOD chain one
-//! model whose levels are its node hierarchies, a skinned or morph-animated placement a model of its own.
+//! of the same mesh and weights sharing one model (drawn instanced) whatever their scale, an authored LOD chain
+//! one model whose levels are its node hierarchies, a skinned or morph-animated placement a model of its own.
+//!
+//! A shared model bakes in the scale of its first placement; every other placement carries its scale over that
+//! one as its instance's own (`Instance::scale`), so instances at other scales, stretched or not, draw the same
+//! mesh and LOD chain. Mirrored placements (a negative determinant) share a model of their own: the mirror is
+//! baked in with the winding reversed, as glTF specifies, and the pipelines cull one winding. With `--impostor`,
+//! placements share a model only when their scales differ by a uniform factor: an impostor is lit in its
+//! model's space, which keeps angles only under a uniform scale.
 
 use crate::error::{Error, Result};
 use crate::geometry::gltf::{self, Content, MeshPrimitives, Placement};
@@ -23,7 +30,7 @@ const PALETTE: [[f32; 3]; 6] = [
 /// What makes two placements one model.
 #[derive(Debug, Clone, PartialEq)]
 enum ModelKey {
-    /// Meshes (one per level), scale (to 1e-6, sign kept: a mirror is its own model) and rest weights.
+    /// Meshes (one per level), what the placements' scales must share (`scale_class`) and rest weights.
     Rigid(Vec<Vec<usize>>, [i64; 3], Vec<u32>),
     /// A skinned mesh posed at rest by its skin (its node's transform ignored), and its weights.
     Skinned(usize, usize, Vec<u32>),
@@ -58,6 +65,8 @@ pub struct PendingModel {
     pub levels: Vec<Mesh>,
     pub authored: Option<ChainInfo>,
     pub deform: Option<DeformSpec>,
+    /// The scale baked into `levels` (its first placement's; one for skinned and deformed models).
+    baked: Vec3,
 }
 
 /// How an instance moves when the animation moves it.
@@ -70,13 +79,14 @@ pub enum Anchor {
     Skeleton { root: usize },
 }
 
-/// An instance at rest: its model, the rotation and translation of its model space, what moves it, and the node
-/// it is.
+/// An instance at rest: its model, the rotation, translation and scale (over its model's) of its model space,
+/// what moves it, and the node it is.
 #[derive(Debug, Clone)]
 pub struct PendingInstance {
     pub model: usize,
     pub rotation: Quat,
     pub translation: Vec3,
+    pub scale: Vec3,
     pub anchor: Anchor,
     pub source: InstanceSource,
 }
@@ -99,6 +109,16 @@ fn scale_key(scale: Vec3) -> [i64; 3] {
     scale
         .to_array()
         .map(|s| (f64::from(s) * 1e6).round() as i64)
+}
+
+/// What the scales of placements sharing a model must have in common: their handedness (a mirror is baked into
+/// its model with the winding reversed), or with `uniform_only` their shape (the scale over its largest
+/// magnitude, to 1e-6, signs kept), so that instances differ from their model by a uniform factor.
+fn scale_class(scale: Vec3, uniform_only: bool) -> [i64; 3] {
+    if uniform_only {
+        return scale_key(scale / scale.abs().max_element());
+    }
+    [i64::from(scale.x * scale.y * scale.z < 0.0), 0, 0]
 }
 
 fn weights_key(w: &[f32]) -> Vec<u32> {
@@ -147,7 +167,8 @@ fn skeleton_root(content: &Content<'_>, skin: &gltf::Skin) -> usize {
 }
 
 /// Reads the models of a file: `rig` says what the chosen animation moves (a skinned placement whose joints
-/// move, or whose weights the clip drives, is deformed per frame).
+/// move, or whose weights the clip drives, is deformed per frame); `--materials` and `--impostor` what a model
+/// holds and which placements share one.
 pub struct Collector<'c, 'a> {
     file: &'c str,
     content: &'c mut Content<'a>,
@@ -157,6 +178,8 @@ pub struct Collector<'c, 'a> {
     prims: HashMap<usize, MeshPrimitives>,
     out: Collected,
     noted: Vec<usize>,
+    /// Placements share a model only when their scales differ by a uniform factor (`--impostor`).
+    uniform_only: bool,
 }
 
 impl<'c, 'a> Collector<'c, 'a> {
@@ -164,9 +187,11 @@ impl<'c, 'a> Collector<'c, 'a> {
         file: &'c str,
         content: &'c mut Content<'a>,
         rig: &'c gltf::Rig,
-        materials: crate::geometry::material::MaterialMode,
+        cfg: &crate::scene::config::SceneConfig,
     ) -> Self {
+        let materials = cfg.materials;
         Collector {
+            uniform_only: cfg.impostor.is_some(),
             file,
             content,
             rig,
@@ -357,17 +382,32 @@ impl<'c, 'a> Collector<'c, 'a> {
                     model,
                     rotation: Quat::IDENTITY,
                     translation: Vec3::ZERO,
+                    scale: Vec3::ONE,
                     anchor: Anchor::Skeleton { root },
                     source,
                 });
             }
             return Ok(());
         }
-        let (scale, rotation, translation) = decompose(self.file, &what, p.world)?;
+        self.rigid(p, &prims, source, &what, (index, weights, animated_weights))
+    }
+
+    /// A placement that is no skin: a model shared by mesh, scale class and weights (one of its own when the
+    /// clip drives its weights), placed at its rotation and translation, scaled over its model's.
+    fn rigid(
+        &mut self,
+        p: &Placement,
+        prims: &MeshPrimitives,
+        source: InstanceSource,
+        what: &str,
+        (index, weights, animated_weights): (usize, Vec<f32>, bool),
+    ) -> Result<()> {
+        let (scale, rotation, translation) = decompose(self.file, what, p.world)?;
         let key = if animated_weights {
             ModelKey::Own(index)
         } else {
-            ModelKey::Rigid(vec![vec![p.mesh]], scale_key(scale), weights_key(&weights))
+            let class = scale_class(scale, self.uniform_only);
+            ModelKey::Rigid(vec![vec![p.mesh]], class, weights_key(&weights))
         };
         let spec = animated_weights.then(|| DeformSpec {
             node: p.node,
@@ -375,19 +415,30 @@ impl<'c, 'a> Collector<'c, 'a> {
             targets: prims.target_count(),
             skin: None,
         });
-        let bake = Mat4::from_scale(scale);
         let model = self.model(key, |c| {
-            let mesh = c.mesh_of(p, &prims, bake, Mat4::IDENTITY, animated_weights)?;
-            Ok(Some(c.pending(p.mesh, vec![mesh], spec)))
+            let mesh = c.mesh_of(
+                p,
+                prims,
+                Mat4::from_scale(scale),
+                Mat4::IDENTITY,
+                animated_weights,
+            )?;
+            Ok(Some(PendingModel {
+                baked: scale,
+                ..c.pending(p.mesh, vec![mesh], spec)
+            }))
         })?;
         if let Some(model) = model {
+            // The model bakes its first placement's scale; this placement draws it at its own over that one.
+            let baked = self.out.models[model].baked;
             self.out.instances.push(PendingInstance {
                 model,
                 rotation,
                 translation,
+                scale: scale / baked,
                 anchor: Anchor::Node {
                     node: p.node,
-                    local: p.instance_local * bake.inverse(),
+                    local: p.instance_local * Mat4::from_scale(baked).inverse(),
                 },
                 source,
             });
@@ -407,6 +458,7 @@ impl<'c, 'a> Collector<'c, 'a> {
             levels,
             authored: None,
             deform,
+            baked: Vec3::ONE,
         }
     }
 
@@ -521,6 +573,7 @@ impl<'c, 'a> Collector<'c, 'a> {
                     chain: chain.clone(),
                 }),
                 deform: None,
+                baked: scale,
             }))
         })?;
         if let Some(model) = model {
@@ -531,6 +584,7 @@ impl<'c, 'a> Collector<'c, 'a> {
                 model,
                 rotation,
                 translation,
+                scale: Vec3::ONE,
                 anchor: Anchor::Node {
                     node: root,
                     local: Mat4::from_scale(scale).inverse(),

@@ -16,6 +16,14 @@ folder's own files). Run from anywhere: python3 tests/data/gltf/make_own.py.
   animation). The tetrahedron cannot be simplified (a chain of LOD0 alone, never in transition) and is deformed
   every frame; the sphere crosses its switches and never moves: what lodpop sees of the sphere must not depend
   on the animation.
+- stretched-instances.gltf: the shape of Blender-IO's tests/roundtrip/24_gpu_instancing (one mesh drawn by two
+  EXT_mesh_gpu_instancing nodes, each instance with its own translation, rotation about y and scale), small: a
+  smooth UV sphere (32 segments, 16 rings, radius 1, normals along the radius) under a parent node turned 30 deg
+  about y; node `stretched` (scale 1, 1.3, 1) places 13 instances, node `plain` 12. Every scale differs and
+  stretches (x from 0.6 to 1.4, y and z by other factors); instance 7 of `plain` is mirrored (x negative).
+- stretched-expanded.gltf: the same 25 placements, each a node of its own whose `matrix` is the placement's world
+  matrix, drawing a mesh of its own (25 meshes over the same accessors): what a reader that gives every scale its
+  own model draws, to compare with the shared model's instances.
 - integral-floats.gltf: the unit tetrahedron of ../tetra.gltf with every integer written as an integral float
   (`"byteStride": 12.0`, `"componentType": 5126.0`, `"mesh": 0.0`, ...), which the glTF Validator accepts.
 """
@@ -205,11 +213,133 @@ def still_and_moving() -> dict:
     }
 
 
+def smooth_sphere(segments: int = 32, rings: int = 16) -> tuple[bytes, list, list, int]:
+    """A UV sphere of radius 1 with shared vertices (normal = position): its buffer, accessors, views, count."""
+    verts = []
+    for j in range(rings + 1):
+        theta = math.pi * j / rings
+        for i in range(segments + 1):
+            phi = 2 * math.pi * i / segments
+            verts.append((math.sin(theta) * math.cos(phi), math.cos(theta), math.sin(theta) * math.sin(phi)))
+    tris = []
+    row = segments + 1
+    for j in range(rings):
+        for i in range(segments):
+            a, b, c, d = j * row + i, j * row + i + 1, (j + 1) * row + i + 1, (j + 1) * row + i
+            if j > 0:
+                tris.append((a, b, c))
+            if j < rings - 1:
+                tris.append((a, c, d))
+    pos = b"".join(struct.pack("<3f", *v) for v in verts)
+    idx = b"".join(struct.pack("<3H", *t) for t in tris)
+    data = pos + pos + idx
+    n = len(verts)
+    accessors = [
+        {"bufferView": 0, "componentType": 5126, "count": n, "type": "VEC3", "min": [-1, -1, -1], "max": [1, 1, 1]},
+        {"bufferView": 1, "componentType": 5126, "count": n, "type": "VEC3"},
+        {"bufferView": 2, "componentType": 5123, "count": 3 * len(tris), "type": "SCALAR"},
+    ]
+    views = [
+        {"buffer": 0, "byteOffset": 0, "byteLength": len(pos)},
+        {"buffer": 0, "byteOffset": len(pos), "byteLength": len(pos)},
+        {"buffer": 0, "byteOffset": 2 * len(pos), "byteLength": len(idx)},
+    ]
+    return data, accessors, views, len(data)
+
+
+def stretched_placements() -> list[tuple[str, tuple, float, tuple]]:
+    """The 25 instances: (node, translation, angle about y in radians, scale)."""
+    out = []
+    for k in range(25):
+        node = "stretched" if k < 13 else "plain"
+        x, z = (k % 5 - 2) * 3.0, (k // 5 - 2) * 3.0
+        s = 0.6 + 0.8 * ((k * 7) % 25) / 24
+        scale = (s, s * (1.0 + 0.5 * ((k * 3) % 5) / 4), s * (0.8 + 0.4 * ((k * 2) % 7) / 6))
+        if k == 13 + 7:
+            scale = (-scale[0], scale[1], scale[2])
+        out.append((node, (x, 0.0, z), 0.4 * k, scale))
+    return out
+
+
+def mat_mul(a: list, b: list) -> list:
+    """Column-major 4x4 product a x b."""
+    return [sum(a[r + 4 * k] * b[k + 4 * c] for k in range(4)) for c in range(4) for r in range(4)]
+
+
+def trs(t: tuple, angle: float, s: tuple) -> list:
+    """Column-major T x R_y(angle) x S."""
+    c, n = math.cos(angle), math.sin(angle)
+    return [c * s[0], 0, -n * s[0], 0, 0, s[1], 0, 0, n * s[2], 0, c * s[2], 0, t[0], t[1], t[2], 1]
+
+
+PARENT_ANGLE = math.radians(30.0)
+NODE_SCALE = {"stretched": (1.0, 1.3, 1.0), "plain": (1.0, 1.0, 1.0)}
+
+
+def stretched_instances() -> dict:
+    data, accessors, views, _ = smooth_sphere()
+    places = stretched_placements()
+    nodes = [{"name": "parent", "rotation": [0.0, math.sin(PARENT_ANGLE / 2), 0.0, math.cos(PARENT_ANGLE / 2)],
+              "children": [1, 2]}]
+    for name in ("stretched", "plain"):
+        mine = [p for p in places if p[0] == name]
+        base = len(data)
+        t = b"".join(struct.pack("<3f", *p[1]) for p in mine)
+        r = b"".join(struct.pack("<4f", 0.0, math.sin(p[2] / 2), 0.0, math.cos(p[2] / 2)) for p in mine)
+        sc = b"".join(struct.pack("<3f", *p[3]) for p in mine)
+        data += t + r + sc
+        attrs = {}
+        for key, blob, off, kind in (("TRANSLATION", t, 0, "VEC3"), ("ROTATION", r, len(t), "VEC4"),
+                                     ("SCALE", sc, len(t) + len(r), "VEC3")):
+            views.append({"buffer": 0, "byteOffset": base + off, "byteLength": len(blob)})
+            accessors.append({"bufferView": len(views) - 1, "componentType": 5126, "count": len(mine),
+                              "type": kind})
+            attrs[key] = len(accessors) - 1
+        node = {"name": name, "mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": attrs}}}
+        if NODE_SCALE[name] != (1.0, 1.0, 1.0):
+            node["scale"] = list(NODE_SCALE[name])
+        nodes.append(node)
+    return {
+        "asset": {"version": "2.0", "generator": GENERATOR},
+        "extensionsUsed": ["EXT_mesh_gpu_instancing"],
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": nodes,
+        "meshes": [{"name": "sphere", "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2}]}],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": len(data), "uri": data_uri(data)}],
+    }
+
+
+def stretched_expanded() -> dict:
+    data, accessors, views, _ = smooth_sphere()
+    parent = trs((0.0, 0.0, 0.0), PARENT_ANGLE, (1.0, 1.0, 1.0))
+    nodes, meshes = [], []
+    for k, (name, t, angle, s) in enumerate(stretched_placements()):
+        world = mat_mul(parent, mat_mul(trs((0.0, 0.0, 0.0), 0.0, NODE_SCALE[name]), trs(t, angle, s)))
+        nodes.append({"name": f"{name}.{k}", "mesh": k, "matrix": [round(v, 9) for v in world]})
+        meshes.append({"name": f"sphere{k}", "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1},
+                                                             "indices": 2}]})
+    return {
+        "asset": {"version": "2.0", "generator": GENERATOR},
+        "scene": 0,
+        "scenes": [{"nodes": list(range(len(nodes)))}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": len(data), "uri": data_uri(data)}],
+    }
+
+
 def main() -> None:
     write("faceted-sphere.gltf", faceted_sphere())
     write("lod-hierarchy.gltf", lod_hierarchy())
     write("integral-floats.gltf", integral_floats())
     write("still-and-moving.gltf", still_and_moving())
+    write("stretched-instances.gltf", stretched_instances())
+    write("stretched-expanded.gltf", stretched_expanded())
 
 
 if __name__ == "__main__":
