@@ -213,6 +213,9 @@ pub struct Image {
     pub width: u32,
     pub height: u32,
     pub rgba: Vec<u8>,
+    /// The bytes it was decoded from and their MIME type, where glTF's core reads them (PNG or JPEG): what an
+    /// exported file carries, so that it decodes to the same pixels without an encoder's time or size.
+    pub encoded: Option<(Vec<u8>, &'static str)>,
 }
 
 /// A scene's materials and the images they sample. Material indices of [`crate::geometry::mesh::Part`] point

@@ -214,12 +214,18 @@ impl Writer {
                     img.name
                 )));
             }
-            let png = crate::raster::png_bytes(img.width, img.height, &img.rgba).map_err(|e| {
-                Error::Config(format!("export: {} cannot be encoded: {e}", img.name))
-            })?;
-            let view = self.view(&png, None);
+            // The bytes the image was read from where glTF's core reads them, else PNG.
+            let (view, mime) = match &img.encoded {
+                Some((bytes, mime)) => (self.view(bytes, None), *mime),
+                None => {
+                    let png = crate::raster::png_bytes(img.width, img.height, &img.rgba).map_err(
+                        |e| Error::Config(format!("export: {} cannot be encoded: {e}", img.name)),
+                    )?;
+                    (self.view(&png, None), "image/png")
+                }
+            };
             self.images
-                .push(json!({"bufferView": view, "mimeType": "image/png", "name": img.name}));
+                .push(json!({"bufferView": view, "mimeType": mime, "name": img.name}));
             images.push(self.images.len() - 1);
         }
         let mut out = Vec::with_capacity(materials.materials.len());

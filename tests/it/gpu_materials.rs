@@ -1,9 +1,10 @@
 //! A user scene's materials as the GPU draws them (src/gpu/surface.rs, shaders/surface/pbr.wgsl), on the
 //! fixtures of tests/data/gltf/make_materials.py: texels where the texture and its KHR_texture_transform put
 //! them; cut-out cards covering what their mask covers, at every LOD; a BLEND surface over an opaque one; the
-//! flat surface of `--materials flat` and `reference-flat`; and what a method does not draw, said in run.json.
+//! flat surface of `--materials flat` and `reference-flat`; what a method does not draw, said in run.json; and
+//! the images `lodbench export` carries.
 
-use crate::common::{col, read_csv, run_into};
+use crate::common::{col, lodbench, read_csv, run_into};
 use std::path::{Path, PathBuf};
 
 fn fixture(name: &str) -> PathBuf {
@@ -212,4 +213,45 @@ fn reference_flat_is_the_reference_without_its_materials() {
     let (_, flat_reference) = frame(&flat, name, "reference", 0, "method");
     assert_eq!(reference_flat, flat_reference);
     assert_ne!(reference_flat, textured);
+}
+
+/// `lodbench export` carries each PNG or JPEG image as the bytes it was read from (texel-grid.gltf's PNG, byte for
+/// byte, with its MIME type), so the file it writes decodes to the same pixels without re-encoding them.
+#[test]
+fn an_export_carries_the_images_it_read() {
+    use base64::Engine;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = fixture("texel-grid.gltf");
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&scene).unwrap()).unwrap();
+    let uri = doc["images"][0]["uri"].as_str().unwrap();
+    let source = base64::engine::general_purpose::STANDARD
+        .decode(uri.split_once(',').unwrap().1)
+        .unwrap();
+    let glb = dir.path().join("texel-grid.glb");
+    let (scene, out) = (scene.to_str().unwrap(), glb.to_str().unwrap());
+    let run = lodbench(&["export", "--scene", scene, "--out", out], &[]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    // GLB: a 12-byte header, then the JSON chunk and the BIN chunk, each after its length and type.
+    let bytes = std::fs::read(&glb).unwrap();
+    let chunk = |at: usize| {
+        let len = u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        (&bytes[at + 8..at + 8 + len], at + 8 + len)
+    };
+    let (json, next) = chunk(12);
+    let (bin, _) = chunk(next);
+    let json: serde_json::Value = serde_json::from_slice(json).unwrap();
+    let image = &json["images"][0];
+    assert_eq!(image["mimeType"], "image/png");
+    let view = &json["bufferViews"][image["bufferView"].as_u64().unwrap() as usize];
+    let at = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let len = view["byteLength"].as_u64().unwrap() as usize;
+    assert!(
+        bin[at..at + len] == source[..],
+        "the exported image is the source's bytes"
+    );
 }
