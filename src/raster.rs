@@ -87,7 +87,7 @@ impl RgbaImage {
             x < self.width && y < self.height,
             "pixel ({x}, {y}) outside the picture"
         );
-        (y as usize * self.width as usize + x as usize) * 4
+        self.index_unchecked(x, y)
     }
 
     /// Pixel (x, y); panics outside the picture, as slice indexing does.

@@ -138,11 +138,16 @@ pub struct Instance {
 }
 
 impl Instance {
-    /// How much larger than its model the instance is drawn: the largest magnitude of its scale, the factor by
-    /// which its model's errors, radius and switch distances grow (a bound along the most stretched axis).
+    /// How much larger than its model the instance is drawn ([`size_of`] its scale).
     pub fn size(&self) -> f32 {
-        self.scale.abs().max_element()
+        size_of(self.scale)
     }
+}
+
+/// An instance's size under `scale` (over its model's): the largest magnitude of the scale, the factor by which
+/// its model's errors, radius and switch distances grow (a bound along the most stretched axis).
+pub fn size_of(scale: Vec3) -> f32 {
+    scale.abs().max_element()
 }
 
 /// How instances move over the frames.

@@ -329,9 +329,9 @@ impl Doc<'_> {
         let decoded = decode_image(&bytes, desc["mimeType"].as_str())
             .map_err(|e| format!("{what} cannot be decoded: {e}"))?;
         let (width, height) = decoded.dimensions();
-        let mime = match crate::raster::format_of(&bytes) {
-            Some(crate::raster::Format::Png) => Some("image/png"),
-            Some(crate::raster::Format::Jpeg) => Some("image/jpeg"),
+        let mime = match format_of(&bytes) {
+            Some(Format::Png) => Some("image/png"),
+            Some(Format::Jpeg) => Some("image/jpeg"),
             _ => None,
         };
         let k = table.materials.images.len() as u32;
@@ -340,7 +340,7 @@ impl Doc<'_> {
             width,
             height,
             rgba: decoded.into_raw(),
-            encoded: mime.map(|m| (bytes.to_vec(), m)),
+            encoded: mime.map(|m| (bytes, m)),
         });
         table.images.insert(i, k);
         Ok(k)

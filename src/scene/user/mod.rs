@@ -35,7 +35,7 @@ use crate::geometry::projection::{fit_distance, Sphere};
 use crate::scene::animated::Animated;
 use crate::scene::config::SceneConfig;
 use crate::scene::kind::{ProfileValues, SceneKind};
-use crate::scene::model::{CameraTrack, Instance, Layout, Model, ModelSet, Motion};
+use crate::scene::model::{size_of, CameraTrack, Instance, Layout, Model, ModelSet, Motion};
 use glam::{Mat4, Vec3};
 use std::path::Path;
 use std::sync::Arc;
@@ -309,7 +309,7 @@ fn build_models(
                 .zip(instances)
                 .filter(|(_, i)| i.model == m)
                 // An instance `size` times its model's shows the model's errors as the model would nearer.
-                .map(|(s, i)| s.centre.distance(eye) / i.scale.abs().max_element())
+                .map(|(s, i)| s.centre.distance(eye) / size_of(i.scale))
                 .fold(f32::INFINITY, f32::min),
             None => fit,
         };
